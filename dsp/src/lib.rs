@@ -1,0 +1,15 @@
+//! Signal math on sample slices for the gpsrx GPS L1 C/A receiver.
+//!
+//! This crate knows nothing about files, threads of a pipeline or the command line: it holds pure
+//! functions and small structs over slices of samples, each testable on its own.
+//!
+//! - [`ca_code`]: the GPS L1 C/A Gold codes (IS-GPS-200 section 3.3.2.3).
+//! - [`nco`]: numerically controlled oscillators (fixed-point phase accumulators and sine tables).
+//! - [`constants`]: GPS L1 C/A signal constants.
+
+pub mod ca_code;
+pub mod constants;
+pub mod nco;
+
+pub use ca_code::{CaCode, Prn, PrnError};
+pub use nco::{PhaseAccumulator, SinCosTable};

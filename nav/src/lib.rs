@@ -1,0 +1,1 @@
+//! GPS domain for gpsrx (being written).

@@ -1,0 +1,1 @@
+//! The gpsrx receiver pipeline and its command-line tool.

@@ -1,0 +1,1 @@
+//! IF samples for gpsrx (being written).
