@@ -1,1 +1,8 @@
-//! The gpsrx receiver pipeline and its command-line tool.
+//! The gpsrx receiver: the pipeline from IF samples to fixes, its outputs, studies, and the
+//! `gpsrx` command-line tool built on them.
+//!
+//! - [`cli`]: command-line arguments (clap derive);
+//! - [`commands`]: one module per subcommand.
+
+pub mod cli;
+pub mod commands;

@@ -1,2 +1,31 @@
 //! IF samples for gpsrx: sample formats (read and write), SigMF and WAV files, streaming sample
 //! sources, recording statistics, and the GPS L1 C/A signal simulator.
+//!
+//! - [`format`](mod@format): the sample formats and their names (table there);
+//! - [`source`]: [`source::open_source`] streams complex baseband from any recording;
+//! - [`writer`]: [`writer::create_writer`] / [`writer::create_wav_writer`];
+//! - [`sigmf`]: `.sigmf-meta` read/write; [`wav`]: WAV layout;
+//! - [`info`]: statistics, histogram and spectrum of a recording (`gpsrx info`).
+
+mod chunk;
+mod codec;
+pub mod error;
+pub mod file_source;
+pub mod format;
+pub mod info;
+mod info_notes;
+mod info_text;
+pub mod mixer;
+pub mod resolve;
+pub mod sigmf;
+pub mod sim;
+pub mod source;
+pub mod span;
+mod spectrum;
+pub mod wav;
+pub mod writer;
+
+pub use error::SampleError;
+pub use format::SampleFormat;
+pub use source::{open_source, SampleSource, SourceConfig};
+pub use writer::{create_wav_writer, create_writer, SampleWriter, WriteStats};

@@ -1,0 +1,95 @@
+//! Atmospheric delay models for a single-frequency L1 user:
+//! the broadcast Klobuchar ionosphere (IS-GPS-200 20.3.3.5.2.5, Figure 20-4) and the
+//! Saastamoinen troposphere with a standard atmosphere.
+
+use crate::constants::GPS_PI;
+use crate::frames::Llh;
+pub use crate::utc::UtcParams;
+
+/// Klobuchar ionospheric coefficients as broadcast in subframe 4 page 18
+/// (IS-GPS-200 20.3.3.5.1.7, Table 20-X), in the ICD's semicircle-based units.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct KlobucharParams {
+    /// alpha_0..alpha_3: amplitude polynomial, s, s/semicircle, s/semicircle^2, s/semicircle^3.
+    pub alpha: [f64; 4],
+    /// beta_0..beta_3: period polynomial, s, s/semicircle, s/semicircle^2, s/semicircle^3.
+    pub beta: [f64; 4],
+}
+
+/// Night-time constant delay DC of the Klobuchar model, s (Figure 20-4).
+pub const KLOBUCHAR_NIGHT_DELAY_S: f64 = 5.0e-9;
+
+/// L1 ionospheric group delay from the broadcast Klobuchar model, s
+/// (IS-GPS-200 20.3.3.5.2.5 and Figure 20-4).
+///
+/// `tow_s` is the GPS time of week of the measurement (any value: it is reduced modulo one
+/// day), `rx` the receiver position, `az_rad`/`el_rad` the satellite direction. Inside, angles
+/// are converted to semicircles as the ICD specifies. Returns 0 for satellites at or below
+/// the horizon and for non-finite inputs.
+pub fn klobuchar_delay_s(
+    p: &KlobucharParams,
+    tow_s: f64,
+    rx: &Llh,
+    az_rad: f64,
+    el_rad: f64,
+) -> f64 {
+    if el_rad.is_nan() || el_rad <= 0.0 || !tow_s.is_finite() || !az_rad.is_finite() {
+        return 0.0;
+    }
+    let el_sc = el_rad / GPS_PI;
+    let phi_u = rx.lat_rad / GPS_PI;
+    let lam_u = rx.lon_rad / GPS_PI;
+    // Earth-centred angle between user and ionospheric pierce point, semicircles.
+    let psi = 0.0137 / (el_sc + 0.11) - 0.022;
+    // Geodetic latitude of the pierce point, clamped to +-0.416 semicircles.
+    let phi_i = (phi_u + psi * az_rad.cos()).clamp(-0.416, 0.416);
+    // Geodetic longitude of the pierce point.
+    let lam_i = lam_u + psi * az_rad.sin() / (phi_i * GPS_PI).cos();
+    // Geomagnetic latitude of the pierce point.
+    let phi_m = phi_i + 0.064 * ((lam_i - 1.617) * GPS_PI).cos();
+    // Local time at the pierce point, s, in [0, 86400).
+    let t = (4.32e4 * lam_i + tow_s).rem_euclid(86_400.0);
+    // Obliquity factor.
+    let f = 1.0 + 16.0 * (0.53 - el_sc).powi(3);
+    let poly = |c: &[f64; 4]| c[0] + phi_m * (c[1] + phi_m * (c[2] + phi_m * c[3]));
+    let per = poly(&p.beta).max(72_000.0);
+    let amp = poly(&p.alpha).max(0.0);
+    let x = 2.0 * GPS_PI * (t - 50_400.0) / per;
+    if x.abs() < 1.57 {
+        let x2 = x * x;
+        f * (KLOBUCHAR_NIGHT_DELAY_S + amp * (1.0 - x2 / 2.0 + x2 * x2 / 24.0))
+    } else {
+        f * KLOBUCHAR_NIGHT_DELAY_S
+    }
+}
+
+/// Relative humidity assumed by [`saastamoinen_delay_m`].
+pub const STANDARD_RELATIVE_HUMIDITY: f64 = 0.7;
+
+/// Slant tropospheric delay, m, from the Saastamoinen model with a standard atmosphere
+/// (Saastamoinen 1972; the standard-atmosphere conventions are those of RTKLIB's `tropmodel`):
+///
+/// - P = 1013.25 (1 - 2.2557e-5 h)^5.2568 hPa, T = 15 - 6.5e-3 h + 273.16 K, with h the
+///   receiver height (m, clamped at 0), relative humidity 0.7 and water-vapour pressure
+///   e = 6.108 RH exp((17.15 T - 4684) / (T - 38.45)) hPa;
+/// - dry = 0.0022768 P / (1 - 0.00266 cos(2 lat) - 0.00028 h_km) / cos(z),
+///   wet = 0.002277 (1255 / T + 0.05) e / cos(z), z = pi/2 - el.
+///
+/// The zenith dry delay is about 2.3 m at sea level. Returns 0 for `el_rad <= 0` and for
+/// heights outside [-100 m, 10 km], where the standard atmosphere does not apply.
+pub fn saastamoinen_delay_m(rx: &Llh, el_rad: f64) -> f64 {
+    if el_rad.is_nan() || el_rad <= 0.0 || !(-100.0..=1.0e4).contains(&rx.h_m) {
+        return 0.0;
+    }
+    let h_m = rx.h_m.max(0.0);
+    let pressure_hpa = 1013.25 * (1.0 - 2.2557e-5 * h_m).powf(5.2568);
+    let temp_k = 15.0 - 6.5e-3 * h_m + 273.16;
+    let e_hpa =
+        6.108 * STANDARD_RELATIVE_HUMIDITY * ((17.15 * temp_k - 4684.0) / (temp_k - 38.45)).exp();
+    let cos_z = (std::f64::consts::FRAC_PI_2 - el_rad).cos();
+    let dry_m = 0.0022768 * pressure_hpa
+        / (1.0 - 0.00266 * (2.0 * rx.lat_rad).cos() - 0.00028 * h_m / 1e3)
+        / cos_z;
+    let wet_m = 0.002277 * (1255.0 / temp_k + 0.05) * e_hpa / cos_z;
+    dry_m + wet_m
+}

@@ -1,0 +1,126 @@
+//! Command-line arguments of `gpsrx`.
+
+use clap::{Args, Parser, Subcommand};
+use gpsrx_samples::{SampleFormat, SourceConfig};
+use std::path::PathBuf;
+
+/// gpsrx: a GPS L1 C/A software receiver with INS-aided tracking loops.
+#[derive(Debug, Parser)]
+#[command(name = "gpsrx", version, about, long_about = None)]
+pub struct Cli {
+    /// More log output (or set GPSRX_LOG=debug).
+    #[arg(short, long, global = true)]
+    pub verbose: bool,
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate GPS L1 C/A IF samples (and truth files) from a scenario file.
+    Simulate(SimulateArgs),
+    /// Describe a recording: size, duration, statistics, histogram and spectrum.
+    Info(InfoArgs),
+    /// Simulate the built-in demo scenario and show what was made.
+    Demo(DemoArgs),
+}
+
+/// Options that say how to read a recording; shared by every subcommand that reads one.
+#[derive(Debug, Clone, Args)]
+pub struct SourceArgs {
+    /// The recording (raw samples, .wav, or SigMF .sigmf-meta/.sigmf-data).
+    pub file: PathBuf,
+    /// Sample format: ci8, cu8, ci16_le, cf32_le, cf64_le, ri8, ri16_le, rf32_le, ci2, ri2, ci1
+    /// (default: from SigMF or WAV metadata).
+    #[arg(long)]
+    pub format: Option<String>,
+    /// Sampling rate, Hz (default: from SigMF or WAV metadata).
+    #[arg(long, value_name = "HZ")]
+    pub fs: Option<f64>,
+    /// Intermediate frequency, Hz (real IF is mixed down to baseband).
+    #[arg(long = "if", value_name = "HZ", default_value_t = 0.0, allow_hyphen_values = true)]
+    pub if_hz: f64,
+    /// Read the samples as I - jQ (some front ends invert Q).
+    #[arg(long)]
+    pub invert_q: bool,
+    /// Skip this many seconds from the start of the file.
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub skip: f64,
+    /// Read at most this many seconds.
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+}
+
+impl SourceArgs {
+    /// The sample-source configuration these options describe.
+    pub fn to_config(&self) -> anyhow::Result<SourceConfig> {
+        let format = match &self.format {
+            Some(f) => Some(f.parse::<SampleFormat>()?),
+            None => None,
+        };
+        Ok(SourceConfig {
+            path: self.file.clone(),
+            format,
+            fs_hz: self.fs,
+            if_hz: self.if_hz,
+            invert_q: self.invert_q,
+            skip_s: self.skip,
+            duration_s: self.duration,
+        })
+    }
+}
+
+/// `gpsrx simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Scenario file (TOML); see samples/scenarios/README.md. Omit with --default.
+    pub scenario: Option<PathBuf>,
+    /// Use the built-in default scenario.
+    #[arg(long, conflicts_with = "scenario")]
+    pub default: bool,
+    /// Output directory: the recording, its .sigmf-meta, truth.csv and truth_sv.csv go there.
+    #[arg(short, long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Override the scenario's duration, s.
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Override the scenario's noise seed.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Override the output format.
+    #[arg(long)]
+    pub format: Option<String>,
+    /// Override the sampling rate, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub fs: Option<f64>,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `gpsrx info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// The recording and how to read it.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// Samples read for statistics (the size and duration always cover the whole file).
+    #[arg(long, default_value_t = 4_000_000)]
+    pub max_samples: u64,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `gpsrx demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Keep the simulated files in this directory (default: a temporary directory, removed).
+    #[arg(long, value_name = "DIR")]
+    pub keep: Option<PathBuf>,
+    /// Shorten the demo recording, s (default: the scenario's 40 s).
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+}

@@ -1,0 +1,5 @@
+//! One module per `gpsrx` subcommand.
+
+pub mod demo;
+pub mod info;
+pub mod simulate;

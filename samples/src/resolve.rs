@@ -1,0 +1,212 @@
+//! Working out how to read a recording: which file holds the data, its format, sampling rate, IF
+//! and Q sign, from the configuration first, then SigMF metadata, then a WAV header.
+//!
+//! Metadata lookup for a path `P`:
+//! - `P` ends in `.sigmf-meta`: the data is `P` with `.sigmf-data` (an error if missing);
+//! - otherwise the metadata is `P` with its extension replaced by `.sigmf-meta` (what
+//!   [`crate::sigmf::write_sigmf_meta`] writes), or else `P` + `.sigmf-meta`, if either exists;
+//! - without metadata, a file starting with a RIFF/WAVE header is read as WAV.
+//!
+//! Precedence: `--format` and `--fs` win over metadata (a disagreement is a warning); a non-zero
+//! `if_hz` in the configuration wins over `gpsrx:if_hz`; Q is inverted when the configuration or
+//! the metadata asks for it.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::SampleError;
+use crate::format::SampleFormat;
+use crate::sigmf::read_sigmf_meta;
+use crate::source::SourceConfig;
+use crate::wav::{looks_like_wav, read_wav_layout};
+
+/// Lowest complex sampling rate that holds the C/A main lobe (±1.023 MHz), in Hz.
+pub const MIN_FS_COMPLEX_HZ: f64 = 1.023e6;
+/// Lowest real sampling rate that holds the C/A main lobe, in Hz.
+pub const MIN_FS_REAL_HZ: f64 = 2.046e6;
+
+/// Everything needed to stream a recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Resolved {
+    /// The file holding the samples.
+    pub data_path: PathBuf,
+    /// The metadata file used, if any.
+    pub meta_path: Option<PathBuf>,
+    /// Byte offset of the first sample (a WAV header's length, else 0).
+    pub data_offset: u64,
+    /// Bytes of sample data.
+    pub data_bytes: u64,
+    /// How samples are stored.
+    pub format: SampleFormat,
+    /// Sampling rate.
+    pub fs_hz: f64,
+    /// Intermediate frequency to mix down.
+    pub if_hz: f64,
+    /// Read as I - jQ.
+    pub invert_q: bool,
+    /// Disagreements between configuration and metadata, and similar notes.
+    pub warnings: Vec<String>,
+}
+
+fn has_extension(path: &Path, ext: &str) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+}
+
+/// Finds the data file and its metadata file for `path`.
+fn locate(path: &Path) -> Result<(PathBuf, Option<PathBuf>), SampleError> {
+    if has_extension(path, "sigmf-meta") {
+        let data = path.with_extension("sigmf-data");
+        if !data.is_file() {
+            return Err(SampleError::SigmfMissingData {
+                meta: path.to_path_buf(),
+                data,
+            });
+        }
+        return Ok((data, Some(path.to_path_buf())));
+    }
+    let by_stem = path.with_extension("sigmf-meta");
+    let mut by_name = path.as_os_str().to_owned();
+    by_name.push(".sigmf-meta");
+    let by_name = PathBuf::from(by_name);
+    let meta = [by_stem, by_name].into_iter().find(|p| p.is_file());
+    Ok((path.to_path_buf(), meta))
+}
+
+/// Checks fs and IF against what GPS L1 C/A needs.
+pub fn validate_rates(
+    path: &Path,
+    format: &SampleFormat,
+    fs_hz: f64,
+    if_hz: f64,
+) -> Result<(), SampleError> {
+    let complex = format.is_complex();
+    let (min_hz, kind) = if complex {
+        (MIN_FS_COMPLEX_HZ, "complex")
+    } else {
+        (MIN_FS_REAL_HZ, "real")
+    };
+    let bad = |reason| SampleError::BadSampleRate {
+        path: path.to_path_buf(),
+        fs_hz,
+        min_hz,
+        kind,
+        reason,
+    };
+    if !(fs_hz.is_finite() && fs_hz > 0.0) {
+        return Err(bad("not a positive finite number"));
+    }
+    if fs_hz < min_hz {
+        return Err(bad("too low for GPS L1 C/A"));
+    }
+    let half = fs_hz / 2.0;
+    let ok = if complex {
+        if_hz.is_finite() && if_hz.abs() <= half
+    } else {
+        if_hz.is_finite() && if_hz > 0.0 && if_hz < half
+    };
+    if !ok {
+        let allowed = if complex {
+            format!("[-{half}, {half}] Hz (complex samples: |IF| <= fs/2)")
+        } else {
+            format!("(0, {half}) Hz (real samples need 0 < IF < fs/2)")
+        };
+        return Err(SampleError::IfOutOfRange {
+            path: path.to_path_buf(),
+            if_hz,
+            fs_hz,
+            allowed,
+        });
+    }
+    Ok(())
+}
+
+/// Resolves `cfg` into a readable recording (see the module documentation).
+pub fn resolve(cfg: &SourceConfig) -> Result<Resolved, SampleError> {
+    let path = &cfg.path;
+    if !path.exists() {
+        return Err(SampleError::NotFound { path: path.clone() });
+    }
+    if !path.is_file() {
+        return Err(SampleError::NotAFile { path: path.clone() });
+    }
+    let (data_path, meta_path) = locate(path)?;
+    let meta = meta_path.as_deref().map(read_sigmf_meta).transpose()?;
+    let wav = if meta.is_none() && looks_like_wav(&data_path) {
+        Some(read_wav_layout(&data_path)?)
+    } else {
+        None
+    };
+    let mut warnings = Vec::new();
+
+    // Format: configuration, then SigMF, then WAV.
+    let described = match (&meta, &meta_path, &wav) {
+        (Some(m), Some(p), _) => Some((m.sample_format(p), "SigMF metadata")),
+        (_, _, Some(w)) => Some((Ok(w.format.clone()), "WAV header")),
+        _ => None,
+    };
+    let format = match (&cfg.format, described) {
+        (Some(f), Some((Ok(d), source))) => {
+            if *f != d {
+                warnings.push(format!("--format {f} overrides {d} from the {source}"));
+            }
+            f.clone()
+        }
+        (Some(f), _) => f.clone(),
+        (None, Some((d, _))) => d?,
+        (None, None) => return Err(SampleError::FormatUnknown { path: path.clone() }),
+    };
+    format.validate()?;
+
+    // Sampling rate likewise.
+    let described_fs = meta
+        .as_ref()
+        .map(|m| m.sample_rate_hz)
+        .filter(|&fs| fs > 0.0)
+        .or(wav.as_ref().map(|w| w.fs_hz));
+    let fs_hz = match (cfg.fs_hz, described_fs) {
+        (Some(fs), Some(d)) => {
+            if fs != d {
+                warnings.push(format!("--fs {fs} Hz overrides {d} Hz from the metadata"));
+            }
+            fs
+        }
+        (Some(fs), None) => fs,
+        (None, Some(d)) => d,
+        (None, None) => return Err(SampleError::SampleRateUnknown { path: path.clone() }),
+    };
+    let if_hz = match (&meta, cfg.if_hz) {
+        (Some(m), 0.0) => m.if_hz,
+        (_, if_hz) => if_hz,
+    };
+    let invert_q = cfg.invert_q || meta.as_ref().is_some_and(|m| m.invert_q);
+    validate_rates(path, &format, fs_hz, if_hz)?;
+
+    let file_len = std::fs::metadata(&data_path)
+        .map_err(|e| SampleError::io("read the size of", &data_path, e))?
+        .len();
+    let (data_offset, data_bytes) = match &wav {
+        Some(w) => {
+            let present = file_len.saturating_sub(w.data_offset);
+            if w.data_bytes > present {
+                warnings.push(format!(
+                    "WAV header announces {} data bytes but the file holds {present}: reading what is there",
+                    w.data_bytes
+                ));
+            }
+            (w.data_offset, w.data_bytes.min(present))
+        }
+        None => (0, file_len),
+    };
+    Ok(Resolved {
+        data_path,
+        meta_path,
+        data_offset,
+        data_bytes,
+        format,
+        fs_hz,
+        if_hz,
+        invert_q,
+        warnings,
+    })
+}

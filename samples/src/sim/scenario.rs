@@ -1,0 +1,529 @@
+//! Simulator scenarios: the TOML file that says what to simulate.
+//!
+//! Every key is documented in `samples/scenarios/README.md`; unknown keys are rejected with the
+//! list of valid ones (a misspelt option must never be silently ignored).
+
+use crate::format::SampleFormat;
+use crate::sim::SimError;
+use gpsrx_nav::time::GpsTime;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The file name a scenario uses to ask for the broadcast ephemerides shipped inside the binary
+/// (`samples/data/brdc0010.22n`, 2022-01-01).
+pub const BUILTIN_NAV: &str = "builtin:brdc0010.22n";
+
+/// The shipped RINEX navigation file, embedded so that `gpsrx demo` needs no other file.
+pub const BUILTIN_NAV_TEXT: &str = include_str!("../../data/brdc0010.22n");
+
+/// The default scenario (static receiver in Seoul, 2022-01-01, 40 s, 4 MHz ci8).
+pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../../scenarios/default.toml");
+
+/// A complete simulation scenario.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Free text describing the scenario.
+    #[serde(default)]
+    pub description: String,
+    /// GPS time of the first sample (receiver clock).
+    pub start: StartTime,
+    /// Length of the recording, seconds.
+    pub duration_s: f64,
+    /// Seed of the noise generator: the same seed gives the same bytes.
+    #[serde(default)]
+    pub seed: u64,
+    /// RINEX 2/3 navigation file (relative to the scenario file), or `builtin:brdc0010.22n`.
+    pub nav: String,
+    /// Output file format, sampling rate and quantisation.
+    pub output: OutputConfig,
+    /// Receiver trajectory.
+    pub receiver: ReceiverConfig,
+    /// Receiver clock.
+    #[serde(default)]
+    pub clock: ClockConfig,
+    /// Which satellites, how strong.
+    #[serde(default)]
+    pub satellites: SatelliteConfig,
+    /// Ionosphere and troposphere switches.
+    #[serde(default)]
+    pub atmosphere: AtmosphereConfig,
+    /// Signal blockages.
+    #[serde(default)]
+    pub outages: Vec<Outage>,
+    /// Truth output options.
+    #[serde(default)]
+    pub truth: TruthConfig,
+}
+
+/// Start time: either `week` + `tow_s`, or a GPS-time calendar string `"2022-01-01 05:30:00"`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StartTime {
+    /// Full GPS week number (not modulo 1024).
+    pub week: Option<u32>,
+    /// GPS time of week, seconds.
+    pub tow_s: Option<f64>,
+    /// Calendar date and time in the GPS time scale, `YYYY-MM-DD HH:MM:SS`.
+    pub gps_calendar: Option<String>,
+}
+
+/// Output sample format and rate.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputConfig {
+    /// Sample format name (`ci8`, `ci16_le`, `cf32_le`, `ri8`, `ci2`, `ci1`, ...).
+    pub format: String,
+    /// Sampling rate, Hz.
+    pub fs_hz: f64,
+    /// Intermediate frequency, Hz (0 for complex baseband).
+    #[serde(default)]
+    pub if_hz: f64,
+    /// Noise standard deviation per component in output units (LSBs for integer formats).
+    /// Default: 20 for 8-bit, 1000 for 16-bit, 1.0 for float, 2.0 for 2-bit (threshold at 1 sigma),
+    /// 1.0 for 1-bit.
+    pub noise_sigma: Option<f64>,
+    /// File name stem of the recording inside the output directory.
+    #[serde(default = "default_name")]
+    pub name: String,
+}
+
+fn default_name() -> String {
+    "signal".to_string()
+}
+
+/// The receiver's motion.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ReceiverConfig {
+    /// A fixed antenna, given as `llh_deg = [lat, lon, h]` or `ecef_m = [x, y, z]`.
+    Static {
+        /// Latitude (deg), longitude (deg), height over the WGS-84 ellipsoid (m).
+        llh_deg: Option<[f64; 3]>,
+        /// ECEF position, m.
+        ecef_m: Option<[f64; 3]>,
+    },
+    /// Positions from a CSV file (`t_s,x_m,y_m,z_m` ECEF or `t_s,lat_deg,lon_deg,h_m`) at any
+    /// rate, interpolated by a natural cubic spline (position, velocity and acceleration
+    /// continuous).
+    Csv {
+        /// Path of the CSV file, relative to the scenario file.
+        path: String,
+    },
+    /// Built-in horizontal motions in the local level frame at the start point.
+    Motion {
+        /// Start position: latitude (deg), longitude (deg), height (m).
+        start_llh_deg: [f64; 3],
+        /// Initial heading, degrees clockwise from north.
+        #[serde(default)]
+        heading_deg: f64,
+        /// Initial speed, m/s.
+        #[serde(default)]
+        speed_mps: f64,
+        /// Time over which longitudinal acceleration and turn rate change between segments
+        /// (linear ramps, so the jerk is bounded), seconds. 0 gives acceleration steps.
+        #[serde(default = "default_transition")]
+        transition_s: f64,
+        /// Motion segments, one after the other; after the last, the motion continues at
+        /// constant velocity.
+        segments: Vec<Segment>,
+    },
+}
+
+fn default_transition() -> f64 {
+    0.5
+}
+
+/// One segment of a built-in motion.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Segment {
+    /// Constant velocity.
+    Cruise {
+        /// Length, s.
+        duration_s: f64,
+    },
+    /// Constant longitudinal acceleration (negative to brake).
+    Accelerate {
+        /// Length, s.
+        duration_s: f64,
+        /// Longitudinal acceleration, m/s^2.
+        accel_mps2: f64,
+    },
+    /// A turn at the current speed with a given radius or centripetal acceleration.
+    Turn {
+        /// Length, s.
+        duration_s: f64,
+        /// Turn radius, m (give this or `accel_g`).
+        radius_m: Option<f64>,
+        /// Centripetal acceleration in g (9.80665 m/s^2), instead of a radius.
+        accel_g: Option<f64>,
+        /// `"left"` or `"right"` (default right).
+        #[serde(default)]
+        direction: TurnDirection,
+    },
+    /// Longitudinal acceleration ramping at a constant jerk from its current value.
+    Jerk {
+        /// Length, s.
+        duration_s: f64,
+        /// Jerk, m/s^3.
+        jerk_mps3: f64,
+    },
+}
+
+/// Turn direction.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TurnDirection {
+    /// Counter-clockwise seen from above.
+    Left,
+    /// Clockwise seen from above.
+    #[default]
+    Right,
+}
+
+/// Receiver clock model: `b(t) = bias_s + drift_s_s * t + w(t)`, `w` a white-frequency-noise
+/// random walk whose Allan deviation at 1 s is `allan_deviation_1s`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClockConfig {
+    /// Clock bias at the first sample, seconds.
+    #[serde(default)]
+    pub bias_s: f64,
+    /// Clock drift, s/s (1e-6 = 1 ppm, about -1575 Hz of Doppler offset).
+    #[serde(default)]
+    pub drift_s_s: f64,
+    /// Allan deviation at tau = 1 s of the white frequency noise (0 = none).
+    #[serde(default)]
+    pub allan_deviation_1s: f64,
+}
+
+/// Satellite selection and signal strength.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SatelliteConfig {
+    /// Elevation mask, degrees: satellites below it at the start are not simulated.
+    #[serde(default = "default_mask")]
+    pub elevation_mask_deg: f64,
+    /// Simulate only these PRNs (those above the horizon); default all above the mask.
+    pub prns: Option<Vec<u8>>,
+    /// C/N0 at zenith, dB-Hz (elevation model: `zenith - horizon_loss * (1 - sin el)`).
+    #[serde(default = "default_cn0_zenith")]
+    pub cn0_zenith_dbhz: f64,
+    /// C/N0 loss from zenith to the horizon, dB.
+    #[serde(default = "default_cn0_loss")]
+    pub cn0_horizon_loss_db: f64,
+    /// One C/N0 for every satellite, dB-Hz, instead of the elevation model.
+    pub cn0_all_dbhz: Option<f64>,
+    /// Per-satellite C/N0 overrides.
+    #[serde(default)]
+    pub cn0: Vec<Cn0Override>,
+    /// Modulate the navigation data bits (false: a dataless signal, for loop studies).
+    #[serde(default = "default_true")]
+    pub nav_data: bool,
+}
+
+impl Default for SatelliteConfig {
+    fn default() -> Self {
+        Self {
+            elevation_mask_deg: default_mask(),
+            prns: None,
+            cn0_zenith_dbhz: default_cn0_zenith(),
+            cn0_horizon_loss_db: default_cn0_loss(),
+            cn0_all_dbhz: None,
+            cn0: Vec::new(),
+            nav_data: true,
+        }
+    }
+}
+
+fn default_mask() -> f64 {
+    5.0
+}
+fn default_cn0_zenith() -> f64 {
+    47.0
+}
+fn default_cn0_loss() -> f64 {
+    9.0
+}
+fn default_true() -> bool {
+    true
+}
+
+/// A fixed C/N0 for one satellite.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cn0Override {
+    /// PRN.
+    pub prn: u8,
+    /// C/N0, dB-Hz.
+    pub dbhz: f64,
+}
+
+/// Atmosphere switches.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AtmosphereConfig {
+    /// Klobuchar ionosphere from the nav file's alpha/beta (code delayed, carrier advanced).
+    #[serde(default = "default_true")]
+    pub ionosphere: bool,
+    /// Saastamoinen troposphere (standard atmosphere).
+    #[serde(default = "default_true")]
+    pub troposphere: bool,
+}
+
+impl Default for AtmosphereConfig {
+    fn default() -> Self {
+        Self {
+            ionosphere: true,
+            troposphere: true,
+        }
+    }
+}
+
+/// A window in which signals are blocked.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Outage {
+    /// Start, seconds from the first sample.
+    pub start_s: f64,
+    /// End, seconds from the first sample.
+    pub end_s: f64,
+    /// Blocked PRNs (empty: all).
+    #[serde(default)]
+    pub prns: Vec<u8>,
+}
+
+/// Truth output options.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TruthConfig {
+    /// Rate of `truth.csv` and `truth_sv.csv` rows, Hz.
+    #[serde(default = "default_truth_rate")]
+    pub rate_hz: f64,
+}
+
+impl Default for TruthConfig {
+    fn default() -> Self {
+        Self {
+            rate_hz: default_truth_rate(),
+        }
+    }
+}
+
+fn default_truth_rate() -> f64 {
+    100.0
+}
+
+impl Scenario {
+    /// Parses a scenario from TOML text. `base_dir` resolves relative paths in it.
+    pub fn from_toml(text: &str) -> Result<Self, SimError> {
+        let sc: Scenario = toml::from_str(text).map_err(|e| SimError::Scenario(e.to_string()))?;
+        sc.validate()?;
+        Ok(sc)
+    }
+
+    /// Reads and validates a scenario file.
+    pub fn load(path: &Path) -> Result<(Self, PathBuf), SimError> {
+        let text = std::fs::read_to_string(path).map_err(|e| SimError::Io {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let sc = Self::from_toml(&text).map_err(|e| match e {
+            SimError::Scenario(m) => SimError::Scenario(format!("{}: {m}", path.display())),
+            other => other,
+        })?;
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Ok((sc, base))
+    }
+
+    /// The built-in default scenario.
+    pub fn default_scenario() -> Result<Self, SimError> {
+        Self::from_toml(DEFAULT_SCENARIO_TOML)
+    }
+
+    /// GPS time of the first sample.
+    pub fn start_time(&self) -> Result<GpsTime, SimError> {
+        let s = &self.start;
+        match (s.week, s.tow_s, &s.gps_calendar) {
+            (Some(w), Some(t), None) => Ok(GpsTime::new(w, t)),
+            (None, None, Some(c)) => parse_calendar(c),
+            _ => Err(SimError::Scenario(
+                "[start] needs either `week` and `tow_s`, or `gps_calendar = \"YYYY-MM-DD HH:MM:SS\"`"
+                    .into(),
+            )),
+        }
+    }
+
+    /// The output sample format.
+    pub fn format(&self) -> Result<SampleFormat, SimError> {
+        self.output
+            .format
+            .parse::<SampleFormat>()
+            .map_err(|e| SimError::Scenario(format!("[output] format: {e}")))
+    }
+
+    /// Noise standard deviation per component in output units.
+    pub fn noise_sigma(&self) -> Result<f64, SimError> {
+        if let Some(s) = self.output.noise_sigma {
+            return Ok(s);
+        }
+        let fmt = self.format()?;
+        Ok(match fmt {
+            SampleFormat::Ci8 | SampleFormat::Ri8 | SampleFormat::Cu8 { .. } => 20.0,
+            SampleFormat::Ci16Le | SampleFormat::Ri16Le => 1000.0,
+            SampleFormat::Cf32Le | SampleFormat::Cf64Le | SampleFormat::Rf32Le => 1.0,
+            SampleFormat::Packed2 { map, .. } => {
+                // Threshold halfway between the inner and outer levels at 1 sigma.
+                let inner = map.iter().map(|v| v.abs()).fold(f32::INFINITY, f32::min);
+                let outer = map.iter().map(|v| v.abs()).fold(0.0f32, f32::max);
+                f64::from(inner + outer) / 2.0
+            }
+            SampleFormat::Packed1Complex => 1.0,
+        })
+    }
+
+    /// Checks values that TOML types cannot.
+    pub fn validate(&self) -> Result<(), SimError> {
+        let bad = |m: String| Err(SimError::Scenario(m));
+        self.start_time()?;
+        let fmt = self.format()?;
+        if !(self.duration_s.is_finite() && self.duration_s > 0.0) {
+            return bad(format!("duration_s = {} must be positive", self.duration_s));
+        }
+        let fs = self.output.fs_hz;
+        let min_fs = if fmt.is_complex() { 1.023e6 } else { 2.046e6 };
+        if !(fs.is_finite() && fs >= min_fs) {
+            return bad(format!(
+                "[output] fs_hz = {fs} is too low for GPS L1 C/A: at least {min_fs} Hz for {} samples",
+                if fmt.is_complex() { "complex" } else { "real" }
+            ));
+        }
+        let f_if = self.output.if_hz;
+        if !f_if.is_finite() || (fmt.is_complex() && f_if.abs() >= fs / 2.0) {
+            return bad(format!(
+                "[output] if_hz = {f_if} is outside the band (|IF| < fs/2)"
+            ));
+        }
+        if !fmt.is_complex() && !(f_if > 1.023e6 && f_if < fs / 2.0 - 1.023e6) {
+            return bad(format!(
+                "[output] if_hz = {f_if}: a real output needs 1.023 MHz < IF < fs/2 - 1.023 MHz \
+                 so the main lobe does not fold over DC or Nyquist"
+            ));
+        }
+        if let Some(s) = self.output.noise_sigma {
+            if !(s.is_finite() && s > 0.0) {
+                return bad(format!("[output] noise_sigma = {s} must be positive"));
+            }
+        }
+        if !(self.truth.rate_hz > 0.0 && self.truth.rate_hz <= 1000.0) {
+            return bad(format!(
+                "[truth] rate_hz = {} must be in (0, 1000]",
+                self.truth.rate_hz
+            ));
+        }
+        if let Some(prns) = &self.satellites.prns {
+            for &p in prns {
+                if !(1..=32).contains(&p) {
+                    return bad(format!("[satellites] prns: {p} is not a GPS PRN (1-32)"));
+                }
+            }
+        }
+        for c in &self.satellites.cn0 {
+            if !(1..=32).contains(&c.prn) || !c.dbhz.is_finite() {
+                return bad(format!(
+                    "[[satellites.cn0]] prn {} dbhz {} is invalid",
+                    c.prn, c.dbhz
+                ));
+            }
+        }
+        for o in &self.outages {
+            if !(o.start_s.is_finite() && o.end_s.is_finite() && o.end_s > o.start_s) {
+                return bad(format!(
+                    "[[outages]] {}..{} s: end must follow start",
+                    o.start_s, o.end_s
+                ));
+            }
+        }
+        if self.clock.allan_deviation_1s < 0.0 || !self.clock.allan_deviation_1s.is_finite() {
+            return bad("[clock] allan_deviation_1s must be >= 0".into());
+        }
+        match &self.receiver {
+            ReceiverConfig::Static { llh_deg, ecef_m } => {
+                if llh_deg.is_some() == ecef_m.is_some() {
+                    return bad(
+                        "[receiver] kind = \"static\" needs exactly one of llh_deg or ecef_m"
+                            .into(),
+                    );
+                }
+            }
+            ReceiverConfig::Csv { .. } => {}
+            ReceiverConfig::Motion {
+                segments,
+                transition_s,
+                ..
+            } => {
+                if *transition_s < 0.0 {
+                    return bad("[receiver] transition_s must be >= 0".into());
+                }
+                for s in segments {
+                    if let Segment::Turn {
+                        radius_m, accel_g, ..
+                    } = s
+                    {
+                        if radius_m.is_some() == accel_g.is_some() {
+                            return bad(
+                                "a turn segment needs exactly one of radius_m or accel_g".into()
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads the navigation data the scenario names.
+    pub fn nav_text(&self, base_dir: &Path) -> Result<(String, String), SimError> {
+        if self.nav == BUILTIN_NAV {
+            return Ok((BUILTIN_NAV_TEXT.to_string(), BUILTIN_NAV.to_string()));
+        }
+        let p = base_dir.join(&self.nav);
+        let text = std::fs::read_to_string(&p).map_err(|e| SimError::Io {
+            path: p.clone(),
+            message: format!("{e} (the scenario's `nav` is relative to the scenario file; `{BUILTIN_NAV}` uses the shipped file)"),
+        })?;
+        Ok((text, p.display().to_string()))
+    }
+}
+
+fn parse_calendar(c: &str) -> Result<GpsTime, SimError> {
+    let err = || {
+        SimError::Scenario(format!(
+            "[start] gps_calendar = \"{c}\": expected \"YYYY-MM-DD HH:MM:SS\" (GPS time scale)"
+        ))
+    };
+    let c = c.trim().replace('T', " ");
+    let (date, time) = c.split_once(' ').ok_or_else(err)?;
+    let d: Vec<&str> = date.split('-').collect();
+    let t: Vec<&str> = time.trim().split(':').collect();
+    if d.len() != 3 || t.len() != 3 {
+        return Err(err());
+    }
+    let y: i32 = d[0].parse().map_err(|_| err())?;
+    let mo: u32 = d[1].parse().map_err(|_| err())?;
+    let da: u32 = d[2].parse().map_err(|_| err())?;
+    let h: u32 = t[0].parse().map_err(|_| err())?;
+    let mi: u32 = t[1].parse().map_err(|_| err())?;
+    let s: f64 = t[2].parse().map_err(|_| err())?;
+    if !(1980..=2200).contains(&y)
+        || !(1..=12).contains(&mo)
+        || !(1..=31).contains(&da)
+        || h > 23
+        || mi > 59
+        || !(0.0..60.0).contains(&s)
+    {
+        return Err(err());
+    }
+    Ok(GpsTime::from_calendar(y, mo, da, h, mi, s))
+}

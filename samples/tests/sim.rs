@@ -1,0 +1,337 @@
+//! The simulator against its own truth and against independent references.
+//!
+//! The replica used here is built from the C/A code generator (checked against IS-GPS-200
+//! Table 3-Ia) and the truth phases; the samples are read back from the written file through the
+//! same `open_source` any recording goes through, so quantisation and file layout are included.
+
+use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
+use gpsrx_dsp::{CaCode, Prn};
+use gpsrx_nav::lnav::decode_subframe;
+use gpsrx_nav::rinex_nav::parse_rinex_nav;
+use gpsrx_samples::sim::geometry::rotate_earth;
+use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
+use gpsrx_samples::sim::{Scenario, SimSatellite, Simulator};
+use gpsrx_samples::{open_source, SourceConfig};
+use num_complex::Complex32;
+use std::path::Path;
+
+fn scenario(extra: &str, duration_s: f64, fs_hz: f64, format: &str) -> Scenario {
+    let text = format!(
+        r#"
+duration_s = {duration_s}
+seed = 5
+nav = "builtin:brdc0010.22n"
+[start]
+week = 2190
+tow_s = 538194.0
+[output]
+format = "{format}"
+fs_hz = {fs_hz}
+[receiver]
+kind = "static"
+llh_deg = [37.5665, 126.9780, 40.0]
+[clock]
+bias_s = 2.0e-4
+drift_s_s = 5.0e-8
+{extra}
+"#
+    );
+    Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Reads a whole (small) recording back as complex baseband.
+fn read_all(path: &Path) -> Vec<Complex32> {
+    let cfg = SourceConfig {
+        path: path.to_path_buf(),
+        format: None,
+        fs_hz: None,
+        if_hz: 0.0,
+        invert_q: false,
+        skip_s: 0.0,
+        duration_s: None,
+    };
+    let mut src = open_source(&cfg).unwrap_or_else(|e| panic!("{e}"));
+    let mut all = Vec::new();
+    let mut buf = vec![Complex32::new(0.0, 0.0); 1 << 16];
+    loop {
+        let (_, n) = src.read(&mut buf).unwrap_or_else(|e| panic!("{e}"));
+        if n == 0 {
+            break;
+        }
+        all.extend_from_slice(&buf[..n]);
+    }
+    all
+}
+
+/// Prompt correlation over samples `[k0, k0 + n)` with a replica of `prn` placed at the truth
+/// code phase and carrier phase (plus `code_offset_chips`), using the simulator's propagation
+/// model as truth.
+fn correlate(
+    sim: &Simulator,
+    sat: &SimSatellite,
+    x: &[Complex32],
+    fs: f64,
+    k0: usize,
+    n: usize,
+    code_offset_chips: f64,
+    replica_prn: Prn,
+) -> Complex32 {
+    let code = CaCode::new(replica_prn);
+    let t0 = k0 as f64 / fs;
+    let t1 = (k0 + n) as f64 / fs;
+    let (o0, _) = sim.observe(sat, t0);
+    let (o1, _) = sim.observe(sat, t1);
+    let mut acc = Complex32::new(0.0, 0.0);
+    for i in 0..n {
+        let u = i as f64 / n as f64;
+        let chips = o0.chips + u * (o1.chips - o0.chips) + code_offset_chips;
+        let ph = o0.carrier_cycles + u * (o1.carrier_cycles - o0.carrier_cycles);
+        let c = f32::from(code.chip(chips.rem_euclid(1023.0) as usize));
+        let rot = Complex32::from_polar(1.0, (-2.0 * std::f64::consts::PI * ph.rem_euclid(1.0)) as f32);
+        acc += x[k0 + i] * rot * c;
+    }
+    acc
+}
+
+#[test]
+fn correlation_at_truth_gives_the_configured_cn0_and_phase() {
+    // Two satellites at fixed C/N0 (45 and 35 dB-Hz), 1.5 s at 2.048 MHz ci8.
+    let sc = scenario(
+        "[satellites]\nprns = [16, 26, 31]\ncn0 = [{ prn = 16, dbhz = 45.0 }, { prn = 26, dbhz = 35.0 }, { prn = 31, dbhz = 40.0 }]\n[truth]\nrate_hz = 10.0",
+        1.5,
+        2.048e6,
+        "ci8",
+    );
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let report = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    let x = read_all(&report.data_path);
+    let fs = 2.048e6;
+    let n = (fs * 1e-3) as usize; // 1 ms coherent
+    let unused = Prn::new(1).unwrap_or_else(|e| panic!("{e}"));
+    for (prn, cn0_set) in [(16u8, 45.0), (26, 35.0), (31, 40.0)] {
+        let sat = sim
+            .satellites
+            .iter()
+            .find(|s| s.prn.get() == prn)
+            .unwrap_or_else(|| panic!("G{prn}"));
+        let mut sig = 0.0f64;
+        let mut noise = 0.0f64;
+        let mut phase_err = Vec::new();
+        let blocks = 1400;
+        for b in 0..blocks {
+            let k0 = 20 * n + b * n;
+            let p = correlate(&sim, sat, &x, fs, k0, n, 0.0, sat.prn);
+            sig += f64::from(p.norm_sqr());
+            // The noise floor: the same samples against a PRN that is not transmitted.
+            noise += f64::from(correlate(&sim, sat, &x, fs, k0, n, 0.0, unused).norm_sqr());
+            // Data bits flip the sign: fold the phase into (-90, 90] degrees.
+            let mut ph = f64::from(p.arg()).to_degrees();
+            if ph > 90.0 {
+                ph -= 180.0;
+            } else if ph <= -90.0 {
+                ph += 180.0;
+            }
+            phase_err.push(ph);
+        }
+        let (sig, noise) = (sig / blocks as f64, noise / blocks as f64);
+        // E|P|^2 = A^2 N^2 + 2 sigma^2 N and E|noise|^2 = 2 sigma^2 N, so
+        // C/N0 = (E|P|^2 - noise) / noise / T with T = 1 ms.
+        let cn0 = 10.0 * ((sig - noise) / noise / 1e-3).log10();
+        // Tolerance 1 dB (the issue's requirement); the estimate's own scatter over 1400 ms is
+        // 0.1-0.3 dB, quantisation to 8 bits at sigma = 20 LSB costs < 0.01 dB.
+        assert!(
+            (cn0 - cn0_set).abs() < 1.0,
+            "G{prn}: measured {cn0:.2} dB-Hz, configured {cn0_set}"
+        );
+        // The truth carrier phase is the signal's: the prompt phase error is thermal only.
+        let mean = phase_err.iter().sum::<f64>() / phase_err.len() as f64;
+        assert!(mean.abs() < 3.0, "G{prn}: mean prompt phase {mean:.2} deg");
+    }
+}
+
+#[test]
+fn code_phase_follows_truth_over_time() {
+    // Early-minus-late at +-0.5 chip around the truth code phase must be balanced at the start
+    // and 8 s later: the signal's code phase drifts exactly as the truth code rate says.
+    let sc = scenario(
+        "[satellites]\nprns = [3, 22]\ncn0_all_dbhz = 50.0\n[truth]\nrate_hz = 10.0",
+        8.2,
+        2.6e6,
+        "ci16_le",
+    );
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let report = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    let x = read_all(&report.data_path);
+    let fs = 2.6e6;
+    let n = 2600;
+    for sat in &sim.satellites {
+        for start_ms in [0usize, 8000] {
+            let (mut e, mut l) = (0.0f64, 0.0f64);
+            for b in 0..100 {
+                let k0 = (start_ms + b) * n;
+                e += f64::from(correlate(&sim, sat, &x, fs, k0, n, -0.5, sat.prn).norm());
+                l += f64::from(correlate(&sim, sat, &x, fs, k0, n, 0.5, sat.prn).norm());
+            }
+            // Normalised E-L envelope: (E-L)/(E+L) = tau_err / (1 - 0.5) for an ideal
+            // triangle with 1-chip spacing, so |tau_err| = 0.5 * |D|.
+            let tau_err_chips = 0.5 * (e - l) / (e + l);
+            assert!(
+                tau_err_chips.abs() < 0.03,
+                "{} at {start_ms} ms: code error {tau_err_chips:.4} chip",
+                sat.prn
+            );
+        }
+        // Code Doppler is carrier Doppler / 1540 (up to ionospheric divergence, < 1 mm/s here).
+        let (o0, _) = sim.observe(sat, 1.0);
+        let (o1, _) = sim.observe(sat, 1.001);
+        let code_doppler = (o1.chips - o0.chips) / 0.001 - CA_CHIP_RATE_HZ;
+        let doppler = (o1.carrier_cycles - o0.carrier_cycles) / 0.001;
+        assert!(
+            (code_doppler - doppler / 1540.0).abs() < 1e-3,
+            "{}: {code_doppler} vs {}",
+            sat.prn,
+            doppler / 1540.0
+        );
+    }
+}
+
+#[test]
+fn navigation_message_decodes_from_the_samples() {
+    // Demodulate 20 ms bits at the truth phases and decode the LNAV subframes with the nav
+    // crate: TOW and subframe IDs must follow the truth transmit time; ephemeris fields must
+    // be those of the RINEX file.
+    let sc = scenario(
+        "[satellites]\nprns = [31]\ncn0_all_dbhz = 45.0\n[truth]\nrate_hz = 10.0",
+        13.0,
+        2.048e6,
+        "ci2",
+    );
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let report = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    let x = read_all(&report.data_path);
+    let fs = 2.048e6;
+    let sat = &sim.satellites[0];
+    // Find the first bit edge after the start from the truth code phase.
+    let (o, _) = sim.observe(sat, 0.0);
+    let chips_to_edge = 20460.0 - o.chips.rem_euclid(20460.0);
+    let t_edge = chips_to_edge / CA_CHIP_RATE_HZ;
+    let mut bits = Vec::new();
+    let mut t = t_edge + 0.0005;
+    while t + 0.021 < 13.0 {
+        let k0 = (t * fs) as usize;
+        let p = correlate(&sim, sat, &x, fs, k0, (0.019 * fs) as usize, 0.0, sat.prn);
+        bits.push(u8::from(p.re < 0.0));
+        t += 0.02;
+    }
+    // Look for preambles; a decoded subframe must pass parity in all 10 words.
+    let mut decoded = 0;
+    for start in 0..bits.len().saturating_sub(300) {
+        let mut sf = [0u8; 300];
+        sf.copy_from_slice(&bits[start..start + 300]);
+        if let Ok(d) = decode_subframe(&sf, false, false) {
+            decoded += 1;
+            // The HOW's TOW count is the TOW of the next subframe start, in 6 s units.
+            let t_sf_start = t_edge + 0.02 * start as f64;
+            let (o, _) = sim.observe(sat, t_sf_start + 0.0005);
+            let tx_tow = sim
+                .env
+                .start
+                .add_seconds(t_sf_start - o.pseudorange_m / 299_792_458.0)
+                .tow_s;
+            assert_eq!(
+                f64::from(d.how.tow_count) * 6.0,
+                (tx_tow / 6.0).round() * 6.0 + 6.0,
+                "TOW of subframe at bit {start}"
+            );
+        }
+    }
+    assert!(decoded >= 1, "no subframe decoded from {} bits", bits.len());
+}
+
+#[test]
+fn satellite_positions_match_the_rinex_ephemeris() {
+    let sc = scenario("[truth]\nrate_hz = 1.0", 0.2, 2.048e6, "ci8");
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        sim.satellites.len() >= 8,
+        "only {} satellites above 5 deg",
+        sim.satellites.len()
+    );
+    for sat in &sim.satellites {
+        let (o, _) = sim.observe(sat, 0.1);
+        let rinex = nav
+            .ephemerides
+            .iter()
+            .filter(|e| e.prn == sat.prn.get())
+            .min_by(|a, b| {
+                let (da, db) = (sim.env.start.diff_s(a.toe), sim.env.start.diff_s(b.toe));
+                da.abs().total_cmp(&db.abs())
+            })
+            .unwrap_or_else(|| panic!("{}", sat.prn));
+        let t_tx = sim.env.start.add_seconds(o.t_true_s - o.tau_s);
+        let p = rotate_earth(&rinex.sv_state(t_tx).pos_m, o.tau_s);
+        // The simulator transmits the ephemeris quantised to IS-GPS-200 LSBs; the difference
+        // from the RINEX (double precision) orbit stays at the centimetre level.
+        assert!(
+            (p - o.sv_pos_m).norm() < 0.05,
+            "{}: {} m",
+            sat.prn,
+            (p - o.sv_pos_m).norm()
+        );
+        // Geometric range and travel time agree.
+        assert!((o.range_m - (o.sv_pos_m - o.rx.pos_m).norm()).abs() < 1e-6);
+        assert!((o.tau_s * 299_792_458.0 - o.range_m).abs() < 1e-3);
+    }
+}
+
+#[test]
+fn same_seed_same_bytes_other_seed_other_bytes() {
+    let sc = scenario("[satellites]\nprns = [16]", 0.3, 2.048e6, "ci8");
+    let mut other = sc.clone();
+    other.seed = 6;
+    let run = |s: &Scenario| {
+        let sim = Simulator::new(s, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+        let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+        let r = sim
+            .run(dir.path(), &|_| {})
+            .unwrap_or_else(|e| panic!("{e}"));
+        std::fs::read(&r.data_path).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let a = run(&sc);
+    assert_eq!(a.len(), 2 * 614_400);
+    assert_eq!(a, run(&sc));
+    assert_ne!(a, run(&other));
+}
+
+#[test]
+fn scenario_errors_are_clear() {
+    let bad = |extra: &str, needle: &str| {
+        let text = format!("duration_s = 1.0\nnav = \"builtin:brdc0010.22n\"\n[start]\nweek = 2190\ntow_s = 538194.0\n[output]\nformat = \"ci8\"\nfs_hz = 2.048e6\n[receiver]\nkind = \"static\"\nllh_deg = [0.0, 0.0, 0.0]\n{extra}");
+        match Scenario::from_toml(&text) {
+            Ok(_) => panic!("accepted: {extra}"),
+            Err(e) => assert!(e.to_string().contains(needle), "{e} (wanted {needle})"),
+        }
+    };
+    bad("[satellites]\nprnz = [1]", "unknown field");
+    bad("[satellites]\nprns = [40]", "not a GPS PRN");
+    bad(
+        "[[outages]]\nstart_s = 5.0\nend_s = 2.0",
+        "end must follow start",
+    );
+    let text = "duration_s = 1.0\nnav = \"builtin:brdc0010.22n\"\n[start]\nweek = 2190\ntow_s = 538194.0\n[output]\nformat = \"ci8\"\nfs_hz = 0.5e6\n[receiver]\nkind = \"static\"\nllh_deg = [0.0, 0.0, 0.0]";
+    let e = Scenario::from_toml(text)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(e.contains("too low"), "{e}");
+}

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Cross-checks of gpsrx against ../shared/data and independent programs (GNSS-SDR, RTKLIB).
+# In CI (CI=true) missing shared data is a failure; elsewhere those checks are skipped.
+# Ends with the line "cross-check: N passed, M failed"; exits non-zero when anything failed.
+set -uo pipefail
+ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+DATA="${GPSRX_SHARED_DATA:-$ROOT/../shared/data}"
+WORK="$(mktemp -d "${TMPDIR:-/tmp}/gpsrx-cross.XXXXXX")"
+trap 'rm -rf "$WORK"' EXIT
+cd "$ROOT"
+
+pass=0
+fail=0
+ok()   { echo "PASS: $*"; pass=$((pass + 1)); }
+bad()  { echo "FAIL: $*"; fail=$((fail + 1)); }
+
+if [ ! -d "$DATA" ]; then
+  if [ "${CI:-}" = "true" ]; then
+    bad "shared data not found at $DATA (CI needs ../shared/data beside the clone)"
+    echo "cross-check: $pass passed, $fail failed"
+    exit 1
+  fi
+  echo "SKIP: shared data not found at $DATA; set GPSRX_SHARED_DATA to run these checks"
+  echo "cross-check: 0 passed, 0 failed"
+  exit 0
+fi
+
+cargo build --release -q -p gpsrx-receiver || { bad "cargo build"; echo "cross-check: $pass passed, $fail failed"; exit 1; }
+GPSRX="$ROOT/target/release/gpsrx"
+
+# --- 1. gpsrx info on the real PocketSDR capture: 2,000,000 samples, 0.5 s, values -3,-1,1,3.
+POCKET="$DATA/real/pocketsdr_L1_20211202_084700_4MHz_IQ.bin"
+if "$GPSRX" info "$POCKET" --format ci8 --fs 4e6 --json >"$WORK/info.json" 2>"$WORK/info.err"; then
+  if python3 - "$WORK/info.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["n_samples"] == 2_000_000, r["n_samples"]
+assert abs(r["duration_s"] - 0.5) < 1e-9, r["duration_s"]
+for comp in ("i", "q"):
+    values = sorted(float(b["value"]) for b in r[comp]["histogram"] if b["count"] > 0)
+    assert values == [-3.0, -1.0, 1.0, 3.0], (comp, values)
+print("info: 2000000 samples, 0.5 s, I and Q values -3,-1,1,3")
+PY
+  then ok "gpsrx info on the PocketSDR capture"; else bad "gpsrx info on the PocketSDR capture (see $WORK/info.json)"; fi
+else
+  bad "gpsrx info failed: $(cat "$WORK/info.err")"
+fi
+
+# --- 2. Simulate 60 s at 4 Msps ci8 (static, Seoul, >= 10 satellites) and let GNSS-SDR fix on it.
+SIM="$WORK/sim"
+if "$GPSRX" simulate samples/scenarios/static-seoul-4msps.toml -o "$SIM" --json >"$WORK/sim.json" 2>"$WORK/sim.err"; then
+  read -r nsat rtf < <(python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); print(len(r["satellites"]), round(r["realtime_factor"],2))' "$WORK/sim.json")
+  echo "simulate: $nsat satellites, real-time factor ${rtf}x"
+  if [ "$nsat" -ge 10 ]; then ok "simulated 60 s 4 Msps ci8 with $nsat satellites (${rtf}x real time)"; else bad "only $nsat satellites simulated"; fi
+  if [ -x scripts/gnss-sdr/run-gnss-sdr.sh ] || [ -f scripts/gnss-sdr/run-gnss-sdr.sh ]; then
+    if MAX_ERR_M=10 bash scripts/gnss-sdr/run-gnss-sdr.sh "$SIM/signal.ci8" ci8 4000000 37.5665 126.9780 40.0 "$WORK/gnss-sdr"; then
+      ok "GNSS-SDR fixes on the simulated recording within 10 m of truth"
+    else
+      bad "GNSS-SDR on the simulated recording"
+    fi
+  else
+    bad "scripts/gnss-sdr/run-gnss-sdr.sh missing"
+  fi
+else
+  bad "gpsrx simulate failed: $(cat "$WORK/sim.err")"
+fi
+
+echo "cross-check: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
