@@ -13,3 +13,4 @@ pub mod nco;
 
 pub use ca_code::{CaCode, Prn, PrnError};
 pub use nco::{PhaseAccumulator, SinCosTable};
+pub mod correlator;

@@ -231,7 +231,7 @@ impl Ephemeris {
         let rel_s = F_REL_S_PER_SQRT_M * self.e * self.sqrt_a_sqrt_m * sin_e;
         let rel_rate_s_s = F_REL_S_PER_SQRT_M * self.e * self.sqrt_a_sqrt_m * cos_e * ek_dot;
         let clock_bias_s =
-            self.af0_s + self.af1_s_s * dt + self.af2_s_s2 * dt * dt - self.tgd_s;
+            self.af0_s + self.af1_s_s * dt + self.af2_s_s2 * dt * dt + rel_s - self.tgd_s;
         let clock_drift_s_s = self.af1_s_s + 2.0 * self.af2_s_s2 * dt + rel_rate_s_s;
         SvState {
             pos_m,

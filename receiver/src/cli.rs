@@ -40,7 +40,12 @@ pub struct SourceArgs {
     #[arg(long, value_name = "HZ")]
     pub fs: Option<f64>,
     /// Intermediate frequency, Hz (real IF is mixed down to baseband).
-    #[arg(long = "if", value_name = "HZ", default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(
+        long = "if",
+        value_name = "HZ",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
     pub if_hz: f64,
     /// Read the samples as I - jQ (some front ends invert Q).
     #[arg(long)]

@@ -69,13 +69,13 @@ fn read_all(path: &Path) -> Vec<Complex32> {
 fn correlate(
     sim: &Simulator,
     sat: &SimSatellite,
-    x: &[Complex32],
-    fs: f64,
+    rec: (&[Complex32], f64),
     k0: usize,
     n: usize,
     code_offset_chips: f64,
     replica_prn: Prn,
 ) -> Complex32 {
+    let (x, fs) = rec;
     let code = CaCode::new(replica_prn);
     let t0 = k0 as f64 / fs;
     let t1 = (k0 + n) as f64 / fs;
@@ -87,7 +87,10 @@ fn correlate(
         let chips = o0.chips + u * (o1.chips - o0.chips) + code_offset_chips;
         let ph = o0.carrier_cycles + u * (o1.carrier_cycles - o0.carrier_cycles);
         let c = f32::from(code.chip(chips.rem_euclid(1023.0) as usize));
-        let rot = Complex32::from_polar(1.0, (-2.0 * std::f64::consts::PI * ph.rem_euclid(1.0)) as f32);
+        let rot = Complex32::from_polar(
+            1.0,
+            (-2.0 * std::f64::consts::PI * ph.rem_euclid(1.0)) as f32,
+        );
         acc += x[k0 + i] * rot * c;
     }
     acc
@@ -123,10 +126,10 @@ fn correlation_at_truth_gives_the_configured_cn0_and_phase() {
         let blocks = 1400;
         for b in 0..blocks {
             let k0 = 20 * n + b * n;
-            let p = correlate(&sim, sat, &x, fs, k0, n, 0.0, sat.prn);
+            let p = correlate(&sim, sat, (&x, fs), k0, n, 0.0, sat.prn);
             sig += f64::from(p.norm_sqr());
             // The noise floor: the same samples against a PRN that is not transmitted.
-            noise += f64::from(correlate(&sim, sat, &x, fs, k0, n, 0.0, unused).norm_sqr());
+            noise += f64::from(correlate(&sim, sat, (&x, fs), k0, n, 0.0, unused).norm_sqr());
             // Data bits flip the sign: fold the phase into (-90, 90] degrees.
             let mut ph = f64::from(p.arg()).to_degrees();
             if ph > 90.0 {
@@ -175,8 +178,8 @@ fn code_phase_follows_truth_over_time() {
             let (mut e, mut l) = (0.0f64, 0.0f64);
             for b in 0..100 {
                 let k0 = (start_ms + b) * n;
-                e += f64::from(correlate(&sim, sat, &x, fs, k0, n, -0.5, sat.prn).norm());
-                l += f64::from(correlate(&sim, sat, &x, fs, k0, n, 0.5, sat.prn).norm());
+                e += f64::from(correlate(&sim, sat, (&x, fs), k0, n, -0.5, sat.prn).norm());
+                l += f64::from(correlate(&sim, sat, (&x, fs), k0, n, 0.5, sat.prn).norm());
             }
             // Normalised E-L envelope: (E-L)/(E+L) = tau_err / (1 - 0.5) for an ideal
             // triangle with 1-chip spacing, so |tau_err| = 0.5 * |D|.
@@ -228,7 +231,7 @@ fn navigation_message_decodes_from_the_samples() {
     let mut t = t_edge + 0.0005;
     while t + 0.021 < 13.0 {
         let k0 = (t * fs) as usize;
-        let p = correlate(&sim, sat, &x, fs, k0, (0.019 * fs) as usize, 0.0, sat.prn);
+        let p = correlate(&sim, sat, (&x, fs), k0, (0.019 * fs) as usize, 0.0, sat.prn);
         bits.push(u8::from(p.re < 0.0));
         t += 0.02;
     }

@@ -6,6 +6,7 @@ mod atmosphere_tests;
 mod common;
 mod ephemeris_tests;
 mod frames_tests;
+mod lnav_rtklib_tests;
 mod lnav_tests;
 mod rinex_tests;
 mod time_tests;

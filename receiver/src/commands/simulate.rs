@@ -11,7 +11,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let (mut scenario, base) = match (&args.scenario, args.default) {
         (Some(p), false) => Scenario::load(p)?,
         (None, true) => (Scenario::default_scenario()?, PathBuf::new()),
-        _ => anyhow::bail!("give a scenario file (e.g. samples/scenarios/default.toml) or --default"),
+        _ => {
+            anyhow::bail!("give a scenario file (e.g. samples/scenarios/default.toml) or --default")
+        }
     };
     if let Some(d) = args.duration {
         scenario.duration_s = d;
@@ -35,9 +37,18 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
 }
 
 /// Prepares and runs a scenario into `out`, with a progress bar when `progress` is set.
-pub fn simulate(scenario: &Scenario, base: &Path, out: &Path, progress: bool) -> anyhow::Result<SimReport> {
+pub fn simulate(
+    scenario: &Scenario,
+    base: &Path,
+    out: &Path,
+    progress: bool,
+) -> anyhow::Result<SimReport> {
     let sim = Simulator::new(scenario, base).context("cannot prepare the scenario")?;
-    let bar = if progress { ProgressBar::new(1000) } else { ProgressBar::hidden() };
+    let bar = if progress {
+        ProgressBar::new(1000)
+    } else {
+        ProgressBar::hidden()
+    };
     bar.set_style(
         ProgressStyle::with_template("simulating {bar:40} {percent:>3}% {elapsed} (eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -67,7 +78,11 @@ pub fn print_report(r: &SimReport) {
         r.clipped
     );
     println!("metadata:  {}", r.meta_path.display());
-    println!("truth:     {} and {}", r.truth_path.display(), r.truth_sv_path.display());
+    println!(
+        "truth:     {} and {}",
+        r.truth_path.display(),
+        r.truth_sv_path.display()
+    );
     println!(
         "simulated {:.1} s in {:.2} s: {:.1}x real time ({:.1} Msamples/s)",
         r.duration_s,

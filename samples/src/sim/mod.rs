@@ -435,7 +435,10 @@ impl Simulator {
                 message: "writer thread panicked".into(),
             })?
         })?;
-        tracing::debug!("samples generated and written in {:.2} s", t0.elapsed().as_secs_f64());
+        tracing::debug!(
+            "samples generated and written in {:.2} s",
+            t0.elapsed().as_secs_f64()
+        );
         let meta = self.sigmf_meta();
         let meta_path = write_sigmf_meta(&data_path, &meta)?;
         let truth_path = out_dir.join("truth.csv");
@@ -500,7 +503,11 @@ impl Simulator {
 
 /// The ephemeris of `prn` with the toe nearest to `t` (within 4 h), healthy or not: an unhealthy
 /// satellite still transmits, with its health bits set, and receivers must cope with that.
-fn nearest_ephemeris(nav: &gpsrx_nav::rinex_nav::NavData, prn: u8, t: GpsTime) -> Option<&Ephemeris> {
+fn nearest_ephemeris(
+    nav: &gpsrx_nav::rinex_nav::NavData,
+    prn: u8,
+    t: GpsTime,
+) -> Option<&Ephemeris> {
     nav.ephemerides
         .iter()
         .filter(|e| e.prn == prn)

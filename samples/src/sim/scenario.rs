@@ -405,10 +405,11 @@ impl Scenario {
                 "[output] if_hz = {f_if} is outside the band (|IF| < fs/2)"
             ));
         }
-        if !fmt.is_complex() && !(f_if > 1.023e6 && f_if < fs / 2.0 - 1.023e6) {
+        let real_if_ok = f_if > 0.0 && f_if < fs / 2.0;
+        if !fmt.is_complex() && !real_if_ok {
             return bad(format!(
-                "[output] if_hz = {f_if}: a real output needs 1.023 MHz < IF < fs/2 - 1.023 MHz \
-                 so the main lobe does not fold over DC or Nyquist"
+                "[output] if_hz = {f_if}: a real output needs 0 < IF < fs/2 \
+                 (ideally 1.023 MHz < IF < fs/2 - 1.023 MHz so the main lobe does not fold)"
             ));
         }
         if let Some(s) = self.output.noise_sigma {

@@ -416,7 +416,7 @@ impl MotionTable {
                         )
                     }
                 };
-                if !(dur > 0.0) {
+                if dur.is_nan() || dur <= 0.0 {
                     return Err(SimError::Scenario(format!(
                         "a motion segment has duration {dur} s; it must be positive"
                     )));
@@ -432,7 +432,6 @@ impl MotionTable {
                 next_switch = phase.t1;
             }
             let c = phase.controls(t);
-            let d = derivative(&s, c);
             let (sin, cos) = s[3].sin_cos();
             let pos = Vector3::new(s[0], s[1], 0.0);
             let vel = Vector3::new(s[2] * sin, s[2] * cos, 0.0);
@@ -441,7 +440,6 @@ impl MotionTable {
                 c.accel_mps2 * cos - s[2] * c.yaw_rate_rad_s * sin,
                 0.0,
             );
-            let _ = d;
             rows.push([pos, vel, acc]);
             // RK4 step with the time-varying controls.
             let h = Self::DT_S;

@@ -17,7 +17,7 @@
 //! - `sv_*`: satellite position at transmission in the ECEF frame of reception.
 
 use crate::sim::{SimError, Simulator};
-use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, SPEED_OF_LIGHT_MPS};
+use gpsrx_dsp::constants::SPEED_OF_LIGHT_MPS;
 use gpsrx_nav::frames::Llh;
 use std::io::Write;
 use std::path::Path;
@@ -136,6 +136,5 @@ pub fn write_satellite_truth(sim: &Simulator, path: &Path) -> Result<(), SimErro
             .map_err(|e| io_err(path, e))?;
         }
     }
-    let _ = CA_CHIP_RATE_HZ;
     w.flush().map_err(|e| io_err(path, e))
 }
