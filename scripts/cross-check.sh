@@ -37,7 +37,9 @@ r = json.load(open(sys.argv[1]))
 assert r["n_samples"] == 2_000_000, r["n_samples"]
 assert abs(r["duration_s"] - 0.5) < 1e-9, r["duration_s"]
 for comp in ("i", "q"):
-    values = sorted(float(b["value"]) for b in r[comp]["histogram"] if b["count"] > 0)
+    h = r[comp]["histogram"]
+    assert h["kind"] == "values", h["kind"]
+    values = sorted(v for v, c in zip(h["values"], h["counts"]) if c > 0)
     assert values == [-3.0, -1.0, 1.0, 3.0], (comp, values)
 print("info: 2000000 samples, 0.5 s, I and Q values -3,-1,1,3")
 PY

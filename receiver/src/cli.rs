@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 /// gpsrx: a GPS L1 C/A software receiver with INS-aided tracking loops.
 #[derive(Debug, Parser)]
-#[command(name = "gpsrx", version, about, long_about = None)]
+#[command(name = "gpsrx", version)]
 pub struct Cli {
     /// More log output (or set GPSRX_LOG=debug).
     #[arg(short, long, global = true)]
