@@ -26,7 +26,7 @@ if [ ! -d "$DATA" ]; then
 fi
 
 cargo build --release -q -p gpsrx-receiver || { bad "cargo build"; echo "cross-check: $pass passed, $fail failed"; exit 1; }
-GPSRX="$ROOT/target/release/gpsrx"
+GPSRX="${CARGO_TARGET_DIR:-$ROOT/target}/release/gpsrx"
 
 # --- 1. gpsrx info on the real PocketSDR capture: 2,000,000 samples, 0.5 s, values -3,-1,1,3.
 POCKET="$DATA/real/pocketsdr_L1_20211202_084700_4MHz_IQ.bin"
