@@ -1,0 +1,7 @@
+//! The receiver pipeline: samples from a source, shared by all channels, block by block.
+//!
+//! - [`ring`]: the window of recent samples addressed by absolute index;
+//! - [`tracker`]: drives the tracking channels over the window, in parallel.
+
+pub mod ring;
+pub mod tracker;

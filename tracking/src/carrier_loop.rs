@@ -1,0 +1,182 @@
+//! The carrier loop a channel drives once per integration interval: discriminators, loop filter
+//! and the aiding sum, as one small state machine-free object.
+
+use num_complex::Complex64;
+
+use crate::aiding;
+use crate::config::{ConfigError, FllDiscriminator, LoopConfig, PllDiscriminator};
+use crate::discriminator;
+use crate::loop_filter::LoopFilter;
+
+/// What one carrier-loop update produced.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CarrierOutput {
+    /// Carrier NCO frequency (Doppler, Hz) to hold over the next interval:
+    /// initial Doppler + feed-forward + loop filter output.
+    pub nco_freq_hz: f64,
+    /// The loop filter's share of it, Hz (the residual the loop itself tracks).
+    pub loop_hz: f64,
+    /// PLL discriminator output, cycles (reported even when no PLL is configured).
+    pub phase_error_cycles: f64,
+    /// FLL discriminator output, Hz (0 on the first update and without an FLL).
+    pub freq_error_hz: f64,
+}
+
+/// PLL / FLL / FLL-assisted PLL carrier tracking loop with an aiding (feed-forward) port.
+///
+/// Per interval the channel calls [`CarrierLoop::update`] with the prompt of the interval just
+/// dumped and the aid for the next one, and holds the returned `nco_freq_hz` over the next
+/// interval (phase-continuous NCO). The timing this assumes is documented in
+/// [`crate::loop_analysis`].
+#[derive(Debug, Clone)]
+pub struct CarrierLoop {
+    cfg: LoopConfig,
+    filter: LoopFilter,
+    base_hz: f64,
+    prev_prompt: Option<Complex64>,
+    last: CarrierOutput,
+}
+
+impl CarrierLoop {
+    /// A carrier loop from a configuration, starting at `initial_doppler_hz` (e.g. from
+    /// acquisition; 0 when all of the Doppler comes through the feed-forward).
+    pub fn new(cfg: &LoopConfig, initial_doppler_hz: f64) -> Result<Self, ConfigError> {
+        let filter = LoopFilter::carrier(cfg)?;
+        if !initial_doppler_hz.is_finite() {
+            return Err(ConfigError::OutOfRange {
+                field: "initial_doppler_hz",
+                value: initial_doppler_hz,
+                valid: "a finite frequency in Hz".to_string(),
+            });
+        }
+        Ok(Self {
+            cfg: *cfg,
+            filter,
+            base_hz: initial_doppler_hz,
+            prev_prompt: None,
+            last: CarrierOutput {
+                nco_freq_hz: initial_doppler_hz,
+                ..CarrierOutput::default()
+            },
+        })
+    }
+
+    /// One update with the prompt of the interval just dumped and the feed-forward Doppler (Hz,
+    /// mean over the next interval, see [`aiding::DopplerAid::mean_over_hz`]; 0 when unaided).
+    pub fn update(&mut self, prompt: Complex64, feedforward_hz: f64) -> CarrierOutput {
+        let t = self.cfg.t_coh_s;
+        let phase_error_cycles = match self.cfg.pll_discriminator {
+            PllDiscriminator::Costas => discriminator::costas_atan(prompt),
+            PllDiscriminator::Atan2 => discriminator::pll_atan2(prompt),
+        };
+        let freq_error_hz = match self.prev_prompt {
+            Some(prev) if self.filter.assist_enabled() => match self.cfg.fll_discriminator {
+                FllDiscriminator::DataInsensitive => {
+                    discriminator::fll_data_insensitive(prev, prompt, t)
+                }
+                FllDiscriminator::Atan2 => discriminator::fll_atan2(prev, prompt, t),
+            },
+            _ => 0.0,
+        };
+        self.prev_prompt = Some(prompt);
+        let primary = if self.filter.has_primary() {
+            phase_error_cycles
+        } else {
+            0.0
+        };
+        let loop_hz = self.filter.update(primary, freq_error_hz, t);
+        let nco_freq_hz = aiding::carrier_nco_hz(feedforward_hz, self.base_hz + loop_hz);
+        self.last = CarrierOutput {
+            nco_freq_hz,
+            loop_hz,
+            phase_error_cycles,
+            freq_error_hz,
+        };
+        self.last
+    }
+
+    /// The output of the last update (or the initial Doppler before the first).
+    pub fn last(&self) -> CarrierOutput {
+        self.last
+    }
+
+    /// The integration time the loop assumes, s.
+    pub fn t_coh_s(&self) -> f64 {
+        self.cfg.t_coh_s
+    }
+
+    /// The configuration the loop runs with.
+    pub fn config(&self) -> &LoopConfig {
+        &self.cfg
+    }
+
+    /// Changes the integration time (e.g. 1 ms -> 20 ms after bit synchronisation). The
+    /// integrators keep their frequency; the FLL history is cleared because the next prompt
+    /// spans a different interval. Rejects a `t_coh_s` outside 1-20 ms or one that would make
+    /// `Bn T` too large for this loop.
+    pub fn set_t_coh_s(&mut self, t_coh_s: f64) -> Result<(), ConfigError> {
+        let new_cfg = LoopConfig {
+            t_coh_s,
+            ..self.cfg
+        };
+        new_cfg.validate()?;
+        self.cfg = new_cfg;
+        self.prev_prompt = None;
+        Ok(())
+    }
+
+    /// Switches the FLL assist off (or on again) without disturbing the frequency memory. For a
+    /// pure FLL (`pll_order = 0`) switching it off freezes the NCO frequency.
+    pub fn set_fll_assist(&mut self, on: bool) {
+        self.filter.set_assist_enabled(on);
+        if !on {
+            self.prev_prompt = None;
+        }
+    }
+
+    /// Forgets the previous prompt (call after a gap in the correlations).
+    pub fn reset_history(&mut self) {
+        self.prev_prompt = None;
+    }
+
+    /// The loop filter.
+    pub fn filter(&self) -> &LoopFilter {
+        &self.filter
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn holds_initial_doppler_and_adds_feedforward() {
+        let cfg = LoopConfig {
+            fll_order: 0,
+            ..LoopConfig::default()
+        };
+        let mut l = CarrierLoop::new(&cfg, 1234.0).ok();
+        let out = l
+            .as_mut()
+            .map(|l| l.update(Complex64::new(1.0, 0.0), 10.0))
+            .unwrap_or_default();
+        assert!((out.nco_freq_hz - 1244.0).abs() < 1e-12);
+        assert_eq!(out.loop_hz, 0.0);
+        assert!(CarrierLoop::new(&cfg, f64::INFINITY).is_err());
+    }
+
+    #[test]
+    fn changing_t_coh_is_validated() {
+        let cfg = LoopConfig {
+            fll_order: 0,
+            pll_bw_hz: 15.0,
+            ..LoopConfig::default()
+        };
+        let Ok(mut l) = CarrierLoop::new(&cfg, 0.0) else {
+            panic!("default config must be valid")
+        };
+        assert!(l.set_t_coh_s(0.02).is_err()); // 15 Hz * 20 ms = 0.3
+        assert!(l.set_t_coh_s(0.01).is_ok());
+        assert_eq!(l.t_coh_s(), 0.01);
+    }
+}

@@ -1,0 +1,487 @@
+//! The tracking channel: one satellite's replica, loops and detectors, driven code period by
+//! code period over a shared window of samples.
+//!
+//! States: [`ChannelState::PullIn`] (1 ms integration, the wide FLL-assisted pull-in loops,
+//! bit synchronisation) -> [`ChannelState::Track`] (the user's loops and integration time,
+//! integrations aligned to data-bit edges) -> [`ChannelState::Lost`] (C/N0 below the threshold for
+//! too long: the channel is released and the satellite goes back to acquisition).
+//!
+//! Every integration starts at the first sample of a C/A code period of the replica: the span of
+//! a period is `n = ceil((1023 - c0) fs / r)` samples for a code phase `c0` (chips, in [0, 1))
+//! at its first sample and code rate `r`, and the next period starts at `c0 + n r / fs - 1023`.
+//! The NCO frequencies are held over each integration interval (phase-continuous) and updated by
+//! the loops at its end. The carrier NCO runs at the fed-forward Doppler plus the loop filter
+//! output (seed 004 Fig. 4); the code NCO at `1.023 MHz (1 + f_carrier / f_L1)` plus the DLL
+//! output (carrier aiding).
+
+use crate::aiding::{code_doppler_chips_s, DopplerAid};
+use crate::bit_sync::{Bit, BitSync, BitSyncConfig, BitSyncState, MS_PER_BIT};
+use crate::carrier_loop::CarrierLoop;
+use crate::cn0::NwprEstimator;
+use crate::code_loop::CodeLoop;
+use crate::config::{ConfigError, LoopConfig};
+use crate::lock_detector::{CodeLockDetector, PllLockConfig, PllLockDetector};
+use gpsrx_dsp::ca_code::{CaCode, Prn};
+use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, CA_CODE_LENGTH, F_L1_HZ};
+use gpsrx_dsp::correlator::{correlate, ReplicaState};
+use num_complex::{Complex32, Complex64};
+use serde::{Deserialize, Serialize};
+
+/// Channel settings: the pull-in and tracking loops and the lock thresholds.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ChannelConfig {
+    /// Loops during pull-in (1 ms integration, wide, FLL-assisted).
+    pub pull_in: LoopConfig,
+    /// Loops after pull-in: the user's order, bandwidth and integration time.
+    pub track: LoopConfig,
+    /// Minimum time in pull-in before the hand-over to tracking, s.
+    pub min_pull_in_s: f64,
+    /// Time after which the FLL assist of the pull-in loop is switched off, s: the
+    /// data-insensitive FLL discriminator folds on noise at low C/N0 and would keep kicking the
+    /// NCO (tracking/README.md), so the PLL finishes the pull-in alone.
+    pub fll_assist_s: f64,
+    /// C/N0 below which the code is considered lost, dB-Hz.
+    pub cn0_lost_dbhz: f64,
+    /// How many consecutive C/N0 estimates (1 s each) below the threshold release the channel.
+    pub lost_estimates: u32,
+}
+
+impl Default for ChannelConfig {
+    fn default() -> Self {
+        Self {
+            pull_in: LoopConfig::default(),
+            track: LoopConfig {
+                pll_order: 2,
+                pll_bw_hz: 10.0,
+                fll_order: 0,
+                fll_bw_hz: 0.0,
+                dll_order: 1,
+                dll_bw_hz: 1.0,
+                t_coh_s: 1.0e-3,
+                el_spacing_chips: 1.0,
+                ..LoopConfig::default()
+            },
+            min_pull_in_s: 0.5,
+            fll_assist_s: 0.3,
+            cn0_lost_dbhz: 25.0,
+            lost_estimates: 2,
+        }
+    }
+}
+
+impl ChannelConfig {
+    /// Checks both loop configurations and the thresholds.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.pull_in.validate()?;
+        self.track.validate()?;
+        let ms = (self.track.t_coh_s * 1e3).round() as usize;
+        if ms == 0 || MS_PER_BIT % ms != 0 {
+            return Err(ConfigError::OutOfRange {
+                field: "t_coh_s",
+                value: self.track.t_coh_s,
+                valid: "1, 2, 4, 5, 10 or 20 ms (a divisor of the 20 ms data bit)".into(),
+            });
+        }
+        if !(self.min_pull_in_s.is_finite() && self.min_pull_in_s >= 0.0) {
+            return Err(ConfigError::OutOfRange {
+                field: "min_pull_in_s",
+                value: self.min_pull_in_s,
+                valid: ">= 0 s".into(),
+            });
+        }
+        if !(self.fll_assist_s.is_finite() && self.fll_assist_s >= 0.0) {
+            return Err(ConfigError::OutOfRange {
+                field: "fll_assist_s",
+                value: self.fll_assist_s,
+                valid: ">= 0 s".into(),
+            });
+        }
+        if !self.cn0_lost_dbhz.is_finite() {
+            return Err(ConfigError::OutOfRange {
+                field: "cn0_lost_dbhz",
+                value: self.cn0_lost_dbhz,
+                valid: "a C/N0 in dB-Hz".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Where a channel is in its life.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChannelState {
+    /// Wide loops at 1 ms, waiting for phase lock and bit synchronisation.
+    PullIn,
+    /// The user's loops, integrations aligned to data bits.
+    Track,
+    /// Signal lost: release the channel.
+    Lost,
+}
+
+/// A satellite found by acquisition, to start a channel from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChannelStart {
+    /// The satellite.
+    pub prn: Prn,
+    /// Absolute index of a sample at which a C/A code period starts.
+    pub code_start_sample: u64,
+    /// Carrier Doppler, Hz (including any front-end frequency offset).
+    pub doppler_hz: f64,
+}
+
+/// What a channel reports at the end of each integration interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChannelEpoch {
+    /// Satellite PRN.
+    pub prn: u8,
+    /// State during the interval.
+    pub state: ChannelState,
+    /// Absolute index of the first sample of the interval.
+    pub sample_index: u64,
+    /// Receive time of that sample (index / fs), s.
+    pub t_rx_s: f64,
+    /// Replica code phase at that sample, chips (near 0: intervals start on code periods).
+    pub code_phase_chips: f64,
+    /// Code NCO rate over the interval, chips/s.
+    pub code_rate_chips_s: f64,
+    /// Accumulated carrier phase of the replica at that sample, cycles (continuous).
+    pub carrier_phase_cycles: f64,
+    /// Carrier NCO frequency over the interval (Doppler, Hz).
+    pub doppler_hz: f64,
+    /// Latest C/N0 estimate, dB-Hz (NaN before the first).
+    pub cn0_dbhz: f64,
+    /// Phase-lock indicator state.
+    pub pll_lock: bool,
+    /// `cos 2 phi` of the phase-lock indicator.
+    pub pll_lock_metric: f64,
+    /// Code (C/N0) lock.
+    pub code_lock: bool,
+    /// Prompt correlation of the interval.
+    pub prompt: Complex64,
+    /// Early correlation.
+    pub early: Complex64,
+    /// Late correlation.
+    pub late: Complex64,
+    /// PLL discriminator output, cycles.
+    pub phase_error_cycles: f64,
+    /// FLL discriminator output, Hz.
+    pub freq_error_hz: f64,
+    /// DLL discriminator output, chips.
+    pub code_error_chips: f64,
+    /// Integration time of the interval, s.
+    pub t_coh_s: f64,
+    /// Milliseconds since the channel started (count of code periods).
+    pub ms_count: u64,
+    /// Whether the interval starts on a data-bit edge (known after bit sync).
+    pub bit_edge: bool,
+    /// The navigation bit completed in this interval, if any.
+    pub bit: Option<Bit>,
+}
+
+/// One tracking channel.
+#[derive(Debug, Clone)]
+pub struct Channel {
+    prn: Prn,
+    code: CaCode,
+    fs_hz: f64,
+    cfg: ChannelConfig,
+    state: ChannelState,
+    carrier: CarrierLoop,
+    code_loop: CodeLoop,
+    pll_lock: PllLockDetector,
+    code_lock: CodeLockDetector,
+    cn0: NwprEstimator,
+    bit_sync: BitSync,
+    /// Next integration's first sample (absolute index).
+    next_sample: u64,
+    /// Code phase (chips) at `next_sample`.
+    code_phase_chips: f64,
+    code_rate_chips_s: f64,
+    /// Accumulated carrier phase (cycles) at `next_sample`.
+    carrier_phase_cycles: f64,
+    carrier_freq_hz: f64,
+    aid: Option<DopplerAid>,
+    ms_count: u64,
+    /// `ms_count` of the first prompt the bit synchroniser saw since its last reset.
+    bit_sync_origin_ms: u64,
+    pull_in_ms: u64,
+    cn0_dbhz: f64,
+    low_cn0_count: u32,
+    /// Accumulators of the current interval: E, P, L. The early replica leads the prompt by
+    /// d/2 chip (its code phase is `c + d/2`), the late one lags it.
+    acc: [Complex64; 3],
+    acc_ms: usize,
+    acc_start: (u64, f64, f64, f64),
+    taps: [f64; 3],
+}
+
+impl Channel {
+    /// A channel from an acquisition result.
+    pub fn new(start: &ChannelStart, fs_hz: f64, cfg: &ChannelConfig) -> Result<Self, ConfigError> {
+        cfg.validate()?;
+        if !(fs_hz.is_finite() && fs_hz > 0.0) {
+            return Err(ConfigError::OutOfRange {
+                field: "fs_hz",
+                value: fs_hz,
+                valid: "> 0".into(),
+            });
+        }
+        let carrier = CarrierLoop::new(&cfg.pull_in, start.doppler_hz)?;
+        let code_loop = CodeLoop::new(&cfg.pull_in)?;
+        let d = cfg.pull_in.el_spacing_chips;
+        Ok(Self {
+            prn: start.prn,
+            code: CaCode::new(start.prn),
+            fs_hz,
+            cfg: *cfg,
+            state: ChannelState::PullIn,
+            carrier,
+            code_loop,
+            pll_lock: PllLockDetector::new(PllLockConfig::default()),
+            code_lock: CodeLockDetector::new(cfg.cn0_lost_dbhz, cfg.lost_estimates),
+            cn0: NwprEstimator::new(1e-3, 20, 50),
+            bit_sync: BitSync::new(BitSyncConfig::default()),
+            next_sample: start.code_start_sample,
+            code_phase_chips: 0.0,
+            code_rate_chips_s: CA_CHIP_RATE_HZ * (1.0 + start.doppler_hz / F_L1_HZ),
+            carrier_phase_cycles: 0.0,
+            carrier_freq_hz: start.doppler_hz,
+            aid: None,
+            ms_count: 0,
+            bit_sync_origin_ms: 0,
+            pull_in_ms: 0,
+            cn0_dbhz: f64::NAN,
+            low_cn0_count: 0,
+            acc: [Complex64::new(0.0, 0.0); 3],
+            acc_ms: 0,
+            acc_start: (start.code_start_sample, 0.0, 0.0, 0.0),
+            taps: [d / 2.0, 0.0, -d / 2.0],
+        })
+    }
+
+    /// The satellite.
+    pub fn prn(&self) -> Prn {
+        self.prn
+    }
+
+    /// The state.
+    pub fn state(&self) -> ChannelState {
+        self.state
+    }
+
+    /// Latest C/N0 estimate, dB-Hz (NaN before the first).
+    pub fn cn0_dbhz(&self) -> f64 {
+        self.cn0_dbhz
+    }
+
+    /// Sets the external Doppler estimate fed forward from the next interval on (the aiding
+    /// port); `None` removes the aid.
+    pub fn set_aid(&mut self, aid: Option<DopplerAid>) {
+        self.aid = aid;
+    }
+
+    /// Absolute index of the first sample the next code period needs, and how many samples it
+    /// spans.
+    pub fn next_span(&self) -> (u64, usize) {
+        let n = ((CA_CODE_LENGTH as f64 - self.code_phase_chips) * self.fs_hz
+            / self.code_rate_chips_s)
+            .ceil();
+        (self.next_sample, n.max(1.0) as usize)
+    }
+
+    /// Skips whole code periods so that the next one starts at or after `sample` (when the
+    /// samples the channel wanted are no longer available).
+    pub fn skip_to(&mut self, sample: u64) {
+        while self.next_sample < sample {
+            let (_, n) = self.next_span();
+            self.advance(n);
+            self.ms_count += 1;
+        }
+        self.acc = [Complex64::new(0.0, 0.0); 3];
+        self.acc_ms = 0;
+        self.carrier.reset_history();
+        self.bit_sync.reset();
+        self.bit_sync_origin_ms = self.ms_count;
+    }
+
+    fn advance(&mut self, n: usize) {
+        let t = n as f64 / self.fs_hz;
+        self.code_phase_chips =
+            (self.code_phase_chips + self.code_rate_chips_s * t - CA_CODE_LENGTH as f64).max(0.0);
+        self.carrier_phase_cycles += self.carrier_freq_hz * t;
+        self.next_sample += n as u64;
+    }
+
+    /// Processes one code period; `samples` must be exactly the span [`Channel::next_span`]
+    /// returned. Returns the epoch report when an integration interval ends.
+    pub fn process_code_period(&mut self, samples: &[Complex32]) -> Option<ChannelEpoch> {
+        if self.state == ChannelState::Lost {
+            return None;
+        }
+        let state_now = ReplicaState {
+            code_phase_chips: self.code_phase_chips,
+            code_rate_chips_s: self.code_rate_chips_s,
+            carrier_phase_cycles: self.carrier_phase_cycles.rem_euclid(1.0),
+            carrier_freq_hz: self.carrier_freq_hz,
+            carrier_rate_hz_s: 0.0,
+        };
+        if self.acc_ms == 0 {
+            self.acc_start = (
+                self.next_sample,
+                self.code_phase_chips,
+                self.carrier_phase_cycles,
+                self.carrier_freq_hz,
+            );
+        }
+        let mut out = [Complex32::new(0.0, 0.0); 3];
+        correlate(
+            samples,
+            self.fs_hz,
+            self.code.chips(),
+            &state_now,
+            &self.taps,
+            &mut out,
+        );
+        let [e, p, l] = out.map(|c| Complex64::new(f64::from(c.re), f64::from(c.im)));
+        let t_start_s = self.next_sample as f64 / self.fs_hz;
+        self.advance(samples.len());
+        let ms_index = self.ms_count;
+        self.ms_count += 1;
+        if self.state == ChannelState::PullIn {
+            self.pull_in_ms += 1;
+            if self.pull_in_ms == (self.cfg.fll_assist_s * 1e3).round() as u64 {
+                self.carrier.set_fll_assist(false);
+            }
+        }
+        for (a, v) in self.acc.iter_mut().zip([e, p, l]) {
+            *a += v;
+        }
+        self.acc_ms += 1;
+
+        // Bit synchronisation and bits, from 1 ms prompts.
+        let bit = self.bit_sync.push(p, t_start_s);
+        // Bit edges fall on code periods k with k mod 20 == edge_phase (k counted by ms_count).
+        let edge_phase = match self.bit_sync.state() {
+            BitSyncState::Synced { edge } => {
+                Some(((self.bit_sync_origin_ms + edge as u64) % MS_PER_BIT as u64) as usize)
+            }
+            _ => None,
+        };
+        let next_is_edge = edge_phase.is_some_and(|edge| {
+            (ms_index + 1) % MS_PER_BIT as u64 == edge as u64 % MS_PER_BIT as u64
+        });
+        let estimate = self.cn0.push(p);
+        if next_is_edge {
+            // NWPR blocks of 20 prompts must not straddle a data-bit transition.
+            self.cn0.align_block();
+        }
+        if let Some(c) = estimate {
+            self.cn0_dbhz = c;
+            let ok = self.code_lock.update(c);
+            self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz {
+                self.low_cn0_count + 1
+            } else {
+                0
+            };
+            if !ok && self.low_cn0_count >= self.cfg.lost_estimates {
+                self.state = ChannelState::Lost;
+            }
+        }
+        self.pll_lock.update(p);
+        if matches!(self.bit_sync.state(), BitSyncState::Failed) {
+            self.bit_sync.reset();
+            self.bit_sync_origin_ms = self.ms_count;
+        }
+
+        // Integration interval complete?
+        let t_coh_ms = (self.carrier.t_coh_s() * 1e3).round() as usize;
+        let aligned = t_coh_ms == 1
+            || next_is_edge
+            || edge_phase.is_some_and(|edge| {
+                let k = (ms_index + 1 + MS_PER_BIT as u64 - edge as u64 % MS_PER_BIT as u64)
+                    % MS_PER_BIT as u64;
+                k % t_coh_ms as u64 == 0
+            });
+        if self.acc_ms < t_coh_ms || !aligned {
+            if self.acc_ms >= t_coh_ms {
+                // Not aligned to a bit boundary yet (only after a switch): drop the partial sum.
+                self.acc = [Complex64::new(0.0, 0.0); 3];
+                self.acc_ms = 0;
+            }
+            return None;
+        }
+        let [ea, pa, la] = self.acc;
+        let ff = self
+            .aid
+            .map(|a| a.mean_over_hz(self.carrier.t_coh_s()))
+            .unwrap_or(0.0);
+        let co = self.carrier.update(pa, ff);
+        let cl = self
+            .code_loop
+            .update(ea, pa, la, code_doppler_chips_s(co.nco_freq_hz));
+        self.carrier_freq_hz = co.nco_freq_hz;
+        self.code_rate_chips_s = cl.code_rate_chips_s;
+        let (s0, cp0, ph0, f0) = self.acc_start;
+        let epoch = ChannelEpoch {
+            prn: self.prn.get(),
+            state: self.state,
+            sample_index: s0,
+            t_rx_s: s0 as f64 / self.fs_hz,
+            code_phase_chips: cp0,
+            code_rate_chips_s: self.code_rate_chips_s,
+            carrier_phase_cycles: ph0,
+            doppler_hz: f0,
+            cn0_dbhz: self.cn0_dbhz,
+            pll_lock: self.pll_lock.locked(),
+            pll_lock_metric: self.pll_lock.cos_2phi(),
+            code_lock: self.code_lock.locked(),
+            prompt: pa,
+            early: ea,
+            late: la,
+            phase_error_cycles: co.phase_error_cycles,
+            freq_error_hz: co.freq_error_hz,
+            code_error_chips: cl.code_error_chips,
+            t_coh_s: self.carrier.t_coh_s(),
+            ms_count: ms_index + 1 - self.acc_ms as u64,
+            bit_edge: edge_phase.is_some_and(|edge| {
+                (ms_index + 1 - self.acc_ms as u64) % MS_PER_BIT as u64
+                    == edge as u64 % MS_PER_BIT as u64
+            }),
+            bit,
+        };
+        self.acc = [Complex64::new(0.0, 0.0); 3];
+        self.acc_ms = 0;
+        self.maybe_hand_over(next_is_edge);
+        Some(epoch)
+    }
+
+    /// Pull-in -> track once the phase is locked, the bits are synchronised and the minimum
+    /// pull-in time has passed; the switch happens on a bit edge so that the longer
+    /// integrations are aligned with the data bits.
+    fn maybe_hand_over(&mut self, at_edge: bool) {
+        if self.state != ChannelState::PullIn || !at_edge {
+            return;
+        }
+        let min_ms = (self.cfg.min_pull_in_s * 1e3) as u64;
+        if self.pull_in_ms < min_ms || !self.pll_lock.locked() {
+            return;
+        }
+        let ff = self
+            .aid
+            .map(|a| a.mean_over_hz(self.cfg.track.t_coh_s))
+            .unwrap_or(0.0);
+        let (Ok(carrier), Ok(code_loop)) = (
+            CarrierLoop::new(&self.cfg.track, self.carrier_freq_hz - ff),
+            CodeLoop::new(&self.cfg.track),
+        ) else {
+            return; // validated at construction; keep pulling in otherwise
+        };
+        self.carrier = carrier;
+        self.code_loop = code_loop;
+        let d = self.cfg.track.el_spacing_chips;
+        self.taps = [d / 2.0, 0.0, -d / 2.0];
+        self.state = ChannelState::Track;
+    }
+}
