@@ -7,6 +7,7 @@
 //! - [`nco`]: numerically controlled oscillators (fixed-point phase accumulators and sine tables).
 //! - [`constants`]: GPS L1 C/A signal constants.
 
+pub mod acquisition;
 pub mod ca_code;
 pub mod constants;
 pub mod nco;

@@ -25,6 +25,8 @@ pub enum Command {
     Info(InfoArgs),
     /// Simulate the built-in demo scenario and show what was made.
     Demo(DemoArgs),
+    /// Search a recording for satellites (FFT parallel code-phase search).
+    Acquire(crate::commands::acquire::AcquireArgs),
 }
 
 /// Options that say how to read a recording; shared by every subcommand that reads one.

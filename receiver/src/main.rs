@@ -18,6 +18,7 @@ fn main() {
         Command::Simulate(args) => commands::simulate::run(&args),
         Command::Info(args) => commands::info::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
+        Command::Acquire(args) => commands::acquire::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -134,6 +134,20 @@ impl CarrierLoop {
         }
     }
 
+    /// Presets the Doppler-rate memory of a 3rd-order loop (Hz/s); see
+    /// [`LoopFilter::preset_rate`].
+    pub fn preset_doppler_rate(&mut self, rate_hz_s: f64) {
+        self.filter.preset_rate(rate_hz_s);
+    }
+
+    /// Moves the loop's base frequency by `delta_hz` (when a feed-forward is switched on or off,
+    /// so that the NCO frequency stays continuous: base - ff_new + ff_new = base).
+    pub fn shift_base_hz(&mut self, delta_hz: f64) {
+        if delta_hz.is_finite() {
+            self.base_hz += delta_hz;
+        }
+    }
+
     /// Forgets the previous prompt (call after a gap in the correlations).
     pub fn reset_history(&mut self) {
         self.prev_prompt = None;

@@ -202,7 +202,10 @@ pub struct Channel {
     /// Accumulated carrier phase (cycles) at `next_sample`.
     carrier_phase_cycles: f64,
     carrier_freq_hz: f64,
-    aid: Option<DopplerAid>,
+    /// The external Doppler estimate and the receive time (s) it refers to.
+    aid: Option<(DopplerAid, f64)>,
+    /// The feed-forward contained in the current NCO frequency, Hz (None: unaided).
+    ff_applied_hz: Option<f64>,
     ms_count: u64,
     /// `ms_count` of the first prompt the bit synchroniser saw since its last reset.
     bit_sync_origin_ms: u64,
@@ -215,6 +218,10 @@ pub struct Channel {
     acc_ms: usize,
     acc_start: (u64, f64, f64, f64),
     taps: [f64; 3],
+    /// Least-squares sums (t, f) of the NCO frequency during pull-in after the FLL assist is
+    /// off: n, sum t, sum f, sum t^2, sum t f. They give the Doppler rate that presets a
+    /// 3rd-order tracking loop at the hand-over.
+    rate_fit: [f64; 5],
 }
 
 impl Channel {
@@ -249,6 +256,7 @@ impl Channel {
             carrier_phase_cycles: 0.0,
             carrier_freq_hz: start.doppler_hz,
             aid: None,
+            ff_applied_hz: None,
             ms_count: 0,
             bit_sync_origin_ms: 0,
             pull_in_ms: 0,
@@ -258,12 +266,18 @@ impl Channel {
             acc_ms: 0,
             acc_start: (start.code_start_sample, 0.0, 0.0, 0.0),
             taps: [d / 2.0, 0.0, -d / 2.0],
+            rate_fit: [0.0; 5],
         })
     }
 
     /// The satellite.
     pub fn prn(&self) -> Prn {
         self.prn
+    }
+
+    /// Sampling rate the channel runs at, Hz.
+    pub fn fs_hz(&self) -> f64 {
+        self.fs_hz
     }
 
     /// The state.
@@ -276,10 +290,20 @@ impl Channel {
         self.cn0_dbhz
     }
 
-    /// Sets the external Doppler estimate fed forward from the next interval on (the aiding
-    /// port); `None` removes the aid.
-    pub fn set_aid(&mut self, aid: Option<DopplerAid>) {
-        self.aid = aid;
+    /// Sets the external Doppler estimate valid at receive time `t_s` (the aiding port), fed
+    /// forward from the next integration interval on: the NCO gets its mean over that interval,
+    /// extrapolated with its rate. `None` removes the aid. Switching the aid on or off keeps the
+    /// NCO frequency continuous (the loop's base frequency takes up the difference).
+    pub fn set_aid(&mut self, aid: Option<DopplerAid>, t_s: f64) {
+        self.aid = aid.map(|a| (a, t_s));
+    }
+
+    /// Feed-forward (Hz) for an interval of `t_coh_s` starting at the channel's next sample.
+    fn feedforward_hz(&self, t_coh_s: f64) -> Option<f64> {
+        self.aid.map(|(a, t_aid)| {
+            let t_next = self.next_sample as f64 / self.fs_hz;
+            a.doppler_hz + a.doppler_rate_hz_s * (t_next - t_aid + 0.5 * t_coh_s)
+        })
     }
 
     /// Absolute index of the first sample the next code period needs, and how many samples it
@@ -413,16 +437,29 @@ impl Channel {
             return None;
         }
         let [ea, pa, la] = self.acc;
-        let ff = self
-            .aid
-            .map(|a| a.mean_over_hz(self.carrier.t_coh_s()))
-            .unwrap_or(0.0);
+        let ff_opt = self.feedforward_hz(self.carrier.t_coh_s());
+        match (self.ff_applied_hz, ff_opt) {
+            (None, Some(f)) => self.carrier.shift_base_hz(-f),
+            (Some(f), None) => self.carrier.shift_base_hz(f),
+            _ => {}
+        }
+        self.ff_applied_hz = ff_opt;
+        let ff = ff_opt.unwrap_or(0.0);
         let co = self.carrier.update(pa, ff);
         let cl = self
             .code_loop
             .update(ea, pa, la, code_doppler_chips_s(co.nco_freq_hz));
         self.carrier_freq_hz = co.nco_freq_hz;
         self.code_rate_chips_s = cl.code_rate_chips_s;
+        if self.state == ChannelState::PullIn
+            && self.pull_in_ms > (self.cfg.fll_assist_s * 1e3) as u64
+        {
+            let t = self.pull_in_ms as f64 * 1e-3;
+            let f = co.nco_freq_hz - ff;
+            for (acc, v) in self.rate_fit.iter_mut().zip([1.0, t, f, t * t, t * f]) {
+                *acc += v;
+            }
+        }
         let (s0, cp0, ph0, f0) = self.acc_start;
         let epoch = ChannelEpoch {
             prn: self.prn.get(),
@@ -468,10 +505,7 @@ impl Channel {
         if self.pull_in_ms < min_ms || !self.pll_lock.locked() {
             return;
         }
-        let ff = self
-            .aid
-            .map(|a| a.mean_over_hz(self.cfg.track.t_coh_s))
-            .unwrap_or(0.0);
+        let ff = self.ff_applied_hz.unwrap_or(0.0);
         let (Ok(carrier), Ok(code_loop)) = (
             CarrierLoop::new(&self.cfg.track, self.carrier_freq_hz - ff),
             CodeLoop::new(&self.cfg.track),
@@ -479,6 +513,11 @@ impl Channel {
             return; // validated at construction; keep pulling in otherwise
         };
         self.carrier = carrier;
+        let [n, st, sf, stt, stf] = self.rate_fit;
+        let den = n * stt - st * st;
+        if n >= 100.0 && den > 0.0 {
+            self.carrier.preset_doppler_rate((n * stf - st * sf) / den);
+        }
         self.code_loop = code_loop;
         let d = self.cfg.track.el_spacing_chips;
         self.taps = [d / 2.0, 0.0, -d / 2.0];

@@ -247,6 +247,16 @@ impl LoopFilter {
         carry + self.k_out * ep
     }
 
+    /// Presets the inner integrator of a two-integrator filter (a 3rd-order PLL's frequency-rate
+    /// memory, Hz/s) so that a loop started mid-track does not have to learn the rate through a
+    /// ringing transient. No effect on filters with fewer than two integrators.
+    pub fn preset_rate(&mut self, rate: f64) {
+        if self.n_int == 2 && rate.is_finite() {
+            self.y[0] = rate;
+            self.x_prev[1] = rate;
+        }
+    }
+
     /// Clears the integrators.
     pub fn reset(&mut self) {
         self.y = [0.0; 2];

@@ -1,5 +1,6 @@
 //! One module per `gpsrx` subcommand.
 
+pub mod acquire;
 pub mod demo;
 pub mod info;
 pub mod simulate;

@@ -1,0 +1,313 @@
+//! Acquisition settings, their validation, and the block layout they imply.
+
+use crate::constants::{CA_CHIP_RATE_HZ, CA_CODE_PERIOD_S};
+use crate::Prn;
+
+/// Largest coherent integration, ms: half a navigation data bit, so a block straddles at most
+/// one bit edge.
+pub const MAX_COHERENT_MS: u32 = 10;
+/// Largest number of fractional Doppler offsets (Doppler step down to 1/(8T)): finer bins buy
+/// nothing, the refinement after detection does the fine part.
+pub const MAX_DOPPLER_SUBDIVISION: usize = 8;
+/// Upper limit of the block spectra an engine keeps for one search, bytes.
+pub const MAX_SPECTRA_BYTES: usize = 1 << 30;
+
+/// Settings of the code-phase / Doppler search.
+///
+/// The defaults are a cold search for a front end with a good oscillator: 1 ms coherent x 10
+/// non-coherent blocks, Doppler 0 +- 5 kHz in 500 Hz bins, false-alarm probability 1e-5 per
+/// PRN search, 100 ms of 1-ms prompts for the fine Doppler and C/N0, cross-correlation margin
+/// 15 dB.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AcqConfig {
+    /// Coherent integration T, in whole C/A code periods (ms), 1..=10.
+    pub coherent_ms: u32,
+    /// Non-coherent sum of this many coherent blocks (>= 1).
+    pub noncoherent: u32,
+    /// Centre of the Doppler search, Hz (the front end's LO offset, if known).
+    pub doppler_center_hz: f64,
+    /// Half-width of the Doppler search, Hz: bins cover centre +- this.
+    pub doppler_max_hz: f64,
+    /// Doppler bin width, Hz; `None` = 1/(2T). Must not exceed 2/(3T); the engine uses
+    /// 1/(Q T) with the smallest integer Q that gives a step no wider than the one asked for.
+    pub doppler_step_hz: Option<f64>,
+    /// Probability that the search of one PRN (all its cells) declares a detection on noise.
+    pub pfa: f64,
+    /// Bit-edge handling for T >= 2 ms: also integrate blocks shifted by floor(T/2) ms and keep
+    /// the better of the two. `None` = on when `coherent_ms >= 2`.
+    pub bit_edge_offsets: Option<bool>,
+    /// Code periods (ms) of prompts used to refine the Doppler and estimate C/N0 after a
+    /// detection (fewer when the samples end sooner; 0 = no refinement).
+    pub refine_ms: u32,
+    /// A detection this many dB (C/N0) below a stronger one of the same search, at a Doppler a
+    /// whole number of kHz away, is taken for a cross-correlation; `None` = no check.
+    pub xcorr_margin_db: Option<f64>,
+}
+
+impl Default for AcqConfig {
+    fn default() -> Self {
+        Self {
+            coherent_ms: 1,
+            noncoherent: 10,
+            doppler_center_hz: 0.0,
+            doppler_max_hz: 5_000.0,
+            doppler_step_hz: None,
+            pfa: 1e-5,
+            bit_edge_offsets: None,
+            refine_ms: 100,
+            xcorr_margin_db: Some(15.0),
+        }
+    }
+}
+
+impl AcqConfig {
+    /// Whether the half-offset pass runs.
+    pub fn uses_bit_edge_offsets(&self) -> bool {
+        self.coherent_ms >= 2 && self.bit_edge_offsets.unwrap_or(true)
+    }
+}
+
+/// Acquisition errors.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AcqError {
+    /// A setting is out of range.
+    #[error("acquisition setting {name} = {value}: {hint}")]
+    BadSetting {
+        /// The setting.
+        name: &'static str,
+        /// Its value, printed.
+        value: String,
+        /// What is allowed.
+        hint: String,
+    },
+    /// Not enough samples for the search.
+    #[error(
+        "acquisition needs {needed} samples ({needed_ms:.1} ms) but got {got}: \
+         read more of the recording or use fewer/shorter blocks"
+    )]
+    NotEnoughSamples {
+        /// Samples needed.
+        needed: usize,
+        /// The same in ms.
+        needed_ms: f64,
+        /// Samples given.
+        got: usize,
+    },
+    /// A PRN's Doppler window does not overlap the engine's Doppler range.
+    #[error(
+        "{prn}: Doppler window {min_hz:.0}..{max_hz:.0} Hz lies outside the search range \
+         {range_min_hz:.0}..{range_max_hz:.0} Hz: widen the engine's Doppler range"
+    )]
+    EmptyDopplerWindow {
+        /// The PRN.
+        prn: Prn,
+        /// Window asked for.
+        min_hz: f64,
+        /// Window asked for.
+        max_hz: f64,
+        /// The engine's range.
+        range_min_hz: f64,
+        /// The engine's range.
+        range_max_hz: f64,
+    },
+}
+
+fn bad(name: &'static str, value: impl ToString, hint: impl Into<String>) -> AcqError {
+    AcqError::BadSetting {
+        name,
+        value: value.to_string(),
+        hint: hint.into(),
+    }
+}
+
+/// Where the coherent blocks lie and how the FFT correlation is organised; derived from the
+/// sampling rate and an [`AcqConfig`].
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Layout {
+    /// Samples per code period (1 ms), possibly fractional.
+    pub period_samples: f64,
+    /// Samples per coherent block (FFT length of the forward transforms).
+    pub block_len: usize,
+    /// Decimation of the block spectrum: `coherent_ms` when a code period is a whole number of
+    /// samples (the replica is then periodic in the block and only every M-th bin of its
+    /// spectrum is non-zero), else 1.
+    pub decimation: usize,
+    /// Length of the inverse FFTs and of the replica spectra: `block_len / decimation`.
+    pub inv_len: usize,
+    /// Code lags searched: one code period of samples.
+    pub n_lags: usize,
+    /// Fractional Doppler offsets Q: the Doppler step is fs / (Q block_len).
+    pub subdivision: usize,
+    /// Doppler step, Hz.
+    pub doppler_step_hz: f64,
+    /// Doppler bins, as multiples of the step: `bin_min..=bin_max`.
+    pub bin_min: i64,
+    /// Last Doppler bin.
+    pub bin_max: i64,
+    /// Start of each coherent block of each pass, in whole code periods from the first sample.
+    pub block_start_ms: Vec<Vec<u32>>,
+    /// Samples the search reads.
+    pub samples_needed: usize,
+}
+
+impl Layout {
+    pub(crate) fn new(fs_hz: f64, cfg: &AcqConfig) -> Result<Self, AcqError> {
+        if !(CA_CHIP_RATE_HZ..=200e6).contains(&fs_hz) {
+            return Err(bad(
+                "fs_hz",
+                fs_hz,
+                "use a sampling rate between 1.023 MHz and 200 MHz",
+            ));
+        }
+        if !(1..=MAX_COHERENT_MS).contains(&cfg.coherent_ms) {
+            return Err(bad(
+                "coherent_ms",
+                cfg.coherent_ms,
+                format!("use 1 to {MAX_COHERENT_MS} ms"),
+            ));
+        }
+        if !(1..=100_000).contains(&cfg.noncoherent) {
+            return Err(bad(
+                "noncoherent",
+                cfg.noncoherent,
+                "use 1 to 100000 blocks",
+            ));
+        }
+        if !(cfg.pfa > 0.0 && cfg.pfa < 1.0) {
+            return Err(bad(
+                "pfa",
+                cfg.pfa,
+                "use a probability in (0, 1), e.g. 1e-5",
+            ));
+        }
+        if !cfg.doppler_center_hz.is_finite() || cfg.doppler_center_hz.abs() > fs_hz / 2.0 {
+            return Err(bad(
+                "doppler_center_hz",
+                cfg.doppler_center_hz,
+                "use |centre| < fs/2",
+            ));
+        }
+        if !cfg.doppler_max_hz.is_finite()
+            || cfg.doppler_max_hz < 0.0
+            || cfg.doppler_max_hz > fs_hz / 2.0
+        {
+            return Err(bad(
+                "doppler_max_hz",
+                cfg.doppler_max_hz,
+                "use a half-width between 0 and fs/2",
+            ));
+        }
+        if cfg
+            .xcorr_margin_db
+            .is_some_and(|m| !(m.is_finite() && m >= 0.0))
+        {
+            return Err(bad(
+                "xcorr_margin_db",
+                format!("{:?}", cfg.xcorr_margin_db),
+                "use a non-negative number of dB (15 is typical) or none",
+            ));
+        }
+        if cfg.refine_ms > 10_000 {
+            return Err(bad("refine_ms", cfg.refine_ms, "use 0 to 10000 ms"));
+        }
+        let period_samples = fs_hz * CA_CODE_PERIOD_S;
+        let m = cfg.coherent_ms as usize;
+        let integer_period = (period_samples - period_samples.round()).abs() < 1e-6;
+        let block_len = (m as f64 * period_samples).round() as usize;
+        let (decimation, n_lags) = if integer_period {
+            (m, period_samples.round() as usize)
+        } else {
+            (1, (period_samples.ceil() as usize).min(block_len))
+        };
+        let inv_len = block_len / decimation;
+        let t_block_s = block_len as f64 / fs_hz;
+        let max_step = 2.0 / (3.0 * t_block_s);
+        let subdivision = match cfg.doppler_step_hz {
+            None => 2,
+            Some(s) => {
+                if !(s.is_finite() && s > 0.0 && s <= max_step * (1.0 + 1e-9)) {
+                    return Err(bad(
+                        "doppler_step_hz",
+                        s,
+                        format!("use a bin width in (0, 2/(3T)] = (0, {max_step:.1}] Hz"),
+                    ));
+                }
+                let q = (1.0 / (t_block_s * s) - 1e-9).ceil().max(2.0) as usize;
+                if q > MAX_DOPPLER_SUBDIVISION {
+                    let min_step = 1.0 / (MAX_DOPPLER_SUBDIVISION as f64 * t_block_s);
+                    return Err(bad(
+                        "doppler_step_hz",
+                        s,
+                        format!(
+                            "use at least 1/(8T) = {min_step:.1} Hz (finer is done by refinement)"
+                        ),
+                    ));
+                }
+                q
+            }
+        };
+        let doppler_step_hz = 1.0 / (subdivision as f64 * t_block_s);
+        let lo = cfg.doppler_center_hz - cfg.doppler_max_hz;
+        let hi = cfg.doppler_center_hz + cfg.doppler_max_hz;
+        let bin_min = (lo / doppler_step_hz - 1e-9).ceil() as i64;
+        let bin_max = ((hi / doppler_step_hz + 1e-9).floor() as i64).max(bin_min);
+        let passes: Vec<u32> = if cfg.uses_bit_edge_offsets() {
+            vec![0, cfg.coherent_ms / 2]
+        } else {
+            vec![0]
+        };
+        let block_start_ms: Vec<Vec<u32>> = passes
+            .iter()
+            .map(|&off| {
+                (0..cfg.noncoherent)
+                    .map(|b| b * cfg.coherent_ms + off)
+                    .collect()
+            })
+            .collect();
+        let last_start = block_start_ms
+            .iter()
+            .filter_map(|p| p.last())
+            .max()
+            .copied()
+            .unwrap_or(0);
+        let samples_needed = (f64::from(last_start) * period_samples).round() as usize + block_len;
+        let spectra_bytes = block_start_ms.len()
+            * cfg.noncoherent as usize
+            * subdivision
+            * block_len
+            * std::mem::size_of::<num_complex::Complex32>();
+        if spectra_bytes > MAX_SPECTRA_BYTES {
+            return Err(bad(
+                "noncoherent",
+                cfg.noncoherent,
+                format!(
+                    "the block spectra would take {} MiB: use fewer blocks or a coarser Doppler step",
+                    spectra_bytes >> 20
+                ),
+            ));
+        }
+        Ok(Self {
+            period_samples,
+            block_len,
+            decimation,
+            inv_len,
+            n_lags,
+            subdivision,
+            doppler_step_hz,
+            bin_min,
+            bin_max,
+            block_start_ms,
+            samples_needed,
+        })
+    }
+
+    /// First sample of a block that starts `ms` code periods after the first sample.
+    pub(crate) fn block_start_sample(&self, ms: u32) -> usize {
+        (f64::from(ms) * self.period_samples).round() as usize
+    }
+
+    /// Coherent block duration T, s.
+    pub(crate) fn t_block_s(&self, fs_hz: f64) -> f64 {
+        self.block_len as f64 / fs_hz
+    }
+}

@@ -1,0 +1,110 @@
+//! The FFT correlation itself: block spectra shared by all PRNs, and one PRN's non-coherent
+//! power grid from them.
+
+use super::engine::{AcquisitionEngine, Scratch};
+use crate::constants::F_L1_HZ;
+use crate::Prn;
+use num_complex::Complex32;
+use rayon::prelude::*;
+
+impl AcquisitionEngine {
+    /// Forward FFTs of every block of every pass at every fractional Doppler offset, stored
+    /// polyphase (`X[D j + r]` at `r * inv_len + j`) so that the decimated reads are contiguous.
+    pub(super) fn block_spectra(&self, samples: &[Complex32]) -> Vec<Complex32> {
+        let l = &self.layout;
+        let n = l.block_len;
+        let q_total = l.subdivision;
+        let starts: Vec<usize> = l
+            .block_start_ms
+            .iter()
+            .flatten()
+            .map(|&ms| l.block_start_sample(ms))
+            .collect();
+        let mut spectra = self
+            .spectra_pool
+            .lock()
+            .ok()
+            .and_then(|mut p| p.pop())
+            .unwrap_or_default();
+        spectra.resize(starts.len() * q_total * n, Complex32::new(0.0, 0.0));
+        spectra.par_chunks_mut(n).enumerate().for_each(|(i, out)| {
+            let (blk, q) = (i / q_total, i % q_total);
+            let src = &samples[starts[blk]..starts[blk] + n];
+            let mut s = self.take_scratch();
+            let tmp = &mut s.buf[..n];
+            if q == 0 {
+                tmp.copy_from_slice(src);
+            } else {
+                let w = &self.wipeoffs[q - 1];
+                for ((t, x), w) in tmp.iter_mut().zip(src).zip(w) {
+                    *t = x * w;
+                }
+            }
+            self.fwd.process_with_scratch(tmp, &mut s.fft);
+            let d = l.decimation;
+            let m = l.inv_len;
+            for r in 0..d {
+                for (j, o) in out[r * m..(r + 1) * m].iter_mut().enumerate() {
+                    *o = tmp[d * j + r];
+                }
+            }
+            self.give_scratch(s);
+        });
+        spectra
+    }
+
+    /// Non-coherent power grid of one PRN and one pass into `s.grid` (rows = Doppler bins
+    /// `b0..=b1`, columns = code lags referred to the first sample).
+    pub(super) fn fill_grid(
+        &self,
+        spectra: &[Complex32],
+        prn: Prn,
+        b0: i64,
+        b1: i64,
+        pass: usize,
+        s: &mut Scratch,
+    ) {
+        let l = &self.layout;
+        let (n, m, lags, q_total) = (l.block_len, l.inv_len, l.n_lags, l.subdivision);
+        let rows = (b1 - b0 + 1) as usize;
+        s.grid.clear();
+        s.grid.resize(rows * lags, 0.0);
+        let replica = &self.replicas[prn.index()];
+        let blocks_per_pass = l.block_start_ms.first().map_or(0, Vec::len);
+        let starts = &l.block_start_ms[pass];
+        for (row, bin) in (b0..=b1).enumerate() {
+            let q = bin.rem_euclid(q_total as i64) as usize;
+            let k = (bin - q as i64) / q_total as i64;
+            let kk = k.rem_euclid(n as i64) as usize;
+            let (r, a) = (kk % l.decimation, kk / l.decimation);
+            let f_hz = bin as f64 * l.doppler_step_hz;
+            let grid_row = &mut s.grid[row * lags..(row + 1) * lags];
+            for (b, &ms) in starts.iter().enumerate() {
+                let base = ((pass * blocks_per_pass + b) * q_total + q) * n + r * m;
+                let src = &spectra[base..base + m];
+                // Y[j] = X[D (j + a) + r] conj(C[j]) / len: the Doppler shift is a rotation.
+                let buf = &mut s.buf[..m];
+                let (head, tail) = buf.split_at_mut(m - a);
+                for ((y, x), c) in head.iter_mut().zip(&src[a..]).zip(&replica[..m - a]) {
+                    *y = x * c;
+                }
+                for ((y, x), c) in tail.iter_mut().zip(&src[..a]).zip(&replica[m - a..]) {
+                    *y = x * c;
+                }
+                self.inv.process_with_scratch(buf, &mut s.fft);
+                // Where the code period that started at lag tau of block 0 starts in this block:
+                // the block start rounding plus the code Doppler (code runs f/f_L1 faster).
+                let ideal = f64::from(ms) * l.period_samples;
+                let shift = (ideal - l.block_start_sample(ms) as f64) - ideal * f_hz / F_L1_HZ;
+                let rs = (shift.round() as i64).rem_euclid(m as i64) as usize;
+                let first = lags.min(m - rs);
+                for (g, y) in grid_row[..first].iter_mut().zip(&buf[rs..rs + first]) {
+                    *g += y.norm_sqr();
+                }
+                for (g, y) in grid_row[first..].iter_mut().zip(&buf[..lags - first]) {
+                    *g += y.norm_sqr();
+                }
+            }
+        }
+    }
+}
