@@ -27,6 +27,8 @@ pub enum Command {
     Demo(DemoArgs),
     /// Search a recording for satellites (FFT parallel code-phase search).
     Acquire(crate::commands::acquire::AcquireArgs),
+    /// Acquire and track satellites; write every integration interval to CSV.
+    Track(crate::commands::track::TrackArgs),
 }
 
 /// Options that say how to read a recording; shared by every subcommand that reads one.
@@ -130,4 +132,88 @@ pub struct DemoArgs {
     /// Shorten the demo recording, s (default: the scenario's 40 s).
     #[arg(long, value_name = "S")]
     pub duration: Option<f64>,
+}
+
+/// Tracking-loop options, shared by `track` and (later) `run`; each overrides the config file.
+#[derive(Debug, Clone, Default, Args)]
+pub struct LoopArgs {
+    /// Configuration file (TOML) with a `[tracking]` table (see `gpsrx track --help`).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// PLL order after pull-in: 1, 2 or 3 (0: FLL only).
+    #[arg(long, value_name = "N")]
+    pub pll_order: Option<u8>,
+    /// PLL noise bandwidth after pull-in, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub pll_bw: Option<f64>,
+    /// FLL order after pull-in: 0 (none), 1 or 2.
+    #[arg(long, value_name = "N")]
+    pub fll_order: Option<u8>,
+    /// FLL noise bandwidth after pull-in, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub fll_bw: Option<f64>,
+    /// DLL order: 1 or 2.
+    #[arg(long, value_name = "N")]
+    pub dll_order: Option<u8>,
+    /// DLL noise bandwidth, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub dll_bw: Option<f64>,
+    /// Coherent integration after bit sync, ms: 1, 2, 4, 5, 10 or 20.
+    #[arg(long, value_name = "MS")]
+    pub t_coh: Option<f64>,
+    /// Early-late spacing, chips (0.1 to 1).
+    #[arg(long, value_name = "CHIPS")]
+    pub el_spacing: Option<f64>,
+}
+
+/// The `[tracking]` table of a configuration file.
+#[derive(Debug, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConfigFile {
+    #[serde(default)]
+    tracking: Option<gpsrx_tracking::ChannelConfig>,
+}
+
+impl LoopArgs {
+    /// The channel configuration: defaults, then the config file, then these options.
+    pub fn channel_config(&self) -> anyhow::Result<gpsrx_tracking::ChannelConfig> {
+        let mut cfg = match &self.config {
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
+                let file: ConfigFile = toml::from_str(&text)
+                    .map_err(|e| anyhow::anyhow!("config {}: {e}", path.display()))?;
+                file.tracking.unwrap_or_default()
+            }
+            None => gpsrx_tracking::ChannelConfig::default(),
+        };
+        let t = &mut cfg.track;
+        if let Some(v) = self.pll_order {
+            t.pll_order = v;
+        }
+        if let Some(v) = self.pll_bw {
+            t.pll_bw_hz = v;
+        }
+        if let Some(v) = self.fll_order {
+            t.fll_order = v;
+        }
+        if let Some(v) = self.fll_bw {
+            t.fll_bw_hz = v;
+        }
+        if let Some(v) = self.dll_order {
+            t.dll_order = v;
+        }
+        if let Some(v) = self.dll_bw {
+            t.dll_bw_hz = v;
+        }
+        if let Some(v) = self.t_coh {
+            t.t_coh_s = v * 1e-3;
+        }
+        if let Some(v) = self.el_spacing {
+            t.el_spacing_chips = v;
+        }
+        cfg.validate()
+            .map_err(|e| anyhow::anyhow!("tracking configuration: {e}"))?;
+        Ok(cfg)
+    }
 }

@@ -19,6 +19,7 @@ fn main() {
         Command::Info(args) => commands::info::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
         Command::Acquire(args) => commands::acquire::run(&args),
+        Command::Track(args) => commands::track::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

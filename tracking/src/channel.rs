@@ -17,7 +17,7 @@
 use crate::aiding::{code_doppler_chips_s, DopplerAid};
 use crate::bit_sync::{Bit, BitSync, BitSyncConfig, BitSyncState, MS_PER_BIT};
 use crate::carrier_loop::CarrierLoop;
-use crate::cn0::NwprEstimator;
+use crate::cn0::SmoothedNwpr;
 use crate::code_loop::CodeLoop;
 use crate::config::{ConfigError, LoopConfig};
 use crate::lock_detector::{CodeLockDetector, PllLockConfig, PllLockDetector};
@@ -43,7 +43,10 @@ pub struct ChannelConfig {
     pub fll_assist_s: f64,
     /// C/N0 below which the code is considered lost, dB-Hz.
     pub cn0_lost_dbhz: f64,
-    /// How many consecutive C/N0 estimates (1 s each) below the threshold release the channel.
+    /// Length of one C/N0 estimate (NWPR over 20 ms blocks aligned to data bits), s: a multiple
+    /// of 20 ms. 0.2 s estimates scatter by about 0.5 dB; 1 s ones by 0.2 dB.
+    pub cn0_window_s: f64,
+    /// How many consecutive C/N0 estimates below the threshold release the channel.
     pub lost_estimates: u32,
 }
 
@@ -65,7 +68,8 @@ impl Default for ChannelConfig {
             min_pull_in_s: 0.5,
             fll_assist_s: 0.3,
             cn0_lost_dbhz: 25.0,
-            lost_estimates: 2,
+            cn0_window_s: 0.2,
+            lost_estimates: 5,
         }
     }
 }
@@ -88,6 +92,16 @@ impl ChannelConfig {
                 field: "min_pull_in_s",
                 value: self.min_pull_in_s,
                 valid: ">= 0 s".into(),
+            });
+        }
+        if !(self.cn0_window_s.is_finite()
+            && self.cn0_window_s >= 0.02
+            && self.cn0_window_s <= 10.0)
+        {
+            return Err(ConfigError::OutOfRange {
+                field: "cn0_window_s",
+                value: self.cn0_window_s,
+                valid: "0.02 to 10 s".into(),
             });
         }
         if !(self.fll_assist_s.is_finite() && self.fll_assist_s >= 0.0) {
@@ -129,6 +143,9 @@ pub struct ChannelStart {
     pub code_start_sample: u64,
     /// Carrier Doppler, Hz (including any front-end frequency offset).
     pub doppler_hz: f64,
+    /// C/N0 estimate from acquisition, dB-Hz (NaN if unknown): reported until the channel's
+    /// own estimate is available.
+    pub cn0_dbhz: f64,
 }
 
 /// What a channel reports at the end of each integration interval.
@@ -192,7 +209,9 @@ pub struct Channel {
     code_loop: CodeLoop,
     pll_lock: PllLockDetector,
     code_lock: CodeLockDetector,
-    cn0: NwprEstimator,
+    cn0: SmoothedNwpr,
+    cn0_started: bool,
+    cn0_window_blocks: u32,
     bit_sync: BitSync,
     /// Next integration's first sample (absolute index).
     next_sample: u64,
@@ -248,7 +267,14 @@ impl Channel {
             code_loop,
             pll_lock: PllLockDetector::new(PllLockConfig::default()),
             code_lock: CodeLockDetector::new(cfg.cn0_lost_dbhz, cfg.lost_estimates),
-            cn0: NwprEstimator::new(1e-3, 20, 50),
+            cn0_started: false,
+            cn0_window_blocks: ((cfg.cn0_window_s / 0.02).round() as u32).max(1),
+            cn0: SmoothedNwpr::new(
+                1e-3,
+                20,
+                ((cfg.cn0_window_s / 0.02).round() as u32).max(1),
+                5,
+            ),
             bit_sync: BitSync::new(BitSyncConfig::default()),
             next_sample: start.code_start_sample,
             code_phase_chips: 0.0,
@@ -260,7 +286,7 @@ impl Channel {
             ms_count: 0,
             bit_sync_origin_ms: 0,
             pull_in_ms: 0,
-            cn0_dbhz: f64::NAN,
+            cn0_dbhz: start.cn0_dbhz,
             low_cn0_count: 0,
             acc: [Complex64::new(0.0, 0.0); 3],
             acc_ms: 0,
@@ -396,27 +422,40 @@ impl Channel {
         let next_is_edge = edge_phase.is_some_and(|edge| {
             (ms_index + 1) % MS_PER_BIT as u64 == edge as u64 % MS_PER_BIT as u64
         });
-        let estimate = self.cn0.push(p);
+        // C/N0 from NWPR blocks of 20 prompts aligned to the data bits: measured from the first
+        // bit edge after bit synchronisation (before it, the acquisition's estimate stands).
+        let estimate = if self.cn0_started {
+            self.cn0.push(p)
+        } else {
+            None
+        };
         if next_is_edge {
-            // NWPR blocks of 20 prompts must not straddle a data-bit transition.
+            if !self.cn0_started {
+                self.cn0_started = true;
+                self.cn0.reset();
+            }
             self.cn0.align_block();
         }
         if let Some(c) = estimate {
             self.cn0_dbhz = c;
-            let ok = self.code_lock.update(c);
-            self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz {
-                self.low_cn0_count + 1
-            } else {
-                0
-            };
-            if !ok && self.low_cn0_count >= self.cfg.lost_estimates {
-                self.state = ChannelState::Lost;
+            // Lock decisions once per estimation window.
+            if self.cn0.blocks() % self.cn0_window_blocks == 0 {
+                let ok = self.code_lock.update(c);
+                self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz {
+                    self.low_cn0_count + 1
+                } else {
+                    0
+                };
+                if !ok && self.low_cn0_count >= self.cfg.lost_estimates {
+                    self.state = ChannelState::Lost;
+                }
             }
         }
         self.pll_lock.update(p);
         if matches!(self.bit_sync.state(), BitSyncState::Failed) {
-            self.bit_sync.reset();
-            self.bit_sync_origin_ms = self.ms_count;
+            // No bit edges within the synchroniser's patience: no usable signal. Release the
+            // channel so the satellite goes back to acquisition.
+            self.state = ChannelState::Lost;
         }
 
         // Integration interval complete?

@@ -201,3 +201,95 @@ mod tests {
         assert_eq!(m.push(Complex64::new(f64::NAN, 0.0)), None);
     }
 }
+
+/// NWPR with a running mean of the block power ratio: after the first `min_blocks` blocks it
+/// gives an estimate at the end of every block, from the mean of all blocks so far (up to
+/// `window_blocks`), then from an exponentially weighted mean with that time constant. Same
+/// estimator as [`NwprEstimator`] (`C/N0 = (mu - 1) / (T (M - mu))`, Van Dierendonck), but
+/// usable within a fraction of a second of bit synchronisation. Feed it only block-aligned
+/// prompts (call [`SmoothedNwpr::align_block`] at bit edges).
+#[derive(Debug, Clone)]
+pub struct SmoothedNwpr {
+    m: u32,
+    t_s: f64,
+    window_blocks: u32,
+    min_blocks: u32,
+    sum: Complex64,
+    wbp: f64,
+    n_in_block: u32,
+    mu: f64,
+    blocks: u32,
+}
+
+impl SmoothedNwpr {
+    /// `m` prompts of `t_s` per block (>= 2), averaging over `window_blocks` (>= 1) blocks and
+    /// estimating from `min_blocks` on (clamped to 1..=window).
+    pub fn new(t_s: f64, m: u32, window_blocks: u32, min_blocks: u32) -> Self {
+        let window_blocks = window_blocks.max(1);
+        Self {
+            m: m.max(2),
+            t_s: if t_s.is_finite() && t_s > 0.0 {
+                t_s
+            } else {
+                1e-3
+            },
+            window_blocks,
+            min_blocks: min_blocks.clamp(1, window_blocks),
+            sum: Complex64::new(0.0, 0.0),
+            wbp: 0.0,
+            n_in_block: 0,
+            mu: 0.0,
+            blocks: 0,
+        }
+    }
+
+    /// Forgets everything (e.g. after a loss of lock or at bit synchronisation).
+    pub fn reset(&mut self) {
+        *self = Self::new(self.t_s, self.m, self.window_blocks, self.min_blocks);
+    }
+
+    /// Restarts the current block (call at a bit edge).
+    pub fn align_block(&mut self) {
+        self.sum = Complex64::new(0.0, 0.0);
+        self.wbp = 0.0;
+        self.n_in_block = 0;
+    }
+
+    /// Blocks averaged so far.
+    pub fn blocks(&self) -> u32 {
+        self.blocks
+    }
+
+    /// Feeds one prompt; returns an estimate (dB-Hz) when a block completes and enough blocks
+    /// are in. Non-finite prompts are skipped.
+    pub fn push(&mut self, prompt: Complex64) -> Option<f64> {
+        if !(prompt.re.is_finite() && prompt.im.is_finite()) {
+            return None;
+        }
+        self.sum += prompt;
+        self.wbp += prompt.norm_sqr();
+        self.n_in_block += 1;
+        if self.n_in_block < self.m {
+            return None;
+        }
+        let np = if self.wbp > 0.0 {
+            self.sum.norm_sqr() / self.wbp
+        } else {
+            1.0
+        };
+        self.align_block();
+        self.blocks = self.blocks.saturating_add(1);
+        let alpha = 1.0 / f64::from(self.blocks.min(self.window_blocks));
+        self.mu += alpha * (np - self.mu);
+        if self.blocks < self.min_blocks {
+            return None;
+        }
+        let m = f64::from(self.m);
+        let cn0 = if self.mu >= m {
+            f64::INFINITY
+        } else {
+            (self.mu - 1.0) / (self.t_s * (m - self.mu))
+        };
+        Some(to_dbhz(cn0))
+    }
+}

@@ -4,3 +4,4 @@ pub mod acquire;
 pub mod demo;
 pub mod info;
 pub mod simulate;
+pub mod track;
