@@ -137,7 +137,8 @@ pub struct DemoArgs {
 /// Tracking-loop options, shared by `track` and (later) `run`; each overrides the config file.
 #[derive(Debug, Clone, Default, Args)]
 pub struct LoopArgs {
-    /// Configuration file (TOML) with a `[tracking]` table (see `gpsrx track --help`).
+    /// Configuration file (TOML) with a `[tracking]` table: `pull_in` and `track` loop settings,
+    /// `min_pull_in_s`, `fll_assist_s`, `cn0_lost_dbhz`, `cn0_window_s`, `lost_estimates`.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// PLL order after pull-in: 1, 2 or 3 (0: FLL only).

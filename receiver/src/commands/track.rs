@@ -3,7 +3,7 @@
 
 use crate::cli::LoopArgs;
 use crate::commands::acquire::{acquire, AcquireArgs};
-use crate::pipeline::tracker::track;
+use crate::pipeline::tracker::{track_with_reacquisition, Reacquisition};
 use anyhow::Context;
 use gpsrx_samples::open_source;
 use gpsrx_tracking::{Channel, ChannelEpoch, ChannelStart, ChannelState};
@@ -122,9 +122,13 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
         }
         None => None,
     };
+    // Lost satellites (and ones not found at the start) are searched for again every second.
+    let engine = gpsrx_dsp::acquisition::AcquisitionEngine::new(fs, gpsrx_dsp::acquisition::AcqConfig::default())?;
+    let prns = args.acquisition.prn.iter().filter_map(|&p| gpsrx_dsp::Prn::new(p).ok()).collect();
+    let reacq = Reacquisition { engine: &engine, interval_s: 1.0, channel_config: cfg, prns };
     let mut summaries: BTreeMap<u8, ChannelSummary> = BTreeMap::new();
     let mut write_err = None;
-    track(src.as_mut(), channels, None, |_, e| {
+    track_with_reacquisition(src.as_mut(), channels, None, Some(&reacq), |_, e| {
         let s = summaries.entry(e.prn).or_insert_with(|| ChannelSummary {
             prn: e.prn,
             ..Default::default()
