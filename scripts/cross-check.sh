@@ -48,7 +48,45 @@ else
   bad "gpsrx info failed: $(cat "$WORK/info.err")"
 fi
 
-# --- 2. Simulate 60 s at 4 Msps ci8 (static, Seoul, >= 10 satellites) and let GNSS-SDR fix on it.
+# --- 2. Acquisition on the real CTTC capture (+-15 kHz): exactly PRNs 29, 25, 31, 12, 2.
+CTTC="$DATA/real/GSoC_CTTC_capture_2012_07_26_4Msps_4ms.dat"
+if "$GPSRX" acquire "$CTTC" --format cf32_le --fs 4e6 --doppler-max 15000 --json >"$WORK/acq.json" 2>"$WORK/acq.err"; then
+  if python3 - "$WORK/acq.json" <<'PY'
+import json, sys
+rows = [r for r in json.load(open(sys.argv[1])) if r.get("detected", True)]
+ref = {29: (3705, 9725), 25: (686, 8995), 31: (1949, 11785), 12: (510, 7180), 2: (873, 8080)}
+found = {r["prn"]: r for r in rows}
+assert set(found) == set(ref), sorted(found)
+for prn, (delay, dop) in ref.items():
+    r = found[prn]
+    assert abs(r["code_phase_samples"] - delay) <= 1.0, (prn, r["code_phase_samples"])
+    assert abs(r["doppler_hz"] - dop) <= 50.0, (prn, r["doppler_hz"])
+print("acquire: CTTC PRNs", sorted(found), "within 1 sample and 50 Hz of the reference")
+PY
+  then ok "gpsrx acquire on the CTTC capture"; else bad "gpsrx acquire on the CTTC capture (see $WORK/acq.json)"; fi
+else
+  bad "gpsrx acquire failed: $(cat "$WORK/acq.err")"
+fi
+
+# --- 3. Tracking on the real PocketSDR capture: lock and data-bit edges of the reference table.
+if "$GPSRX" track "$POCKET" --format ci8 --fs 4e6 --invert-q --json >"$WORK/track.json" 2>"$WORK/track.err"; then
+  if python3 - "$WORK/track.json" <<'PY'
+import json, sys
+rows = {r["prn"]: r for r in json.load(open(sys.argv[1]))}
+ref = {31: 6.0, 26: 6.0, 16: 12.0, 29: 13.5, 32: 15.0}
+for prn, edge in ref.items():
+    r = rows[prn]
+    assert r["first_lock_s"] is not None, prn
+    d = (r["bit_edge_ms_mod_20"] - edge + 10.0) % 20.0 - 10.0
+    assert abs(d) <= 1.0, (prn, r["bit_edge_ms_mod_20"])
+    print(f"track: PRN {prn} locked at {r['first_lock_s']:.2f} s, bit edge {r['bit_edge_ms_mod_20']:.2f} ms (ref {edge}), C/N0 {r['cn0_dbhz']:.1f}")
+PY
+  then ok "gpsrx track on the PocketSDR capture"; else bad "gpsrx track on the PocketSDR capture (see $WORK/track.json)"; fi
+else
+  bad "gpsrx track failed: $(cat "$WORK/track.err")"
+fi
+
+# --- 4. Simulate 60 s at 4 Msps ci8 (static, Seoul, >= 10 satellites) and let GNSS-SDR fix on it.
 SIM="$WORK/sim"
 if "$GPSRX" simulate samples/scenarios/static-seoul-4msps.toml -o "$SIM" --json >"$WORK/sim.json" 2>"$WORK/sim.err"; then
   read -r nsat rtf < <(python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); print(len(r["satellites"]), round(r["realtime_factor"],2))' "$WORK/sim.json")
