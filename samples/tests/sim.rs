@@ -52,16 +52,8 @@ drift_s_s = 5.0e-8
 
 /// Reads a whole (small) recording back as complex baseband.
 fn read_all(path: &Path) -> Vec<Complex32> {
-    let cfg = SourceConfig {
-        path: path.to_path_buf(),
-        format: None,
-        fs_hz: None,
-        if_hz: 0.0,
-        invert_q: false,
-        skip_s: 0.0,
-        duration_s: None,
-    };
-    let mut src = open_source(&cfg).unwrap_or_else(|e| panic!("{e}"));
+    let mut src =
+        open_source(&SourceConfig::new(path.to_path_buf())).unwrap_or_else(|e| panic!("{e}"));
     let mut all = Vec::new();
     let mut buf = vec![Complex32::new(0.0, 0.0); 1 << 16];
     loop {

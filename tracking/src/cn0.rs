@@ -33,15 +33,58 @@ fn to_dbhz(cn0_hz: f64) -> f64 {
     }
 }
 
+/// One NWPR block: the coherent sum and the summed power of `m` prompts.
+#[derive(Debug, Clone, Copy)]
+struct NwprBlock {
+    sum: Complex64,
+    wbp: f64,
+    n: u32,
+}
+
+impl NwprBlock {
+    const EMPTY: Self = Self {
+        sum: Complex64::new(0.0, 0.0),
+        wbp: 0.0,
+        n: 0,
+    };
+
+    /// Adds a prompt; returns the block's normalised power `|sum|^2 / sum |p|^2` (1 for noise,
+    /// `m` for a pure carrier) when the block holds `m` prompts, and starts a new block.
+    /// Non-finite prompts are skipped.
+    fn push(&mut self, prompt: Complex64, m: u32) -> Option<f64> {
+        if !(prompt.re.is_finite() && prompt.im.is_finite()) {
+            return None;
+        }
+        self.sum += prompt;
+        self.wbp += prompt.norm_sqr();
+        self.n += 1;
+        if self.n < m {
+            return None;
+        }
+        let np = (self.wbp > 0.0).then(|| self.sum.norm_sqr() / self.wbp);
+        *self = Self::EMPTY;
+        np
+    }
+}
+
+/// C/N0 (linear, Hz) from the mean normalised power `mu` of blocks of `m` prompts of `t_s`:
+/// `(mu - 1) / (T (M - mu))` (Van Dierendonck's NWPR).
+fn nwpr_cn0_hz(mu: f64, m: u32, t_s: f64) -> f64 {
+    let m = f64::from(m);
+    if mu >= m {
+        f64::INFINITY
+    } else {
+        (mu - 1.0) / (t_s * (m - mu))
+    }
+}
+
 /// Narrow-band / wide-band power ratio C/N0 estimator.
 #[derive(Debug, Clone)]
 pub struct NwprEstimator {
     m: u32,
     k: u32,
     t_s: f64,
-    sum: Complex64,
-    wbp: f64,
-    n_in_block: u32,
+    block: NwprBlock,
     np_sum: f64,
     blocks: u32,
     last_dbhz: Option<f64>,
@@ -60,9 +103,7 @@ impl NwprEstimator {
             } else {
                 1e-3
             },
-            sum: Complex64::new(0.0, 0.0),
-            wbp: 0.0,
-            n_in_block: 0,
+            block: NwprBlock::EMPTY,
             np_sum: 0.0,
             blocks: 0,
             last_dbhz: None,
@@ -71,41 +112,22 @@ impl NwprEstimator {
 
     /// Restarts the current block (call at a bit edge to align blocks with the data bits).
     pub fn align_block(&mut self) {
-        self.sum = Complex64::new(0.0, 0.0);
-        self.wbp = 0.0;
-        self.n_in_block = 0;
+        self.block = NwprBlock::EMPTY;
     }
 
     /// Feeds one prompt; returns a new estimate (dB-Hz) when `k` blocks are complete.
     /// Non-finite prompts are skipped.
     pub fn push(&mut self, prompt: Complex64) -> Option<f64> {
-        if !(prompt.re.is_finite() && prompt.im.is_finite()) {
-            return None;
-        }
-        self.sum += prompt;
-        self.wbp += prompt.norm_sqr();
-        self.n_in_block += 1;
-        if self.n_in_block < self.m {
-            return None;
-        }
-        if self.wbp > 0.0 {
-            self.np_sum += self.sum.norm_sqr() / self.wbp;
-            self.blocks += 1;
-        }
-        self.align_block();
+        let np = self.block.push(prompt, self.m)?;
+        self.np_sum += np;
+        self.blocks += 1;
         if self.blocks < self.k {
             return None;
         }
         let mu = self.np_sum / f64::from(self.blocks);
         self.np_sum = 0.0;
         self.blocks = 0;
-        let m = f64::from(self.m);
-        let cn0 = if mu >= m {
-            f64::INFINITY
-        } else {
-            (mu - 1.0) / (self.t_s * (m - mu))
-        };
-        let db = to_dbhz(cn0);
+        let db = to_dbhz(nwpr_cn0_hz(mu, self.m, self.t_s));
         self.last_dbhz = Some(db);
         Some(db)
     }
@@ -214,9 +236,7 @@ pub struct SmoothedNwpr {
     t_s: f64,
     window_blocks: u32,
     min_blocks: u32,
-    sum: Complex64,
-    wbp: f64,
-    n_in_block: u32,
+    block: NwprBlock,
     mu: f64,
     blocks: u32,
 }
@@ -235,9 +255,7 @@ impl SmoothedNwpr {
             },
             window_blocks,
             min_blocks: min_blocks.clamp(1, window_blocks),
-            sum: Complex64::new(0.0, 0.0),
-            wbp: 0.0,
-            n_in_block: 0,
+            block: NwprBlock::EMPTY,
             mu: 0.0,
             blocks: 0,
         }
@@ -250,9 +268,7 @@ impl SmoothedNwpr {
 
     /// Restarts the current block (call at a bit edge).
     pub fn align_block(&mut self) {
-        self.sum = Complex64::new(0.0, 0.0);
-        self.wbp = 0.0;
-        self.n_in_block = 0;
+        self.block = NwprBlock::EMPTY;
     }
 
     /// Blocks averaged so far.
@@ -263,33 +279,13 @@ impl SmoothedNwpr {
     /// Feeds one prompt; returns an estimate (dB-Hz) when a block completes and enough blocks
     /// are in. Non-finite prompts are skipped.
     pub fn push(&mut self, prompt: Complex64) -> Option<f64> {
-        if !(prompt.re.is_finite() && prompt.im.is_finite()) {
-            return None;
-        }
-        self.sum += prompt;
-        self.wbp += prompt.norm_sqr();
-        self.n_in_block += 1;
-        if self.n_in_block < self.m {
-            return None;
-        }
-        let np = if self.wbp > 0.0 {
-            self.sum.norm_sqr() / self.wbp
-        } else {
-            1.0
-        };
-        self.align_block();
+        let np = self.block.push(prompt, self.m)?;
         self.blocks = self.blocks.saturating_add(1);
         let alpha = 1.0 / f64::from(self.blocks.min(self.window_blocks));
         self.mu += alpha * (np - self.mu);
         if self.blocks < self.min_blocks {
             return None;
         }
-        let m = f64::from(self.m);
-        let cn0 = if self.mu >= m {
-            f64::INFINITY
-        } else {
-            (self.mu - 1.0) / (self.t_s * (m - self.mu))
-        };
-        Some(to_dbhz(cn0))
+        Some(to_dbhz(nwpr_cn0_hz(self.mu, self.m, self.t_s)))
     }
 }

@@ -123,9 +123,22 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
         None => None,
     };
     // Lost satellites (and ones not found at the start) are searched for again every second.
-    let engine = gpsrx_dsp::acquisition::AcquisitionEngine::new(fs, gpsrx_dsp::acquisition::AcqConfig::default())?;
-    let prns = args.acquisition.prn.iter().filter_map(|&p| gpsrx_dsp::Prn::new(p).ok()).collect();
-    let reacq = Reacquisition { engine: &engine, interval_s: 1.0, channel_config: cfg, prns };
+    let engine = gpsrx_dsp::acquisition::AcquisitionEngine::new(
+        fs,
+        gpsrx_dsp::acquisition::AcqConfig::default(),
+    )?;
+    let prns = args
+        .acquisition
+        .prn
+        .iter()
+        .filter_map(|&p| gpsrx_dsp::Prn::new(p).ok())
+        .collect();
+    let reacq = Reacquisition {
+        engine: &engine,
+        interval_s: 1.0,
+        channel_config: cfg,
+        prns,
+    };
     let mut summaries: BTreeMap<u8, ChannelSummary> = BTreeMap::new();
     let mut write_err = None;
     track_with_reacquisition(src.as_mut(), channels, None, Some(&reacq), |_, e| {
