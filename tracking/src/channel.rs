@@ -195,6 +195,8 @@ pub struct ChannelEpoch {
     pub bit_edge: bool,
     /// The navigation bit completed in this interval, if any.
     pub bit: Option<Bit>,
+    /// `ms_count` of the first code period of that bit (its leading edge), for time tagging.
+    pub bit_start_ms: Option<u64>,
 }
 
 /// One tracking channel.
@@ -241,6 +243,9 @@ pub struct Channel {
     /// off: n, sum t, sum f, sum t^2, sum t f. They give the Doppler rate that presets a
     /// 3rd-order tracking loop at the hand-over.
     rate_fit: [f64; 5],
+    /// A completed bit and the `ms_count` of its first code period, waiting for the end of the
+    /// integration interval.
+    pending_bit: Option<(Bit, u64)>,
 }
 
 impl Channel {
@@ -293,6 +298,7 @@ impl Channel {
             acc_start: (start.code_start_sample, 0.0, 0.0, 0.0),
             taps: [d / 2.0, 0.0, -d / 2.0],
             rate_fit: [0.0; 5],
+            pending_bit: None,
         })
     }
 
@@ -411,7 +417,11 @@ impl Channel {
         self.acc_ms += 1;
 
         // Bit synchronisation and bits, from 1 ms prompts.
-        let bit = self.bit_sync.push(p, t_start_s);
+        if let Some(b) = self.bit_sync.push(p, t_start_s) {
+            // Reported with the integration interval that ends next (bits end on interval ends
+            // once the integrations are bit-aligned).
+            self.pending_bit = Some((b, (ms_index + 1).saturating_sub(MS_PER_BIT as u64)));
+        }
         // Bit edges fall on code periods k with k mod 20 == edge_phase (k counted by ms_count).
         let edge_phase = match self.bit_sync.state() {
             BitSyncState::Synced { edge } => {
@@ -476,6 +486,7 @@ impl Channel {
             return None;
         }
         let [ea, pa, la] = self.acc;
+        let bit = self.pending_bit.take();
         let ff_opt = self.feedforward_hz(self.carrier.t_coh_s());
         match (self.ff_applied_hz, ff_opt) {
             (None, Some(f)) => self.carrier.shift_base_hz(-f),
@@ -525,7 +536,8 @@ impl Channel {
                 (ms_index + 1 - self.acc_ms as u64) % MS_PER_BIT as u64
                     == edge as u64 % MS_PER_BIT as u64
             }),
-            bit,
+            bit: bit.map(|(b, _)| b),
+            bit_start_ms: bit.map(|(_, m)| m),
         };
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;

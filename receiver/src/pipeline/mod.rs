@@ -1,7 +1,9 @@
 //! The receiver pipeline: samples from a source, shared by all channels, block by block.
 //!
 //! - [`ring`]: the window of recent samples addressed by absolute index;
+//! - [`navdata`]: frame sync, subframes, ephemerides and SV time per satellite;
 //! - [`tracker`]: drives the tracking channels over the window, in parallel.
 
+pub mod navdata;
 pub mod ring;
 pub mod tracker;

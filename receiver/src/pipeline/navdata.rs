@@ -1,0 +1,235 @@
+//! Per-satellite navigation-message decoding: the bit stream of a tracking channel ->
+//! frame synchronisation -> parity-checked subframes -> ephemeris, ionosphere/UTC, and the SV
+//! time of every code period.
+//!
+//! Frame sync (IS-GPS-200 20.3.2): a candidate is a position where the 8-bit preamble appears
+//! in either polarity (the Costas loop's 180 deg ambiguity) and all ten words of the 300-bit
+//! subframe pass parity; it is confirmed when the next subframe, 300 bits later, passes parity
+//! too with a TOW count one higher. Only then are subframes used (including the first one,
+//! kept until the confirmation). Words that fail parity are counted and never used.
+//!
+//! Time tag: the HOW of a subframe gives the TOW of its first bit, so the code period that
+//! starts that bit left the satellite at `tow_start`; code period `m` later left it at
+//! `tow_start + (m - m0) ms`, and a point `c` chips into that period at `+ c / 1.023e6 s`.
+
+use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
+use gpsrx_nav::atmosphere::{KlobucharParams, UtcParams};
+use gpsrx_nav::ephemeris::Ephemeris;
+use gpsrx_nav::lnav::{
+    decode_subframe_any_polarity, DecodedSubframe, EphemerisAssembler, SubframePayload,
+};
+use std::collections::VecDeque;
+
+const SUBFRAME_BITS: usize = 300;
+
+/// What a new bit produced.
+#[derive(Debug, Clone, PartialEq)]
+pub enum NavEvent {
+    /// Frame synchronisation confirmed.
+    FrameSync {
+        /// TOW of the first confirmed subframe's start, s.
+        tow_s: u32,
+    },
+    /// A subframe passed parity (after frame sync).
+    Subframe {
+        /// Subframe ID 1-5.
+        id: u8,
+        /// TOW of its start, s.
+        tow_s: u32,
+    },
+    /// A complete, consistent ephemeris (subframes 1-3 with matching IODE/IODC).
+    Ephemeris(Box<Ephemeris>),
+    /// A subframe failed parity.
+    ParityFailure,
+}
+
+/// The navigation-message decoder of one satellite.
+#[derive(Debug, Clone)]
+pub struct NavDecoder {
+    prn: u8,
+    /// Recent bits (0/1 as received, before polarity correction) and the `ms_count` of their
+    /// first code period.
+    bits: VecDeque<(u8, u64)>,
+    /// Index in `bits` where the next subframe starts, once synchronised.
+    next_subframe: Option<usize>,
+    /// A parity-checked candidate waiting for confirmation: (its subframe, its first bit's ms).
+    candidate: Option<(DecodedSubframe, u64)>,
+    assembler: EphemerisAssembler,
+    /// Latest ephemeris.
+    pub ephemeris: Option<Ephemeris>,
+    /// Latest ionosphere parameters (subframe 4 page 18).
+    pub iono: Option<KlobucharParams>,
+    /// Latest GPS-UTC parameters (weeks resolved).
+    pub utc: Option<UtcParams>,
+    /// Time tag: `ms_count` of a subframe's first code period and that subframe's TOW (s).
+    time_tag: Option<(u64, u32)>,
+    reference_week: u32,
+    /// Subframes decoded, and subframes that failed parity after sync.
+    pub subframes_ok: u32,
+    /// Subframes that failed parity after frame sync.
+    pub parity_failures: u32,
+    consecutive_failures: u32,
+}
+
+impl NavDecoder {
+    /// A decoder for `prn`; `reference_week` resolves the 10-bit week (the latest full week
+    /// consistent with it is taken).
+    pub fn new(prn: u8, reference_week: u32) -> Self {
+        Self {
+            prn,
+            bits: VecDeque::with_capacity(2 * SUBFRAME_BITS + 8),
+            next_subframe: None,
+            candidate: None,
+            assembler: EphemerisAssembler::new(prn, reference_week),
+            ephemeris: None,
+            iono: None,
+            utc: None,
+            time_tag: None,
+            reference_week,
+            subframes_ok: 0,
+            parity_failures: 0,
+            consecutive_failures: 0,
+        }
+    }
+
+    /// The satellite.
+    pub fn prn(&self) -> u8 {
+        self.prn
+    }
+
+    /// Whether frame sync is confirmed (and the SV time known).
+    pub fn synced(&self) -> bool {
+        self.time_tag.is_some()
+    }
+
+    /// Forgets the bit stream (after a loss of lock): frame sync must be found again.
+    pub fn reset_sync(&mut self) {
+        self.bits.clear();
+        self.next_subframe = None;
+        self.candidate = None;
+        self.time_tag = None;
+        self.consecutive_failures = 0;
+    }
+
+    /// SV transmit time (TOW, s; may exceed a week's end by a fraction, which the caller's
+    /// `GpsTime` normalises) of the point `code_phase_chips` into code period `ms_count`.
+    pub fn sv_tow_s(&self, ms_count: u64, code_phase_chips: f64) -> Option<f64> {
+        let (m0, tow0) = self.time_tag?;
+        let dm = ms_count as f64 - m0 as f64;
+        Some(f64::from(tow0) + dm * 1e-3 + code_phase_chips / CA_CHIP_RATE_HZ)
+    }
+
+    /// Feeds one bit (+1/-1 as decided by the channel) whose first code period is `ms`.
+    pub fn push_bit(&mut self, value: i8, ms: u64) -> Vec<NavEvent> {
+        let mut events = Vec::new();
+        if let Some(&(_, last_ms)) = self.bits.back() {
+            if ms != last_ms + 20 {
+                // A gap in the bit stream: the positions no longer line up.
+                self.reset_sync();
+            }
+        }
+        self.bits.push_back((u8::from(value < 0), ms));
+        match self.next_subframe {
+            Some(start) => {
+                if self.bits.len() >= start + SUBFRAME_BITS {
+                    let (decoded, first_ms) = self.decode_at(start);
+                    match decoded {
+                        Some(sf) => self.accept(sf, first_ms, &mut events),
+                        None => {
+                            self.parity_failures += 1;
+                            self.consecutive_failures += 1;
+                            events.push(NavEvent::ParityFailure);
+                        }
+                    }
+                    // Keep the last subframe's bits only (for the next decode).
+                    self.bits.drain(..start + SUBFRAME_BITS);
+                    self.next_subframe = Some(0);
+                    if self.consecutive_failures >= 3 {
+                        // Three bad subframes in a row: the sync (or the bit stream) is wrong.
+                        self.reset_sync();
+                    }
+                }
+            }
+            None => self.search(&mut events),
+        }
+        events
+    }
+
+    /// Looks for a subframe ending at the newest bit; confirms a candidate 300 bits later.
+    fn search(&mut self, events: &mut Vec<NavEvent>) {
+        if self.bits.len() < SUBFRAME_BITS {
+            return;
+        }
+        let start = self.bits.len() - SUBFRAME_BITS;
+        let (decoded, first_ms) = self.decode_at(start);
+        let Some(sf) = decoded else {
+            // Bound the buffer while searching.
+            if self.bits.len() > 2 * SUBFRAME_BITS {
+                self.bits.pop_front();
+            }
+            return;
+        };
+        match self.candidate.take() {
+            Some((prev, prev_ms))
+                if first_ms == prev_ms + 6000
+                    && sf.how.tow_count == prev.how.tow_count % 100_800 + 1 =>
+            {
+                events.push(NavEvent::FrameSync {
+                    tow_s: prev.how.subframe_start_tow_s(),
+                });
+                self.accept(prev, prev_ms, events);
+                self.accept(sf, first_ms, events);
+                self.bits.drain(..start + SUBFRAME_BITS);
+                self.next_subframe = Some(0);
+            }
+            _ => self.candidate = Some((sf, first_ms)),
+        }
+    }
+
+    fn decode_at(&self, start: usize) -> (Option<DecodedSubframe>, u64) {
+        let mut bits = [0u8; SUBFRAME_BITS];
+        for (i, b) in bits.iter_mut().enumerate() {
+            *b = self.bits[start + i].0;
+        }
+        let first_ms = self.bits[start].1;
+        (
+            decode_subframe_any_polarity(&bits).ok().map(|(sf, _)| sf),
+            first_ms,
+        )
+    }
+
+    fn accept(&mut self, sf: DecodedSubframe, first_ms: u64, events: &mut Vec<NavEvent>) {
+        self.subframes_ok += 1;
+        self.consecutive_failures = 0;
+        let tow_s = sf.how.subframe_start_tow_s();
+        self.time_tag = Some((first_ms, tow_s));
+        events.push(NavEvent::Subframe {
+            id: sf.how.subframe_id,
+            tow_s,
+        });
+        match sf.payload {
+            SubframePayload::Page18 { iono, utc } => {
+                self.iono = Some(iono);
+                self.utc = Some(utc.resolve_weeks(self.reference_week));
+            }
+            _ => {
+                if let Some(eph) = self.assembler.push(&sf) {
+                    self.ephemeris = Some(eph.clone());
+                    events.push(NavEvent::Ephemeris(Box::new(eph)));
+                }
+            }
+        }
+    }
+}
+
+/// The GPS week of the current date, to resolve 10-bit week numbers when nothing better is
+/// known: GPS time from the system clock (leap seconds ignored: they do not move the week by
+/// more than 18 s).
+pub fn current_gps_week() -> u32 {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0);
+    // GPS epoch 1980-01-06 is 315,964,800 s after the Unix epoch.
+    (((secs - 315_964_800.0) / 604_800.0).floor().max(0.0)) as u32
+}
