@@ -9,6 +9,7 @@ pub mod constants;
 pub mod ephemeris;
 pub mod frames;
 pub mod lnav;
+pub mod pvt;
 pub mod rinex_nav;
 pub mod time;
 pub mod utc;

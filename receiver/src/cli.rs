@@ -29,6 +29,8 @@ pub enum Command {
     Acquire(crate::commands::acquire::AcquireArgs),
     /// Acquire and track satellites; write every integration interval to CSV.
     Track(crate::commands::track::TrackArgs),
+    /// Process a recording into position fixes and standard files (RINEX, NMEA, GeoJSON, KML, CSV).
+    Run(crate::commands::run::RunArgs),
 }
 
 /// Options that say how to read a recording; shared by every subcommand that reads one.

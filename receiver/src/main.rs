@@ -20,6 +20,7 @@ fn main() {
         Command::Demo(args) => commands::demo::run(&args),
         Command::Acquire(args) => commands::acquire::run(&args),
         Command::Track(args) => commands::track::run(&args),
+        Command::Run(args) => commands::run::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

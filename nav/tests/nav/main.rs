@@ -8,5 +8,6 @@ mod ephemeris_tests;
 mod frames_tests;
 mod lnav_rtklib_tests;
 mod lnav_tests;
+mod pvt_tests;
 mod rinex_tests;
 mod time_tests;

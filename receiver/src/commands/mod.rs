@@ -3,5 +3,6 @@
 pub mod acquire;
 pub mod demo;
 pub mod info;
+pub mod run;
 pub mod simulate;
 pub mod track;

@@ -2,8 +2,10 @@
 //!
 //! - [`ring`]: the window of recent samples addressed by absolute index;
 //! - [`navdata`]: frame sync, subframes, ephemerides and SV time per satellite;
+//! - [`observables`]: pseudoranges, carrier phase, Doppler at common receiver epochs;
 //! - [`tracker`]: drives the tracking channels over the window, in parallel.
 
 pub mod navdata;
+pub mod observables;
 pub mod ring;
 pub mod tracker;

@@ -64,6 +64,8 @@ pub struct NavDecoder {
     /// Time tag: `ms_count` of a subframe's first code period and that subframe's TOW (s).
     time_tag: Option<(u64, u32)>,
     reference_week: u32,
+    /// Full transmission week from subframe 1 (10-bit week resolved with the reference week).
+    week: Option<u32>,
     /// Subframes decoded, and subframes that failed parity after sync.
     pub subframes_ok: u32,
     /// Subframes that failed parity after frame sync.
@@ -86,6 +88,7 @@ impl NavDecoder {
             utc: None,
             time_tag: None,
             reference_week,
+            week: None,
             subframes_ok: 0,
             parity_failures: 0,
             consecutive_failures: 0,
@@ -100,6 +103,16 @@ impl NavDecoder {
     /// Whether frame sync is confirmed (and the SV time known).
     pub fn synced(&self) -> bool {
         self.time_tag.is_some()
+    }
+
+    /// The GPS week of the signal: from subframe 1 once decoded, else the reference week.
+    pub fn week(&self) -> u32 {
+        self.week.unwrap_or(self.reference_week)
+    }
+
+    /// The GPS week decoded from subframe 1, if any.
+    pub fn decoded_week(&self) -> Option<u32> {
+        self.week
     }
 
     /// Forgets the bit stream (after a loss of lock): frame sync must be found again.
@@ -207,6 +220,12 @@ impl NavDecoder {
             id: sf.how.subframe_id,
             tow_s,
         });
+        if let SubframePayload::Subframe1(s1) = &sf.payload {
+            self.week = Some(gpsrx_nav::time::GpsTime::resolve_week_10bit(
+                s1.week_mod_1024,
+                self.reference_week,
+            ));
+        }
         match sf.payload {
             SubframePayload::Page18 { iono, utc } => {
                 self.iono = Some(iono);

@@ -1,0 +1,54 @@
+//! Dilution of precision in the local East-North-Up frame.
+//!
+//! With G the unweighted design matrix (rows [-l^T, 1] for satellites, [u^T, 0] for
+//! landmarks), Q = (G^T G)^-1 in ECEF is rotated to ENU, Q_enu = R Q_pos R^T, and
+//! GDOP = sqrt(tr Q), PDOP = sqrt(Q_EE + Q_NN + Q_UU), HDOP = sqrt(Q_EE + Q_NN),
+//! VDOP = sqrt(Q_UU), TDOP = sqrt(Q_tt) (Kaplan & Hegarty 2nd ed. 7.3.1). DOP depends on the
+//! geometry only, not on the weights.
+
+use crate::frames::{enu_rotation, Llh};
+use nalgebra::{Matrix3, Matrix4, Vector4};
+
+/// Dilution-of-precision factors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dop {
+    /// Geometric DOP.
+    pub gdop: f64,
+    /// Position DOP.
+    pub pdop: f64,
+    /// Horizontal DOP.
+    pub hdop: f64,
+    /// Vertical DOP.
+    pub vdop: f64,
+    /// Time DOP.
+    pub tdop: f64,
+}
+
+/// DOP of the design rows at `origin`; None when G^T G is singular (GDOP above
+/// [`super::wls::MAX_GDOP`]) or the result not finite.
+pub fn dop_enu(rows: &[[f64; 4]], origin: &Llh) -> Option<Dop> {
+    let mut g = Matrix4::zeros();
+    for r in rows {
+        let a = Vector4::from(*r);
+        g += a * a.transpose();
+    }
+    let q = g.try_inverse()?;
+    if !(q.trace() >= 0.0 && q.trace().sqrt() <= super::wls::MAX_GDOP) {
+        return None;
+    }
+    let r = enu_rotation(origin);
+    let qp: Matrix3<f64> = q.fixed_view::<3, 3>(0, 0).into_owned();
+    let qe = r * qp * r.transpose();
+    let (e, n, u, t) = (qe[(0, 0)], qe[(1, 1)], qe[(2, 2)], q[(3, 3)]);
+    let dop = Dop {
+        gdop: (e + n + u + t).sqrt(),
+        pdop: (e + n + u).sqrt(),
+        hdop: (e + n).sqrt(),
+        vdop: u.sqrt(),
+        tdop: t.sqrt(),
+    };
+    let all_finite = [dop.gdop, dop.pdop, dop.hdop, dop.vdop, dop.tdop]
+        .iter()
+        .all(|v| v.is_finite());
+    all_finite.then_some(dop)
+}

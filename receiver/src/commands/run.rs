@@ -1,0 +1,557 @@
+//! `gpsrx run`: a recording in, position fixes and standard files out.
+//!
+//! acquisition -> tracking channels (with re-acquisition) -> navigation message per satellite
+//! -> observables at common receiver epochs -> WLS PVT with RAIM -> outputs in `--out DIR`:
+//! `pvt.csv`, `pvt.nmea`, `observables.rnx`, `ephemeris.rnx`, `track.geojson`, `track.kml`,
+//! `channels.csv`.
+
+use crate::cli::{LoopArgs, SourceArgs};
+use crate::output::{
+    self, create_file, ChannelCsvWriter, ChannelRow, Fix, FixQuality, NavHeader, NavRecord,
+    NmeaOptions, NmeaWriter, ObsEpoch, ObsHeader, PvtCsvWriter, RinexObsWriter, SatObs, SatView,
+};
+use crate::pipeline::navdata::{current_gps_week, NavDecoder, NavEvent};
+use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
+use crate::pipeline::tracker::{track_with_reacquisition, Reacquisition};
+use anyhow::Context;
+use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
+use gpsrx_nav::ephemeris::Ephemeris;
+use gpsrx_nav::frames::azimuth_elevation;
+use gpsrx_nav::pvt::{solve, PvtOptions, PvtSolution, RaimStatus, SatMeasurement};
+use gpsrx_nav::rinex_nav::{read_rinex_nav, NavData};
+use gpsrx_samples::open_source;
+use gpsrx_tracking::{Channel, ChannelStart, ChannelState};
+use indicatif::{ProgressBar, ProgressStyle};
+use num_complex::Complex32;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Ionosphere model switch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum IonoModel {
+    /// Broadcast Klobuchar (decoded from subframe 4 page 18, or from --nav).
+    Klobuchar,
+    /// No correction.
+    None,
+}
+
+/// Troposphere model switch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TropoModel {
+    /// Saastamoinen, standard atmosphere.
+    Saastamoinen,
+    /// No correction.
+    None,
+}
+
+/// `gpsrx run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// The recording and how to read it.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// Loop settings.
+    #[command(flatten)]
+    pub loops: LoopArgs,
+    /// Output directory (created if needed).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
+    #[arg(long, value_name = "FILE")]
+    pub nav: Option<PathBuf>,
+    /// Ionosphere correction.
+    #[arg(long, value_enum, default_value_t = IonoModel::Klobuchar)]
+    pub iono: IonoModel,
+    /// Troposphere correction (`none` for simulated files without troposphere).
+    #[arg(long, value_enum, default_value_t = TropoModel::Saastamoinen)]
+    pub tropo: TropoModel,
+    /// Elevation mask, degrees.
+    #[arg(long, value_name = "DEG", default_value_t = 5.0)]
+    pub elevation_mask: f64,
+    /// Observable and fix rate, Hz (1 to 50).
+    #[arg(long, value_name = "HZ", default_value_t = 10.0)]
+    pub rate: f64,
+    /// Full GPS week near the recording, to resolve the broadcast 10-bit week (default: from
+    /// SigMF metadata, else the current week).
+    #[arg(long, value_name = "WEEK")]
+    pub week: Option<u32>,
+    /// Doppler search half-width of the acquisition, Hz.
+    #[arg(long, value_name = "HZ", default_value_t = 5000.0)]
+    pub doppler_max: f64,
+    /// RAIM false-alarm probability.
+    #[arg(long, value_name = "P", default_value_t = 1e-3)]
+    pub raim_pfa: f64,
+    /// Use satellites whose ephemeris says they are unhealthy (some simulators copy a health
+    /// flag that the real satellite had at the time).
+    #[arg(long)]
+    pub allow_unhealthy: bool,
+}
+
+/// What a run produced.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct RunSummary {
+    /// Seconds of recording processed.
+    pub duration_s: f64,
+    /// Wall-clock seconds.
+    pub wall_s: f64,
+    /// Satellites tracked at some point.
+    pub tracked_prns: Vec<u8>,
+    /// Receive time (s from the file start) of the first fix.
+    pub first_fix_s: Option<f64>,
+    /// Number of fixes.
+    pub fixes: usize,
+    /// Mean position of the fixes, LLH degrees/m.
+    pub mean_llh: Option<(f64, f64, f64)>,
+    /// Mean PDOP.
+    pub mean_pdop: Option<f64>,
+}
+
+/// Runs the receiver on a file.
+pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSummary, Vec<Fix>)> {
+    let t_wall = std::time::Instant::now();
+    if !(1.0..=50.0).contains(&args.rate) {
+        anyhow::bail!("--rate {} Hz: use 1 to 50 Hz", args.rate);
+    }
+    let cfg = args.loops.channel_config()?;
+    let src_cfg = args.source.to_config()?;
+    let mut src =
+        open_source(&src_cfg).with_context(|| format!("cannot read {}", src_cfg.path.display()))?;
+    let fs = src.fs_hz();
+    let total = src.total_samples();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let nav_assist: Option<NavData> = match &args.nav {
+        Some(p) => Some(
+            read_rinex_nav(p)
+                .with_context(|| format!("cannot read the navigation file {}", p.display()))?,
+        ),
+        None => None,
+    };
+    let reference_week = args.week.unwrap_or_else(current_gps_week);
+
+    // Cold acquisition on the first samples.
+    let acq_cfg = AcqConfig {
+        doppler_max_hz: args.doppler_max,
+        ..AcqConfig::default()
+    };
+    let engine = AcquisitionEngine::new(fs, acq_cfg)?;
+    let mut first = vec![Complex32::new(0.0, 0.0); engine.samples_wanted()];
+    let (first_index, n) = {
+        let mut acq_src = open_source(&src_cfg)?;
+        let mut filled = 0usize;
+        let mut first_index = None;
+        while filled < first.len() {
+            let (idx, got) = acq_src.read(&mut first[filled..])?;
+            if got == 0 {
+                break;
+            }
+            first_index.get_or_insert(idx);
+            filled += got;
+        }
+        (first_index.unwrap_or(0), filled)
+    };
+    if n < engine.samples_needed() {
+        anyhow::bail!(
+            "the recording is too short for acquisition ({n} samples; at least {} needed)",
+            engine.samples_needed()
+        );
+    }
+    let found = engine.search_all(&first[..n])?;
+    let mut channels = Vec::new();
+    for d in found.iter().filter(|d| d.detected) {
+        let start = ChannelStart {
+            prn: d.prn,
+            code_start_sample: first_index + d.code_phase_samples.round().max(0.0) as u64,
+            doppler_hz: d.doppler_hz,
+            cn0_dbhz: d.cn0_dbhz.unwrap_or(f64::NAN),
+        };
+        channels.push(Channel::new(&start, fs, &cfg)?);
+        tracing::info!(
+            "{}: acquired, Doppler {:.0} Hz, C/N0 {:.1} dB-Hz",
+            d.prn,
+            d.doppler_hz,
+            d.cn0_dbhz.unwrap_or(f64::NAN)
+        );
+    }
+    let reacq = Reacquisition {
+        engine: &engine,
+        interval_s: 1.0,
+        channel_config: cfg,
+        prns: Vec::new(),
+    };
+
+    let bar = if show_progress {
+        total
+            .map(ProgressBar::new)
+            .unwrap_or_else(ProgressBar::no_length)
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {percent:>3}% {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+
+    let mut decoders: BTreeMap<u8, NavDecoder> = BTreeMap::new();
+    let mut builder = ObservableBuilder::new(fs, args.rate);
+    let opts = PvtOptions {
+        tropo: args.tropo == TropoModel::Saastamoinen,
+        elevation_mask_deg: args.elevation_mask,
+        raim_pfa: args.raim_pfa,
+        ..PvtOptions::default()
+    };
+    let out = |name: &str| args.out.join(name);
+    let mut pvt_csv = PvtCsvWriter::create(&out("pvt.csv"))?;
+    let mut nmea = NmeaWriter::create(&out("pvt.nmea"), NmeaOptions::default())?;
+    let mut channels_csv = ChannelCsvWriter::create(&out("channels.csv"))?;
+    let mut obs_writer: Option<RinexObsWriter<std::io::BufWriter<std::fs::File>>> = None;
+    let mut obs_backlog: Vec<ObsEpoch> = Vec::new();
+    let mut fixes: Vec<Fix> = Vec::new();
+    let mut prior: Option<PvtSolution> = None;
+    let mut summary = RunSummary::default();
+    let mut err: Option<anyhow::Error> = None;
+    let mut last_row_t: BTreeMap<usize, f64> = BTreeMap::new();
+
+    let mut handle_epoch = |epoch: ObservableEpoch,
+                            decoders: &BTreeMap<u8, NavDecoder>,
+                            builder: &mut ObservableBuilder|
+     -> anyhow::Result<()> {
+        let iono = if args.iono == IonoModel::Klobuchar {
+            decoders
+                .values()
+                .find_map(|d| d.iono)
+                .or_else(|| nav_assist.as_ref().and_then(|n| n.iono))
+        } else {
+            None
+        };
+        let ephs: Vec<(u8, Ephemeris)> = epoch
+            .sats
+            .iter()
+            .filter_map(|s| {
+                let decoded = decoders.get(&s.prn).and_then(|d| d.ephemeris.clone());
+                decoded
+                    .or_else(|| {
+                        nav_assist
+                            .as_ref()
+                            .and_then(|n| n.select(s.prn, epoch.rx_time).cloned())
+                    })
+                    .map(|e| (s.prn, e))
+            })
+            .collect();
+        let meas: Vec<SatMeasurement<'_>> = epoch
+            .sats
+            .iter()
+            .filter_map(|s| {
+                let (_, eph) = ephs.iter().find(|(p, _)| *p == s.prn)?;
+                (eph.sv_health == 0 || args.allow_unhealthy).then_some(SatMeasurement {
+                    prn: s.prn,
+                    pseudorange_m: s.smoothed_pseudorange_m,
+                    doppler_hz: Some(s.doppler_hz),
+                    cn0_dbhz: s.cn0_dbhz,
+                    tx_time: None,
+                    ephemeris: eph,
+                })
+            })
+            .collect();
+        let opts = PvtOptions { iono, ..opts };
+        if std::env::var("GPSRX_DUMP_OBS").is_ok() && meas.len() >= 4 {
+            for s in &epoch.sats {
+                eprintln!(
+                    "OBS {:.6} {} {:.3} {:.3}",
+                    epoch.sample / fs,
+                    s.prn,
+                    s.pseudorange_m,
+                    s.doppler_hz
+                );
+            }
+        }
+        let solution = if meas.len() >= 4 {
+            match solve(epoch.rx_time, &meas, &[], &opts, prior.as_ref()) {
+                Ok(s) => Some(s),
+                Err(e) => {
+                    tracing::debug!("no fix at {:.3}: {e}", epoch.rx_time.tow_s);
+                    None
+                }
+            }
+        } else {
+            tracing::trace!(
+                "{} satellites with ephemeris at {:.3}",
+                meas.len(),
+                epoch.rx_time.tow_s
+            );
+            None
+        };
+        // Observables to RINEX (held until the first fix gives the header's position).
+        let obs = ObsEpoch {
+            time: epoch.rx_time,
+            clock_offset_s: None,
+            sats: epoch
+                .sats
+                .iter()
+                .map(|s| SatObs {
+                    prn: s.prn,
+                    pseudorange_m: Some(s.pseudorange_m),
+                    carrier_cycles: Some(s.carrier_cycles),
+                    doppler_hz: Some(s.doppler_hz),
+                    cn0_dbhz: s.cn0_dbhz.is_finite().then_some(s.cn0_dbhz),
+                    loss_of_lock: s.loss_of_lock || epoch.clock_step_ms != 0,
+                    half_cycle_ambiguous: s.half_cycle_ambiguous,
+                })
+                .collect(),
+        };
+        match (&mut obs_writer, &solution) {
+            (Some(w), _) => w.write_epoch(&obs)?,
+            (None, Some(sol)) => {
+                let header = ObsHeader {
+                    approx_position_m: [sol.pos_ecef_m.x, sol.pos_ecef_m.y, sol.pos_ecef_m.z],
+                    interval_s: Some(1.0 / args.rate),
+                    ..ObsHeader::default()
+                };
+                let mut w = RinexObsWriter::create(&out("observables.rnx"), header)?;
+                for mut o in obs_backlog.drain(..) {
+                    // Epochs before subframe 1 carried the reference week: relabel them.
+                    o.time.week = epoch.rx_time.week;
+                    if o.time.tow_s < epoch.rx_time.tow_s {
+                        w.write_epoch(&o)?;
+                    }
+                }
+                w.write_epoch(&obs)?;
+                obs_writer = Some(w);
+            }
+            (None, None) => obs_backlog.push(obs),
+        }
+        let Some(sol) = solution else {
+            return Ok(());
+        };
+        // Keep the receiver clock within +-0.5 ms of GPS time by whole-millisecond steps.
+        let bias_ms = sol.clock_bias_m / 299_792_458.0 * 1e3;
+        if bias_ms.abs() > 0.5 {
+            builder.step_clock_ms(-bias_ms.round() as i64);
+            tracing::debug!("receiver clock stepped by {} ms", -bias_ms.round() as i64);
+        }
+        let t_file = epoch.sample / fs;
+        if summary.first_fix_s.is_none() {
+            summary.first_fix_s = Some(t_file);
+            tracing::info!(
+                "first fix at {:.2} s: {:.7} {:.7} {:.1} m, {} satellites, PDOP {:.1}",
+                t_file,
+                sol.llh.lat_rad.to_degrees(),
+                sol.llh.lon_rad.to_degrees(),
+                sol.llh.h_m,
+                sol.n_sv,
+                sol.dop.pdop
+            );
+        }
+        let sats_in_view = ephs
+            .iter()
+            .map(|(prn, eph)| {
+                let sv = eph.sv_state(sol.time);
+                let (az, el) = azimuth_elevation(&sol.pos_ecef_m, &sv.pos_m);
+                let cn0 = epoch
+                    .sats
+                    .iter()
+                    .find(|s| s.prn == *prn)
+                    .map(|s| s.cn0_dbhz)
+                    .filter(|c| c.is_finite());
+                SatView {
+                    prn: *prn,
+                    el_deg: el.to_degrees(),
+                    az_deg: az.to_degrees().rem_euclid(360.0),
+                    cn0_dbhz: cn0,
+                }
+            })
+            .collect();
+        let fix = Fix {
+            time: sol.time,
+            ecef_m: [sol.pos_ecef_m.x, sol.pos_ecef_m.y, sol.pos_ecef_m.z],
+            llh: sol.llh,
+            vel_ecef_mps: sol.vel_ecef_mps.map(|v| [v.x, v.y, v.z]),
+            clock_bias_m: sol.clock_bias_m,
+            clock_drift_mps: sol.clock_drift_mps,
+            n_sv: sol.n_sv,
+            used_prns: sol.used_prns.clone(),
+            pdop: sol.dop.pdop,
+            hdop: sol.dop.hdop,
+            vdop: sol.dop.vdop,
+            raim: raim_text(&sol.raim),
+            quality: FixQuality::Gnss,
+            sats_in_view,
+        };
+        pvt_csv.write_fix(&fix)?;
+        nmea.write_fix(&fix)?;
+        fixes.push(fix);
+        prior = Some(sol);
+        Ok(())
+    };
+
+    let mut processed = 0u64;
+    track_with_reacquisition(src.as_mut(), channels, None, Some(&reacq), |i, e| {
+        if err.is_some() {
+            return;
+        }
+        let dec = decoders
+            .entry(e.prn)
+            .or_insert_with(|| NavDecoder::new(e.prn, reference_week));
+        if let (Some(b), Some(ms)) = (e.bit, e.bit_start_ms) {
+            for ev in dec.push_bit(b.value, ms) {
+                match ev {
+                    NavEvent::FrameSync { tow_s } => {
+                        tracing::info!("G{:02}: frame sync, TOW {tow_s} s", e.prn)
+                    }
+                    NavEvent::Ephemeris(eph) => {
+                        tracing::info!("G{:02}: ephemeris decoded (IODE {})", e.prn, eph.iode)
+                    }
+                    _ => {}
+                }
+            }
+        }
+        if e.state == ChannelState::Lost {
+            dec.reset_sync();
+        }
+        if last_row_t
+            .get(&i)
+            .is_none_or(|&t| e.t_rx_s - t >= 1.0 / args.rate - 1e-9)
+        {
+            last_row_t.insert(i, e.t_rx_s);
+            let row = ChannelRow {
+                time: builder
+                    .rx_time_origin()
+                    .map(|t0| t0.add_seconds(e.t_rx_s))
+                    .unwrap_or(gpsrx_nav::time::GpsTime {
+                        week: 0,
+                        tow_s: e.t_rx_s,
+                    }),
+                channel: i as u32,
+                prn: e.prn,
+                state: format!("{:?}", e.state).to_lowercase(),
+                cn0_dbhz: e.cn0_dbhz.is_finite().then_some(e.cn0_dbhz),
+                doppler_hz: Some(e.doppler_hz),
+                code_phase_chips: Some(e.code_phase_chips),
+                pll_lock_indicator: Some(e.pll_lock_metric),
+                code_lock: e.code_lock,
+                carrier_lock: e.pll_lock,
+                bit_sync: e.bit_edge || dec.synced(),
+                frame_sync: dec.synced(),
+            };
+            if let Err(x) = channels_csv.write_row(&row) {
+                err = Some(x.into());
+            }
+        }
+        let ready = match decoders.get(&e.prn) {
+            Some(d) => builder.push(e, d),
+            None => Vec::new(),
+        };
+        for epoch in ready {
+            if let Err(x) = handle_epoch(epoch, &decoders, &mut builder) {
+                err = Some(x);
+            }
+        }
+        let s = e.sample_index;
+        if s > processed + (fs * 0.2) as u64 {
+            processed = s;
+            bar.set_position(s);
+            let synced = decoders.values().filter(|d| d.synced()).count();
+            let with_eph = decoders.values().filter(|d| d.ephemeris.is_some()).count();
+            bar.set_message(format!(
+                "{} satellites, {synced} frame-synced, {with_eph} with ephemeris",
+                decoders.len()
+            ));
+        }
+    })?;
+    bar.finish_and_clear();
+    if let Some(e) = err {
+        return Err(e);
+    }
+    pvt_csv.finish()?;
+    nmea.finish()?;
+    channels_csv.finish()?;
+    match obs_writer {
+        Some(w) => {
+            w.finish()?;
+        }
+        None if !obs_backlog.is_empty() => {
+            // No fix: the observables still go out, with an unknown approximate position.
+            let header = ObsHeader {
+                interval_s: Some(1.0 / args.rate),
+                ..ObsHeader::default()
+            };
+            let mut w = RinexObsWriter::create(&out("observables.rnx"), header)?;
+            for o in obs_backlog.drain(..) {
+                w.write_epoch(&o)?;
+            }
+            w.finish()?;
+        }
+        None => {}
+    }
+    // Decoded ephemerides.
+    let records: Vec<NavRecord> = decoders
+        .values()
+        .filter_map(|d| d.ephemeris.clone())
+        .map(NavRecord::from)
+        .collect();
+    let header = NavHeader {
+        iono: decoders.values().find_map(|d| d.iono),
+        utc: decoders.values().find_map(|d| d.utc),
+        ..NavHeader::default()
+    };
+    output::rinex_nav::write_rinex_nav_file(&out("ephemeris.rnx"), &header, &records)?;
+    let mut f = create_file(&out("track.geojson"))?;
+    output::write_geojson(&mut f, "track.geojson", &fixes)?;
+    let mut f = create_file(&out("track.kml"))?;
+    output::write_kml(&mut f, "track.kml", "gpsrx track", &fixes)?;
+
+    summary.duration_s = total
+        .map(|t| t as f64 / fs)
+        .unwrap_or(processed as f64 / fs);
+    summary.wall_s = t_wall.elapsed().as_secs_f64();
+    summary.tracked_prns = decoders.keys().copied().collect();
+    summary.fixes = fixes.len();
+    if !fixes.is_empty() {
+        let n = fixes.len() as f64;
+        let lat = fixes
+            .iter()
+            .map(|f| f.llh.lat_rad.to_degrees())
+            .sum::<f64>()
+            / n;
+        let lon = fixes
+            .iter()
+            .map(|f| f.llh.lon_rad.to_degrees())
+            .sum::<f64>()
+            / n;
+        let h = fixes.iter().map(|f| f.llh.h_m).sum::<f64>() / n;
+        summary.mean_llh = Some((lat, lon, h));
+        summary.mean_pdop = Some(fixes.iter().map(|f| f.pdop).sum::<f64>() / n);
+    }
+    Ok((summary, fixes))
+}
+
+fn raim_text(r: &RaimStatus) -> String {
+    match r {
+        RaimStatus::Ok => "ok".into(),
+        RaimStatus::FaultExcluded { prn } => format!("excluded G{prn:02}"),
+        other => format!("{other:?}").to_lowercase(),
+    }
+}
+
+/// Runs `gpsrx run`.
+pub fn run(args: &RunArgs) -> anyhow::Result<()> {
+    let (s, _) = run_file(args, true)?;
+    println!(
+        "processed {:.1} s in {:.1} s ({:.1}x real time)",
+        s.duration_s,
+        s.wall_s,
+        s.duration_s / s.wall_s.max(1e-9)
+    );
+    println!("satellites tracked: {:?}", s.tracked_prns);
+    match (s.first_fix_s, s.mean_llh) {
+        (Some(t), Some((lat, lon, h))) => {
+            println!("first fix {t:.2} s after the start; {} fixes", s.fixes);
+            println!("mean position {lat:.7} deg, {lon:.7} deg, {h:.2} m; mean PDOP {:.2}", s.mean_pdop.unwrap_or(f64::NAN));
+        }
+        _ => println!(
+            "no fix: the recording ended before 4 satellites had their ephemeris (subframes 1-3 take 18-30 s; give --nav FILE to start sooner)"
+        ),
+    }
+    println!("outputs in {}", args.out.display());
+    Ok(())
+}

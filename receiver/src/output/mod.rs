@@ -1,0 +1,351 @@
+//! Output files of the receiver: standard formats other tools read, and CSV logs.
+//!
+//! - [`rinex_obs`]: RINEX 3.04 GPS observation file (`observables.rnx`), streamed epoch by epoch;
+//! - [`rinex_nav`]: RINEX 3.04 GPS navigation file (`ephemeris.rnx`);
+//! - [`nmea`]: NMEA 0183 GGA, RMC, GSA and GSV sentences (`pvt.nmea`);
+//! - [`geojson`] and [`kml`]: the track for maps (`track.geojson`, `track.kml`);
+//! - [`pvt_csv`]: one row per fix (`pvt.csv`) and one row per channel and epoch
+//!   (`channels.csv`).
+//!
+//! The writers take the small, format-neutral input types defined here ([`ObsEpoch`], [`Fix`],
+//! [`ChannelRow`]); the pipeline converts its own types into them. Every writer takes any
+//! [`std::io::Write`] plus the file name used in error messages, and reports failures as
+//! [`OutputError`]. Bad values (NaN, out-of-range numbers) never panic: they are written as
+//! empty fields where the format allows it and reported as errors where it does not.
+
+pub mod geojson;
+pub mod kml;
+pub mod nmea;
+pub mod pvt_csv;
+pub mod rinex_nav;
+pub mod rinex_obs;
+
+use gpsrx_nav::{GpsTime, Llh};
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+
+pub use geojson::write_geojson;
+pub use kml::write_kml;
+pub use nmea::{NmeaOptions, NmeaWriter};
+pub use pvt_csv::{ChannelCsvWriter, PvtCsvWriter};
+pub use rinex_nav::{write_rinex_nav, NavHeader, NavRecord};
+pub use rinex_obs::{ObsHeader, RinexObsWriter};
+
+/// Why an output file could not be written. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// Creating, writing or flushing the file failed.
+    #[error("cannot write output file `{file}`: {source}; check the directory exists, is writable and the disk is not full")]
+    Io {
+        /// File being written.
+        file: String,
+        /// Underlying I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The CSV writer failed (normally an I/O error underneath).
+    #[error("cannot write CSV file `{file}`: {source}")]
+    Csv {
+        /// File being written.
+        file: String,
+        /// Underlying CSV error.
+        #[source]
+        source: csv::Error,
+    },
+    /// The JSON serialiser failed (normally an I/O error underneath).
+    #[error("cannot write JSON file `{file}`: {source}")]
+    Json {
+        /// File being written.
+        file: String,
+        /// Underlying JSON error.
+        #[source]
+        source: serde_json::Error,
+    },
+    /// An input value the format cannot represent.
+    #[error("`{file}`: {reason}")]
+    InvalidInput {
+        /// File being written.
+        file: String,
+        /// What was wrong, with the value.
+        reason: String,
+    },
+    /// A file that needs at least one record was finished with none.
+    #[error("`{file}`: no {what} to write, so the file would not be valid; nothing was written")]
+    Empty {
+        /// File being written.
+        file: String,
+        /// What was missing (`epochs`, `fixes`).
+        what: &'static str,
+    },
+}
+
+impl OutputError {
+    pub(crate) fn io(file: &str) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
+        move |source| OutputError::Io {
+            file: file.to_string(),
+            source,
+        }
+    }
+
+    pub(crate) fn invalid(file: &str, reason: String) -> OutputError {
+        OutputError::InvalidInput {
+            file: file.to_string(),
+            reason,
+        }
+    }
+}
+
+/// Creates (truncates) `path` for buffered writing; the error names the file.
+pub fn create_file(path: &Path) -> Result<BufWriter<File>, OutputError> {
+    File::create(path)
+        .map(BufWriter::new)
+        .map_err(OutputError::io(&path.display().to_string()))
+}
+
+/// Observations of all tracked satellites at one receiver epoch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObsEpoch {
+    /// Receiver time of the epoch (GPS time scale, as read from the receiver clock).
+    pub time: GpsTime,
+    /// Receiver clock offset, s, if the writer should report it (RINEX epoch line field).
+    pub clock_offset_s: Option<f64>,
+    /// One entry per satellite.
+    pub sats: Vec<SatObs>,
+}
+
+/// L1 C/A observations of one satellite at one epoch. `None` or non-finite values are written
+/// as blank (not observed).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SatObs {
+    /// GPS PRN, 1-32 (RINEX allows 1-99).
+    pub prn: u8,
+    /// Pseudorange, m.
+    pub pseudorange_m: Option<f64>,
+    /// Carrier phase, cycles (RINEX sign convention: grows with range).
+    pub carrier_cycles: Option<f64>,
+    /// Doppler, Hz (positive for an approaching satellite).
+    pub doppler_hz: Option<f64>,
+    /// Carrier-to-noise density, dB-Hz.
+    pub cn0_dbhz: Option<f64>,
+    /// Lock was lost (or a cycle slip detected) since the previous epoch of this satellite.
+    pub loss_of_lock: bool,
+    /// The carrier phase may be off by half a cycle (navigation bit sign not yet resolved).
+    pub half_cycle_ambiguous: bool,
+}
+
+/// What kind of solution a [`Fix`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FixQuality {
+    /// Autonomous GNSS fix.
+    Gnss,
+    /// Dead-reckoning (propagated or INS-aided) solution.
+    DeadReckoning,
+    /// No valid position.
+    #[default]
+    None,
+}
+
+impl FixQuality {
+    /// Name used in CSV and GeoJSON outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            FixQuality::Gnss => "gnss",
+            FixQuality::DeadReckoning => "dead_reckoning",
+            FixQuality::None => "none",
+        }
+    }
+}
+
+/// One satellite as seen from the fix position.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SatView {
+    /// GPS PRN.
+    pub prn: u8,
+    /// Elevation, degrees.
+    pub el_deg: f64,
+    /// Azimuth, degrees clockwise from north.
+    pub az_deg: f64,
+    /// C/N0, dB-Hz, if tracked.
+    pub cn0_dbhz: Option<f64>,
+}
+
+/// A position, velocity and time solution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fix {
+    /// GPS time of the solution (receiver time corrected by the clock bias).
+    pub time: GpsTime,
+    /// ECEF position, m.
+    pub ecef_m: [f64; 3],
+    /// Geodetic position (WGS-84, height above the ellipsoid).
+    pub llh: Llh,
+    /// ECEF velocity, m/s.
+    pub vel_ecef_mps: Option<[f64; 3]>,
+    /// Receiver clock bias, m.
+    pub clock_bias_m: f64,
+    /// Receiver clock drift, m/s.
+    pub clock_drift_mps: Option<f64>,
+    /// Number of satellites used.
+    pub n_sv: usize,
+    /// PRNs used in the solution.
+    pub used_prns: Vec<u8>,
+    /// Position dilution of precision.
+    pub pdop: f64,
+    /// Horizontal dilution of precision.
+    pub hdop: f64,
+    /// Vertical dilution of precision.
+    pub vdop: f64,
+    /// RAIM outcome as text (e.g. `ok`, `excluded G12`, `unavailable`).
+    pub raim: String,
+    /// Solution kind.
+    pub quality: FixQuality,
+    /// Satellites in view, for NMEA GSV.
+    pub sats_in_view: Vec<SatView>,
+}
+
+/// Per-channel tracking state at one epoch, one row of `channels.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelRow {
+    /// Receiver time of the epoch.
+    pub time: GpsTime,
+    /// Channel number.
+    pub channel: u32,
+    /// GPS PRN tracked.
+    pub prn: u8,
+    /// Channel state name (e.g. `acquiring`, `pull_in`, `tracking`, `lost`).
+    pub state: String,
+    /// C/N0 estimate, dB-Hz.
+    pub cn0_dbhz: Option<f64>,
+    /// Carrier Doppler, Hz.
+    pub doppler_hz: Option<f64>,
+    /// Code phase, chips.
+    pub code_phase_chips: Option<f64>,
+    /// PLL lock indicator (e.g. the cos 2 phi estimate, 1 = locked).
+    pub pll_lock_indicator: Option<f64>,
+    /// Code (DLL) lock declared.
+    pub code_lock: bool,
+    /// Carrier (PLL) lock declared.
+    pub carrier_lock: bool,
+    /// Navigation bit synchronisation achieved.
+    pub bit_sync: bool,
+    /// Subframe (preamble) synchronisation achieved.
+    pub frame_sync: bool,
+}
+
+/// A calendar date and time rounded to a number of decimals of the second, without ever
+/// producing second 60 by rounding (the rounding is done on the time of week first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Calendar {
+    pub year: i32,
+    pub month: u32,
+    pub day: u32,
+    pub hour: u32,
+    pub minute: u32,
+    pub second: u32,
+    /// Fraction of the second in units of 10^-decimals s.
+    pub frac: u64,
+}
+
+/// Calendar of `t` in its own time scale, rounded to `decimals` (0-9) decimals of the second.
+/// `None` for a non-finite or negative time of week.
+pub(crate) fn calendar_rounded(t: GpsTime, decimals: u32) -> Option<Calendar> {
+    const WEEK_S: u64 = 604_800;
+    const DAY_S: u64 = 86_400;
+    let scale = 10u64.checked_pow(decimals.min(9))?;
+    let ticks_f = (t.tow_s * scale as f64).round();
+    if !ticks_f.is_finite() || ticks_f < 0.0 || ticks_f > 2.0 * (WEEK_S * scale) as f64 {
+        return None;
+    }
+    let mut ticks = ticks_f as u64;
+    let mut week = t.week;
+    while ticks >= WEEK_S * scale {
+        ticks -= WEEK_S * scale;
+        week = week.checked_add(1)?;
+    }
+    let day_in_week = ticks / (DAY_S * scale);
+    let sod_ticks = ticks % (DAY_S * scale);
+    let (year, month, day, _, _, _) =
+        GpsTime::new(week, (day_in_week * DAY_S) as f64).to_calendar();
+    let sod = sod_ticks / scale;
+    Some(Calendar {
+        year,
+        month,
+        day,
+        hour: (sod / 3600) as u32,
+        minute: ((sod % 3600) / 60) as u32,
+        second: (sod % 60) as u32,
+        frac: sod_ticks % scale,
+    })
+}
+
+/// Current UTC date as `yyyymmdd hhmmss UTC`, the RINEX 3 `PGM / RUN BY / DATE` form.
+pub(crate) fn rinex_creation_date_now() -> String {
+    /// Seconds from 1970-01-01 to 1980-01-06.
+    const UNIX_TO_GPS_EPOCH_S: u64 = 315_964_800;
+    let unix_s = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    // Used purely as a calendar conversion (no leap seconds added), so the result is UTC.
+    let t = GpsTime::new(0, unix_s.saturating_sub(UNIX_TO_GPS_EPOCH_S) as f64);
+    match calendar_rounded(t, 0) {
+        Some(c) => format!(
+            "{:04}{:02}{:02} {:02}{:02}{:02} UTC",
+            c.year, c.month, c.day, c.hour, c.minute, c.second
+        ),
+        None => String::new(),
+    }
+}
+
+/// `text` made printable ASCII and fitted to exactly `width` columns (truncated or padded on
+/// the right), for fixed-column formats.
+pub(crate) fn fit_ascii(text: &str, width: usize) -> String {
+    let mut s: String = text
+        .chars()
+        .map(|c| {
+            if c.is_ascii_graphic() || c == ' ' {
+                c
+            } else {
+                '?'
+            }
+        })
+        .take(width)
+        .collect();
+    while s.len() < width {
+        s.push(' ');
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn calendar_rounding_never_gives_second_60() {
+        let t = GpsTime::from_calendar(2022, 1, 1, 23, 59, 59.999_999_99);
+        let c = calendar_rounded(t, 7).expect("finite time");
+        assert_eq!(
+            (c.year, c.month, c.day, c.hour, c.minute, c.second, c.frac),
+            (2022, 1, 2, 0, 0, 0, 0)
+        );
+        let end_of_week = GpsTime::new(2190, 604_799.999_999_999);
+        let c = calendar_rounded(end_of_week, 3).expect("finite time");
+        assert_eq!((c.hour, c.minute, c.second, c.frac), (0, 0, 0, 0));
+        assert_eq!(c.day, 2);
+        assert!(calendar_rounded(
+            GpsTime {
+                week: 1,
+                tow_s: f64::NAN
+            },
+            3
+        )
+        .is_none());
+    }
+
+    #[test]
+    fn fit_ascii_pads_truncates_and_cleans() {
+        assert_eq!(fit_ascii("ab", 4), "ab  ");
+        assert_eq!(fit_ascii("abcdef", 4), "abcd");
+        assert_eq!(fit_ascii("é\tx", 3), "??x");
+    }
+}

@@ -1,0 +1,308 @@
+//! NMEA 0183 (version 2.3 fields) GGA, RMC, GSA and GSV sentences (`pvt.nmea`), talker `GP`.
+//!
+//! Each sentence is `$<body>*hh\r\n` where `hh` is the XOR of every byte between `$` and `*`
+//! as two upper-case hexadecimal digits. Times are UTC = GPS time - leap seconds
+//! ([`NmeaOptions::leap_seconds`], 18 s since 2017-01-01).
+//!
+//! **Altitude.** GGA field 9 is meant to be the altitude above mean sea level (the geoid) and
+//! field 11 the geoid separation N (ellipsoid - geoid). We carry no geoid model: unless the
+//! caller gives [`NmeaOptions::geoid_separation_m`], we write the height above the WGS-84
+//! ellipsoid as the altitude and a separation of 0.0, so altitude + separation is the
+//! ellipsoidal height either way.
+
+use super::{calendar_rounded, create_file, Fix, FixQuality, OutputError};
+use gpsrx_nav::{enu_rotation, GpsTime, Vector3};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+/// Knots per metre per second (1 international nautical mile = 1852 m).
+const KNOTS_PER_MPS: f64 = 3600.0 / 1852.0;
+/// Satellites per GSV sentence.
+const GSV_SATS_PER_SENTENCE: usize = 4;
+/// GSV message numbers are one digit.
+const GSV_MAX_SENTENCES: usize = 9;
+/// GSA lists at most 12 PRNs.
+const GSA_MAX_PRNS: usize = 12;
+
+/// How sentences are formed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NmeaOptions {
+    /// GPS - UTC, s (18 since 2017-01-01).
+    pub leap_seconds: i32,
+    /// Geoid separation N at the fix, m; `None` writes ellipsoidal height with N = 0.
+    pub geoid_separation_m: Option<f64>,
+}
+
+impl Default for NmeaOptions {
+    fn default() -> NmeaOptions {
+        NmeaOptions {
+            leap_seconds: 18,
+            geoid_separation_m: None,
+        }
+    }
+}
+
+/// `$body*hh\r\n` with the NMEA checksum.
+pub fn sentence(body: &str) -> String {
+    format!("${body}*{:02X}\r\n", checksum(body))
+}
+
+/// XOR of all bytes of `body` (the text between `$` and `*`).
+pub fn checksum(body: &str) -> u8 {
+    body.bytes().fold(0, |acc, b| acc ^ b)
+}
+
+/// UTC time `hhmmss.ss` and date `ddmmyy` of `t`, rounded to 0.01 s.
+fn utc_fields(t: GpsTime, leap_seconds: i32) -> (String, String) {
+    match calendar_rounded(t.add_seconds(-f64::from(leap_seconds)), 2) {
+        Some(c) => (
+            format!("{:02}{:02}{:02}.{:02}", c.hour, c.minute, c.second, c.frac),
+            format!("{:02}{:02}{:02}", c.day, c.month, c.year.rem_euclid(100)),
+        ),
+        None => (String::new(), String::new()),
+    }
+}
+
+/// `ddmm.mmmm,N` / `dddmm.mmmm,E` for an angle in degrees (rounded on 1e-4 minute, so the
+/// minutes never print as 60). Empty fields for a non-finite angle.
+fn angle_fields(deg: f64, deg_digits: usize, pos: char, neg: char) -> String {
+    if !deg.is_finite() || deg.abs() > 180.0 {
+        return ",".to_string();
+    }
+    let hemi = if deg < 0.0 { neg } else { pos };
+    let ticks = (deg.abs() * 60.0 * 10_000.0).round() as u64;
+    let whole_deg = ticks / 600_000;
+    let min_ticks = ticks % 600_000;
+    format!(
+        "{whole_deg:0deg_digits$}{:02}.{:04},{hemi}",
+        min_ticks / 10_000,
+        min_ticks % 10_000
+    )
+}
+
+fn position_valid(fix: &Fix) -> bool {
+    fix.quality != FixQuality::None
+        && fix.llh.lat_rad.is_finite()
+        && fix.llh.lon_rad.is_finite()
+        && fix.llh.h_m.is_finite()
+}
+
+fn lat_lon(fix: &Fix) -> String {
+    if !position_valid(fix) {
+        return ",,,".to_string();
+    }
+    format!(
+        "{},{}",
+        angle_fields(fix.llh.lat_rad.to_degrees(), 2, 'N', 'S'),
+        angle_fields(fix.llh.lon_rad.to_degrees(), 3, 'E', 'W')
+    )
+}
+
+fn opt_num(v: f64, decimals: usize) -> String {
+    if v.is_finite() {
+        format!("{v:.decimals$}")
+    } else {
+        String::new()
+    }
+}
+
+/// GGA: time, position, quality (1 GNSS fix, 6 dead reckoning, 0 invalid), satellites used,
+/// HDOP, altitude (see the module note), geoid separation.
+pub fn gga(fix: &Fix, opts: &NmeaOptions) -> String {
+    let (time, _) = utc_fields(fix.time, opts.leap_seconds);
+    let quality = match fix.quality {
+        FixQuality::Gnss => 1,
+        FixQuality::DeadReckoning => 6,
+        FixQuality::None => 0,
+    };
+    let n_sv = fix.n_sv.min(99);
+    let (alt, sep) = if position_valid(fix) {
+        let n = opts
+            .geoid_separation_m
+            .filter(|n| n.is_finite())
+            .unwrap_or(0.0);
+        (opt_num(fix.llh.h_m - n, 3), opt_num(n, 3))
+    } else {
+        (String::new(), String::new())
+    };
+    sentence(&format!(
+        "GPGGA,{time},{},{quality},{n_sv:02},{},{alt},M,{sep},M,,",
+        lat_lon(fix),
+        opt_num(fix.hdop, 1)
+    ))
+}
+
+/// Speed over ground (knots) and course over ground (degrees true, [0, 360)) from the ECEF
+/// velocity rotated to local East-North-Up; `None` without a finite velocity.
+pub fn speed_course(fix: &Fix) -> Option<(f64, f64)> {
+    let v = fix.vel_ecef_mps?;
+    let enu = enu_rotation(&fix.llh) * Vector3::new(v[0], v[1], v[2]);
+    let speed_mps = enu.x.hypot(enu.y);
+    if !speed_mps.is_finite() {
+        return None;
+    }
+    let mut course = enu.x.atan2(enu.y).to_degrees();
+    if course < 0.0 {
+        course += 360.0;
+    }
+    if course >= 359.95 {
+        // Would print as 360.0.
+        course = 0.0;
+    }
+    Some((speed_mps * KNOTS_PER_MPS, course))
+}
+
+/// RMC: time, status (A valid / V invalid), position, speed (knots), course (deg true), date,
+/// magnetic variation (empty), mode (A autonomous, E estimated/dead reckoning, N invalid).
+pub fn rmc(fix: &Fix, opts: &NmeaOptions) -> String {
+    let (time, date) = utc_fields(fix.time, opts.leap_seconds);
+    let valid = position_valid(fix);
+    let (status, mode) = match fix.quality {
+        _ if !valid => ('V', 'N'),
+        FixQuality::Gnss => ('A', 'A'),
+        FixQuality::DeadReckoning => ('A', 'E'),
+        FixQuality::None => ('V', 'N'),
+    };
+    let (speed, course) = match speed_course(fix).filter(|_| valid) {
+        Some((kn, deg)) => (format!("{kn:.2}"), format!("{deg:.1}")),
+        None => (String::new(), String::new()),
+    };
+    sentence(&format!(
+        "GPRMC,{time},{status},{},{speed},{course},{date},,,{mode}",
+        lat_lon(fix)
+    ))
+}
+
+/// GSA: automatic mode, fix type (1 none, 2 2D, 3 3D), up to 12 PRNs used, PDOP, HDOP, VDOP.
+pub fn gsa(fix: &Fix) -> String {
+    let fix_type = if !position_valid(fix) {
+        1
+    } else if fix.used_prns.len() == 3 {
+        2
+    } else {
+        3
+    };
+    let mut prns: Vec<String> = fix
+        .used_prns
+        .iter()
+        .take(GSA_MAX_PRNS)
+        .map(|p| format!("{p:02}"))
+        .collect();
+    prns.resize(GSA_MAX_PRNS, String::new());
+    sentence(&format!(
+        "GPGSA,A,{fix_type},{},{},{},{}",
+        prns.join(","),
+        opt_num(fix.pdop, 1),
+        opt_num(fix.hdop, 1),
+        opt_num(fix.vdop, 1)
+    ))
+}
+
+/// GSV: satellites in view, 4 per sentence (at most 9 sentences): PRN, elevation (deg,
+/// 0-90), azimuth (deg true, 0-359), SNR (C/N0, dB-Hz, 0-99, empty when not tracked).
+pub fn gsv(fix: &Fix) -> Vec<String> {
+    let sats: Vec<_> = fix
+        .sats_in_view
+        .iter()
+        .take(GSV_SATS_PER_SENTENCE * GSV_MAX_SENTENCES)
+        .collect();
+    let total = sats.len().div_ceil(GSV_SATS_PER_SENTENCE).max(1);
+    (0..total)
+        .map(|k| {
+            let mut body = format!("GPGSV,{total},{},{:02}", k + 1, sats.len());
+            for s in sats
+                .iter()
+                .skip(k * GSV_SATS_PER_SENTENCE)
+                .take(GSV_SATS_PER_SENTENCE)
+            {
+                let el = if s.el_deg.is_finite() {
+                    format!("{:02}", s.el_deg.round().clamp(0.0, 90.0) as u32)
+                } else {
+                    String::new()
+                };
+                let az = if s.az_deg.is_finite() {
+                    format!("{:03}", (s.az_deg.round().rem_euclid(360.0) as u32) % 360)
+                } else {
+                    String::new()
+                };
+                let snr = s
+                    .cn0_dbhz
+                    .filter(|c| c.is_finite())
+                    .map(|c| format!("{:02}", c.round().clamp(0.0, 99.0) as u32))
+                    .unwrap_or_default();
+                body.push_str(&format!(",{:02},{el},{az},{snr}", s.prn));
+            }
+            sentence(&body)
+        })
+        .collect()
+}
+
+/// Streams GGA, RMC, GSA and GSV sentences for each fix.
+#[derive(Debug)]
+pub struct NmeaWriter<W: Write> {
+    out: W,
+    file: String,
+    opts: NmeaOptions,
+}
+
+impl NmeaWriter<BufWriter<File>> {
+    /// Creates the file at `path`.
+    pub fn create(path: &Path, opts: NmeaOptions) -> Result<Self, OutputError> {
+        Ok(NmeaWriter::new(
+            create_file(path)?,
+            path.display().to_string(),
+            opts,
+        ))
+    }
+}
+
+impl<W: Write> NmeaWriter<W> {
+    /// A writer to `out`; `file` names the destination in errors.
+    pub fn new(out: W, file: impl Into<String>, opts: NmeaOptions) -> Self {
+        NmeaWriter {
+            out,
+            file: file.into(),
+            opts,
+        }
+    }
+
+    /// Writes GGA, RMC, GSA and the GSV group of one fix.
+    pub fn write_fix(&mut self, fix: &Fix) -> Result<(), OutputError> {
+        let mut text = gga(fix, &self.opts);
+        text.push_str(&rmc(fix, &self.opts));
+        text.push_str(&gsa(fix));
+        for s in gsv(fix) {
+            text.push_str(&s);
+        }
+        self.out
+            .write_all(text.as_bytes())
+            .map_err(OutputError::io(&self.file))
+    }
+
+    /// Flushes and returns the destination.
+    pub fn finish(mut self) -> Result<W, OutputError> {
+        self.out.flush().map_err(OutputError::io(&self.file))?;
+        Ok(self.out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angles_round_without_sixty_minutes() {
+        assert_eq!(angle_fields(48.117_3, 2, 'N', 'S'), "4807.0380,N");
+        assert_eq!(angle_fields(-11.516_666_7, 3, 'E', 'W'), "01131.0000,W");
+        assert_eq!(angle_fields(9.999_999_999, 2, 'N', 'S'), "1000.0000,N");
+        assert_eq!(angle_fields(f64::NAN, 2, 'N', 'S'), ",");
+    }
+
+    #[test]
+    fn checksum_of_a_textbook_sentence() {
+        // Widely published example GGA sentence; its checksum is 47.
+        let body = "GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,";
+        assert_eq!(checksum(body), 0x47);
+    }
+}

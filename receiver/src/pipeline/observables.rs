@@ -1,0 +1,229 @@
+//! Observables at common receive epochs: every satellite's transmit time, pseudorange,
+//! accumulated carrier phase, Doppler and C/N0 at the same receiver-clock instants.
+//!
+//! Receiver time scale: the sample with index `k` is at receiver time `T0 + k / fs`. `T0` is set
+//! when the first satellite's SV time becomes known, so that this satellite's pseudorange is
+//! 75 ms (a typical travel time) at that instant, rounded to a whole millisecond; the PVT then
+//! estimates the clock bias against GPS time. When the bias leaves +-0.5 ms the receiver clock is
+//! stepped by a whole number of milliseconds (pseudoranges jump by c x 1 ms = 299,792.458 m and
+//! carrier phases by 1,575,420 cycles per ms, consistently, so the carrier stays continuous with
+//! the code); steps are reported so outputs can flag them.
+//!
+//! A channel report covers `[t_rx, t_rx + T)`; the observables at an epoch `t` inside it come
+//! from the NCO state at its start advanced to `t`: SV time by `(t - t_rx) r / 1.023 MHz` for the
+//! code rate `r`, carrier phase by `(t - t_rx) f_D`.
+
+use crate::pipeline::navdata::NavDecoder;
+use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ, SPEED_OF_LIGHT_MPS};
+use gpsrx_nav::time::GpsTime;
+use gpsrx_tracking::{ChannelEpoch, ChannelState};
+use std::collections::BTreeMap;
+
+/// One satellite's observables at an epoch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SatObservable {
+    /// PRN.
+    pub prn: u8,
+    /// SV transmit time (TOW, s, SV clock).
+    pub sv_tow_s: f64,
+    /// Pseudorange, m (receiver clock).
+    pub pseudorange_m: f64,
+    /// Carrier-smoothed pseudorange (Hatch filter), m.
+    pub smoothed_pseudorange_m: f64,
+    /// Accumulated carrier phase, cycles (RINEX sign: grows as the range grows).
+    pub carrier_cycles: f64,
+    /// Doppler, Hz (positive when approaching): the carrier phase change since the previous
+    /// epoch over the epoch interval when both are in lock, else the NCO frequency.
+    pub doppler_hz: f64,
+    /// C/N0, dB-Hz.
+    pub cn0_dbhz: f64,
+    /// The phase lock indicator was off at some point since the previous epoch (or the channel
+    /// restarted): a cycle slip may have happened.
+    pub loss_of_lock: bool,
+    /// The Costas half-cycle ambiguity is not resolved.
+    pub half_cycle_ambiguous: bool,
+}
+
+/// Observables of all satellites at one receiver-clock instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObservableEpoch {
+    /// Receiver time of the epoch (GPS time scale + the receiver clock bias).
+    pub rx_time: GpsTime,
+    /// Sample index (fractional) of the epoch.
+    pub sample: f64,
+    /// Whether the receiver clock was stepped just before this epoch.
+    pub clock_step_ms: i64,
+    /// One entry per satellite with a known SV time.
+    pub sats: Vec<SatObservable>,
+}
+
+/// Builds observable epochs from channel reports.
+#[derive(Debug)]
+pub struct ObservableBuilder {
+    fs_hz: f64,
+    rate_hz: f64,
+    /// Receiver time of sample 0 (None until the first SV time is known).
+    t0: Option<GpsTime>,
+    pending_step_ms: i64,
+    total_step_ms: i64,
+    /// Epoch index -> observables collected so far.
+    pending: BTreeMap<i64, Vec<SatObservable>>,
+    /// Per PRN: lock lost since the last epoch, and the carrier-phase origin (cycles) used to
+    /// keep the accumulated phase small.
+    lli: BTreeMap<u8, bool>,
+    /// Highest epoch index any channel has reached.
+    newest: i64,
+    /// Per PRN: the previous epoch's index, carrier phase (cycles) and smoothed pseudorange
+    /// with its number of averaged epochs (Hatch filter state), and the clock steps (ms) so far.
+    smoothing: BTreeMap<u8, (i64, f64, f64, u32, i64, f64)>,
+    /// Hatch filter length, epochs.
+    hatch_epochs: u32,
+}
+
+impl ObservableBuilder {
+    /// Epochs at `rate_hz` (1-50 Hz) of receiver time, for samples at `fs_hz`.
+    pub fn new(fs_hz: f64, rate_hz: f64) -> Self {
+        Self {
+            fs_hz,
+            rate_hz,
+            t0: None,
+            pending_step_ms: 0,
+            total_step_ms: 0,
+            pending: BTreeMap::new(),
+            lli: BTreeMap::new(),
+            newest: i64::MIN,
+            smoothing: BTreeMap::new(),
+            hatch_epochs: (rate_hz * 10.0).round().max(1.0) as u32,
+        }
+    }
+
+    /// Receiver time of sample 0, once known.
+    pub fn rx_time_origin(&self) -> Option<GpsTime> {
+        self.t0
+    }
+
+    /// Steps the receiver clock by `ms` milliseconds (receiver time of every sample moves by
+    /// `+ms`): used to keep the clock bias within +-0.5 ms.
+    pub fn step_clock_ms(&mut self, ms: i64) {
+        if let Some(t0) = self.t0 {
+            self.t0 = Some(t0.add_seconds(ms as f64 * 1e-3));
+            self.pending_step_ms += ms;
+            self.total_step_ms += ms;
+            // Epochs not yet emitted were measured on the old scale: drop them.
+            self.pending.clear();
+        }
+    }
+
+    /// Takes one channel report (with the decoder of its satellite); returns the epochs that
+    /// are complete (no channel can add to them any more).
+    pub fn push(&mut self, e: &ChannelEpoch, dec: &NavDecoder) -> Vec<ObservableEpoch> {
+        let lost = self.lli.entry(e.prn).or_insert(true);
+        *lost |= !e.pll_lock || e.state == ChannelState::Lost;
+        let Some(sv_tow0) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) else {
+            return Vec::new();
+        };
+        let t_rx = e.sample_index as f64 / self.fs_hz;
+        let t0 = *self.t0.get_or_insert_with(|| {
+            // Travel time 75 ms, receiver time of sample 0 on a whole millisecond.
+            let t = sv_tow0 + 0.075 - t_rx;
+            GpsTime::new(dec.week(), (t * 1e3).round() * 1e-3)
+        });
+        // The week label comes from the reference week until a subframe 1 is decoded.
+        let t0 = match dec.decoded_week() {
+            Some(w) if w != t0.week => {
+                let fixed = GpsTime {
+                    week: w,
+                    tow_s: t0.tow_s,
+                };
+                self.t0 = Some(fixed);
+                fixed
+            }
+            _ => t0,
+        };
+        // Epoch indices whose receiver time falls inside this report's interval.
+        let start_rx = t0.tow_s + t_rx;
+        let end_rx = start_rx + e.t_coh_s;
+        let first = (start_rx * self.rate_hz).ceil() as i64;
+        let mut n = first;
+        while (n as f64) / self.rate_hz < end_rx {
+            let t_epoch = n as f64 / self.rate_hz;
+            let dt = t_epoch - start_rx;
+            let sv_tow = sv_tow0 + dt * e.code_rate_chips_s / CA_CHIP_RATE_HZ;
+            // Week-boundary safe difference of two TOWs.
+            let mut tau = t_epoch - sv_tow;
+            tau -= (tau / 604_800.0).round() * 604_800.0;
+            let carrier = e.carrier_phase_cycles + dt * e.doppler_hz;
+            let lost_flag = std::mem::replace(self.lli.entry(e.prn).or_insert(false), false);
+            let pseudorange_m = tau * SPEED_OF_LIGHT_MPS;
+            // The NCO phase grows with the Doppler (range shrinking); RINEX phase grows with the
+            // range: negate. The receiver clock steps move it by f_L1 per second.
+            let carrier_cycles = -carrier + self.total_step_ms as f64 * 1e-3 * F_L1_HZ;
+            // Hatch filter (carrier smoothing, 10 s) and carrier Doppler, restarted on any loss
+            // of lock or gap: P_s(k) = P(k)/M + (M-1)/M (P_s(k-1) + lambda (L(k) - L(k-1))).
+            let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+            let (smoothed, doppler_hz, m) = match self.smoothing.get(&e.prn) {
+                Some(&(k_prev, l_prev, ps_prev, m_prev, steps_prev, ts_prev))
+                    if k_prev == n - 1 && !lost_flag =>
+                {
+                    let m = (m_prev + 1).min(self.hatch_epochs);
+                    let mf = f64::from(m);
+                    let dl = carrier_cycles - l_prev;
+                    let ps = pseudorange_m / mf + (mf - 1.0) / mf * (ps_prev + lambda * dl);
+                    // A clock step is not a Doppler.
+                    let dl_signal = dl - (self.total_step_ms - steps_prev) as f64 * 1e-3 * F_L1_HZ;
+                    // Over the elapsed sample time (an epoch after a clock step is not 1/rate
+                    // after the previous one).
+                    let dt = t_epoch - t0.tow_s - ts_prev;
+                    (ps, -dl_signal / dt, m)
+                }
+                _ => (pseudorange_m, e.doppler_hz, 1),
+            };
+            self.smoothing.insert(
+                e.prn,
+                (
+                    n,
+                    carrier_cycles,
+                    smoothed,
+                    m,
+                    self.total_step_ms,
+                    t_epoch - t0.tow_s,
+                ),
+            );
+            self.pending.entry(n).or_default().push(SatObservable {
+                prn: e.prn,
+                sv_tow_s: sv_tow,
+                pseudorange_m,
+                smoothed_pseudorange_m: smoothed,
+                carrier_cycles,
+                doppler_hz,
+                cn0_dbhz: e.cn0_dbhz,
+                loss_of_lock: lost_flag,
+                half_cycle_ambiguous: false,
+            });
+            self.newest = self.newest.max(n);
+            n += 1;
+        }
+        // Epochs two or more behind the newest are complete.
+        let done: Vec<i64> = self
+            .pending
+            .keys()
+            .copied()
+            .filter(|&k| k + 2 <= self.newest)
+            .collect();
+        let mut out = Vec::new();
+        for k in done {
+            if let Some(mut sats) = self.pending.remove(&k) {
+                sats.sort_by_key(|s| s.prn);
+                sats.dedup_by_key(|s| s.prn);
+                let t = k as f64 / self.rate_hz;
+                out.push(ObservableEpoch {
+                    rx_time: GpsTime::new(t0.week, t),
+                    sample: (t - t0.tow_s) * self.fs_hz,
+                    clock_step_ms: std::mem::take(&mut self.pending_step_ms),
+                    sats,
+                });
+            }
+        }
+        out
+    }
+}
