@@ -127,7 +127,17 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         ),
         None => None,
     };
-    let reference_week = args.week.unwrap_or_else(current_gps_week);
+    // The week that resolves the broadcast 10-bit week: --week, else the navigation file's,
+    // else today's.
+    let reference_week = args
+        .week
+        .or_else(|| {
+            nav_assist
+                .as_ref()
+                .and_then(|n| n.ephemerides.first())
+                .map(|e| e.toe.week)
+        })
+        .unwrap_or_else(current_gps_week);
 
     // Cold acquisition on the first samples.
     let acq_cfg = AcqConfig {

@@ -4,9 +4,10 @@
 //!
 //! Frame sync (IS-GPS-200 20.3.2): a candidate is a position where the 8-bit preamble appears
 //! in either polarity (the Costas loop's 180 deg ambiguity) and all ten words of the 300-bit
-//! subframe pass parity; it is confirmed when the next subframe, 300 bits later, passes parity
-//! too with a TOW count one higher. Only then are subframes used (including the first one,
-//! kept until the confirmation). Words that fail parity are counted and never used.
+//! subframe pass parity; it is confirmed when the next subframe's TLM starts with the preamble
+//! in the same polarity, 300 bits after the candidate's (160 ms after the candidate ends).
+//! Only then are subframes used (including the candidate itself). Subframes that fail parity
+//! afterwards are counted and never used; three in a row drop the sync.
 //!
 //! Time tag: the HOW of a subframe gives the TOW of its first bit, so the code period that
 //! starts that bit left the satellite at `tow_start`; code period `m` later left it at
@@ -16,7 +17,8 @@ use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
 use gpsrx_nav::atmosphere::{KlobucharParams, UtcParams};
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::lnav::{
-    decode_subframe_any_polarity, DecodedSubframe, EphemerisAssembler, SubframePayload,
+    decode_subframe_any_polarity, preamble_polarity, DecodedSubframe, EphemerisAssembler, Polarity,
+    SubframePayload,
 };
 use std::collections::VecDeque;
 
@@ -52,8 +54,9 @@ pub struct NavDecoder {
     bits: VecDeque<(u8, u64)>,
     /// Index in `bits` where the next subframe starts, once synchronised.
     next_subframe: Option<usize>,
-    /// A parity-checked candidate waiting for confirmation: (its subframe, its first bit's ms).
-    candidate: Option<(DecodedSubframe, u64)>,
+    /// A parity-checked candidate waiting for confirmation: its subframe, its first bit's ms and
+    /// its polarity.
+    candidate: Option<(DecodedSubframe, u64, Polarity)>,
     assembler: EphemerisAssembler,
     /// Latest ephemeris.
     pub ephemeris: Option<Ephemeris>,
@@ -147,7 +150,7 @@ impl NavDecoder {
                 if self.bits.len() >= start + SUBFRAME_BITS {
                     let (decoded, first_ms) = self.decode_at(start);
                     match decoded {
-                        Some(sf) => self.accept(sf, first_ms, &mut events),
+                        Some((sf, _)) => self.accept(sf, first_ms, &mut events),
                         None => {
                             self.parity_failures += 1;
                             self.consecutive_failures += 1;
@@ -168,47 +171,58 @@ impl NavDecoder {
         events
     }
 
-    /// Looks for a subframe ending at the newest bit; confirms a candidate 300 bits later.
+    /// Confirms a candidate with the next TLM preamble, or looks for a subframe ending at the
+    /// newest bit.
     fn search(&mut self, events: &mut Vec<NavEvent>) {
+        if let Some((sf, first_ms, polarity)) = self.candidate {
+            // The next subframe starts 300 bits (6000 ms) after the candidate's first bit.
+            let next_ms = first_ms + 6000;
+            let Some(idx) = self.bits.iter().position(|&(_, ms)| ms == next_ms) else {
+                return;
+            };
+            if self.bits.len() < idx + 8 {
+                return;
+            }
+            let head: Vec<u8> = self
+                .bits
+                .iter()
+                .skip(idx)
+                .take(8)
+                .map(|&(b, _)| b)
+                .collect();
+            self.candidate = None;
+            if preamble_polarity(&head) == Some(polarity) {
+                events.push(NavEvent::FrameSync {
+                    tow_s: sf.how.subframe_start_tow_s(),
+                });
+                self.accept(sf, first_ms, events);
+                self.bits.drain(..idx);
+                self.next_subframe = Some(0);
+                return;
+            }
+        }
         if self.bits.len() < SUBFRAME_BITS {
             return;
         }
         let start = self.bits.len() - SUBFRAME_BITS;
-        let (decoded, first_ms) = self.decode_at(start);
-        let Some(sf) = decoded else {
-            // Bound the buffer while searching.
-            if self.bits.len() > 2 * SUBFRAME_BITS {
-                self.bits.pop_front();
+        match self.decode_at(start) {
+            (Some((sf, polarity)), first_ms) => self.candidate = Some((sf, first_ms, polarity)),
+            _ => {
+                // Bound the buffer while searching.
+                if self.bits.len() > 2 * SUBFRAME_BITS {
+                    self.bits.pop_front();
+                }
             }
-            return;
-        };
-        match self.candidate.take() {
-            Some((prev, prev_ms))
-                if first_ms == prev_ms + 6000
-                    && sf.how.tow_count == prev.how.tow_count % 100_800 + 1 =>
-            {
-                events.push(NavEvent::FrameSync {
-                    tow_s: prev.how.subframe_start_tow_s(),
-                });
-                self.accept(prev, prev_ms, events);
-                self.accept(sf, first_ms, events);
-                self.bits.drain(..start + SUBFRAME_BITS);
-                self.next_subframe = Some(0);
-            }
-            _ => self.candidate = Some((sf, first_ms)),
         }
     }
 
-    fn decode_at(&self, start: usize) -> (Option<DecodedSubframe>, u64) {
+    fn decode_at(&self, start: usize) -> (Option<(DecodedSubframe, Polarity)>, u64) {
         let mut bits = [0u8; SUBFRAME_BITS];
         for (i, b) in bits.iter_mut().enumerate() {
             *b = self.bits[start + i].0;
         }
         let first_ms = self.bits[start].1;
-        (
-            decode_subframe_any_polarity(&bits).ok().map(|(sf, _)| sf),
-            first_ms,
-        )
+        (decode_subframe_any_polarity(&bits).ok(), first_ms)
     }
 
     fn accept(&mut self, sf: DecodedSubframe, first_ms: u64, events: &mut Vec<NavEvent>) {
