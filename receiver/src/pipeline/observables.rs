@@ -119,6 +119,11 @@ impl ObservableBuilder {
     pub fn push(&mut self, e: &ChannelEpoch, dec: &NavDecoder) -> Vec<ObservableEpoch> {
         let lost = self.lli.entry(e.prn).or_insert(true);
         *lost |= !e.pll_lock || e.state == ChannelState::Lost;
+        // Only phase-locked channels give observables (a channel that has just lost its signal
+        // still reports until its C/N0 test releases it).
+        if !e.pll_lock || e.state == ChannelState::Lost {
+            return Vec::new();
+        }
         let Some(sv_tow0) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) else {
             return Vec::new();
         };
