@@ -1,8 +1,10 @@
 //! `gpsrx demo`: simulate the built-in scenario and show what was made. Needs no file.
 
-use crate::cli::DemoArgs;
+use crate::cli::{DemoArgs, LoopArgs, SourceArgs};
+use crate::commands::run::{run_file, IonoModel, RunArgs, TropoModel};
 use crate::commands::simulate::{print_report, simulate};
 use anyhow::Context;
+use gpsrx_nav::frames::{enu_rotation, Vector3};
 use gpsrx_samples::sim::Scenario;
 use std::path::PathBuf;
 
@@ -31,6 +33,76 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     let report = simulate(&scenario, &PathBuf::new(), &dir, true)?;
     print_report(&report);
     print_truth_summary(&report.truth_sv_path)?;
+    println!(
+        "\nrunning the receiver on it (gpsrx run {} --out {})",
+        report.data_path.display(),
+        dir.join("run").display()
+    );
+    let run_args = RunArgs {
+        source: SourceArgs {
+            file: report.data_path.clone(),
+            format: None,
+            fs: None,
+            if_hz: 0.0,
+            invert_q: false,
+            skip: 0.0,
+            duration: None,
+        },
+        loops: LoopArgs::default(),
+        out: dir.join("run"),
+        nav: None,
+        iono: IonoModel::Klobuchar,
+        tropo: TropoModel::Saastamoinen,
+        elevation_mask: 5.0,
+        rate: 10.0,
+        week: Some(scenario.start_time()?.week),
+        doppler_max: 5000.0,
+        raim_pfa: 1e-3,
+        allow_unhealthy: false,
+    };
+    let (summary, fixes) = run_file(&run_args, true)?;
+    println!(
+        "processed {:.1} s in {:.1} s ({:.1}x real time); satellites tracked: {:?}",
+        summary.duration_s,
+        summary.wall_s,
+        summary.duration_s / summary.wall_s.max(1e-9),
+        summary.tracked_prns
+    );
+    match (summary.first_fix_s, truth_position(&report.truth_path)?) {
+        (Some(t), Some(truth)) => {
+            let (mut h2, mut v2) = (0.0, 0.0);
+            for f in &fixes {
+                let d = Vector3::new(
+                    f.ecef_m[0] - truth.x,
+                    f.ecef_m[1] - truth.y,
+                    f.ecef_m[2] - truth.z,
+                );
+                let enu = enu_rotation(&f.llh) * d;
+                h2 += enu.x * enu.x + enu.y * enu.y;
+                v2 += enu.z * enu.z;
+            }
+            let n = fixes.len() as f64;
+            let last = &fixes[fixes.len() - 1];
+            println!(
+                "first fix {t:.1} s after the start (subframes 1-3 complete at 24.1 s); {} fixes",
+                fixes.len()
+            );
+            println!(
+                "last fix: {:.7} deg, {:.7} deg, {:.2} m, {} satellites, PDOP {:.2}",
+                last.llh.lat_rad.to_degrees(),
+                last.llh.lon_rad.to_degrees(),
+                last.llh.h_m,
+                last.n_sv,
+                last.pdop
+            );
+            println!(
+                "error against the truth: horizontal RMS {:.2} m, vertical RMS {:.2} m",
+                (h2 / n).sqrt(),
+                (v2 / n).sqrt()
+            );
+        }
+        _ => println!("no fix (the recording is too short: subframes 1-3 need about 24 s here)"),
+    }
     if args.keep.is_none() {
         println!("(temporary files removed; use --keep DIR to keep them)");
     }
@@ -78,4 +150,24 @@ fn print_truth_summary(truth_sv: &std::path::Path) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The (static) truth position: the first row of `truth.csv`.
+fn truth_position(truth: &std::path::Path) -> anyhow::Result<Option<Vector3<f64>>> {
+    let mut rdr = csv::Reader::from_path(truth)
+        .with_context(|| format!("cannot read {}", truth.display()))?;
+    let headers = rdr.headers()?.clone();
+    let col = |name: &str| headers.iter().position(|h| h == name);
+    let (Some(x), Some(y), Some(z)) = (col("x_m"), col("y_m"), col("z_m")) else {
+        return Ok(None);
+    };
+    let Some(rec) = rdr.records().next() else {
+        return Ok(None);
+    };
+    let rec = rec?;
+    let f = |i: usize| rec.get(i).and_then(|v| v.parse::<f64>().ok());
+    Ok(match (f(x), f(y), f(z)) {
+        (Some(a), Some(b), Some(c)) => Some(Vector3::new(a, b, c)),
+        _ => None,
+    })
 }
