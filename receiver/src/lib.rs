@@ -6,5 +6,6 @@
 
 pub mod cli;
 pub mod commands;
+pub mod landmarks;
 pub mod output;
 pub mod pipeline;

@@ -59,6 +59,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         doppler_max: 5000.0,
         raim_pfa: 1e-3,
         allow_unhealthy: false,
+        landmarks: None,
     };
     let (summary, fixes) = run_file(&run_args, true)?;
     println!(

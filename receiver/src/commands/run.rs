@@ -81,6 +81,10 @@ pub struct RunArgs {
     /// RAIM false-alarm probability.
     #[arg(long, value_name = "P", default_value_t = 1e-3)]
     pub raim_pfa: f64,
+    /// Landmark range observations, CSV `tow_s,x_m,y_m,z_m,range_m,sigma_m` (seed 001): added to
+    /// the fixes without a clock term, so 3 satellites and 1 landmark give a fix.
+    #[arg(long, value_name = "FILE")]
+    pub landmarks: Option<PathBuf>,
     /// Use satellites whose ephemeris says they are unhealthy (some simulators copy a health
     /// flag that the real satellite had at the time).
     #[arg(long)]
@@ -129,6 +133,10 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
     };
     // The week that resolves the broadcast 10-bit week: --week, else the navigation file's,
     // else today's.
+    let landmark_obs = match &args.landmarks {
+        Some(p) => crate::landmarks::read_landmarks(p)?,
+        None => Vec::new(),
+    };
     let reference_week = args
         .week
         .or_else(|| {
@@ -275,8 +283,15 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
                 );
             }
         }
-        let solution = if meas.len() >= 4 {
-            match solve(epoch.rx_time, &meas, &[], &opts, prior.as_ref()) {
+        // Landmark observations of this epoch (receiver time within half an interval; the clock
+        // bias is kept below 0.5 ms, far less than that).
+        let landmarks: Vec<gpsrx_nav::pvt::Landmark> = landmark_obs
+            .iter()
+            .filter(|l| (l.tow_s - epoch.rx_time.tow_s).abs() <= 0.5 / args.rate)
+            .map(|l| l.landmark)
+            .collect();
+        let solution = if meas.len() + landmarks.len() >= 4 && !meas.is_empty() {
+            match solve(epoch.rx_time, &meas, &landmarks, &opts, prior.as_ref()) {
                 Ok(s) => Some(s),
                 Err(e) => {
                     tracing::debug!("no fix at {:.3}: {e}", epoch.rx_time.tow_s);
