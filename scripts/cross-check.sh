@@ -58,6 +58,11 @@ PY
   else
     bad "gpsrx run on the GPS-SDR-SIM recording: $(tail -3 "$WORK/seoul.err")"
   fi
+  # The same recording through GNSS-SDR, for comparison (reported, not scored: GNSS-SDR's first
+  # fix comes at 36-48 s of this 40 s file, so it may have none).
+  echo "GNSS-SDR on the same recording (for comparison):"
+  TROP_MODEL=OFF FILE_START=2190:538200 MAX_ERR_M=1000 bash scripts/gnss-sdr/run-gnss-sdr.sh "$SEOUL" ci8 2600000 37.5665 126.9780 40.0 "$WORK/gnss-sdr-seoul" 2>&1 \
+    | grep -E "tracked PRNs|fixes|first fix|mean pos err|per-fix err|gnss-sdr     :|RESULT" || true
   rm -f "$SEOUL"
 else
   bad "cannot decompress the GPS-SDR-SIM recording"
@@ -112,6 +117,11 @@ PY
   else
     bad "gpsrx run on the GPS-SDR-SIM recording: $(tail -3 "$WORK/seoul.err")"
   fi
+  # The same recording through GNSS-SDR, for comparison (reported, not scored: GNSS-SDR's first
+  # fix comes at 36-48 s of this 40 s file, so it may have none).
+  echo "GNSS-SDR on the same recording (for comparison):"
+  TROP_MODEL=OFF FILE_START=2190:538200 MAX_ERR_M=1000 bash scripts/gnss-sdr/run-gnss-sdr.sh "$SEOUL" ci8 2600000 37.5665 126.9780 40.0 "$WORK/gnss-sdr-seoul" 2>&1 \
+    | grep -E "tracked PRNs|fixes|first fix|mean pos err|per-fix err|gnss-sdr     :|RESULT" || true
   rm -f "$SEOUL"
 else
   bad "cannot decompress the GPS-SDR-SIM recording"
@@ -238,6 +248,11 @@ PY
   else
     bad "gpsrx run on the GPS-SDR-SIM recording: $(tail -3 "$WORK/seoul.err")"
   fi
+  # The same recording through GNSS-SDR, for comparison (reported, not scored: GNSS-SDR's first
+  # fix comes at 36-48 s of this 40 s file, so it may have none).
+  echo "GNSS-SDR on the same recording (for comparison):"
+  TROP_MODEL=OFF FILE_START=2190:538200 MAX_ERR_M=1000 bash scripts/gnss-sdr/run-gnss-sdr.sh "$SEOUL" ci8 2600000 37.5665 126.9780 40.0 "$WORK/gnss-sdr-seoul" 2>&1 \
+    | grep -E "tracked PRNs|fixes|first fix|mean pos err|per-fix err|gnss-sdr     :|RESULT" || true
   rm -f "$SEOUL"
 else
   bad "cannot decompress the GPS-SDR-SIM recording"

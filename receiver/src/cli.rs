@@ -31,6 +31,16 @@ pub enum Command {
     Track(crate::commands::track::TrackArgs),
     /// Process a recording into position fixes and standard files (RINEX, NMEA, GeoJSON, KML, CSV).
     Run(crate::commands::run::RunArgs),
+    /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
+    Config(ConfigArgs),
+}
+
+/// `gpsrx config`.
+#[derive(Debug, Args)]
+pub struct ConfigArgs {
+    /// Print the default, commented gpsrx.toml.
+    #[arg(long)]
+    pub default: bool,
 }
 
 /// Options that say how to read a recording; shared by every subcommand that reads one.

@@ -21,6 +21,7 @@ fn main() {
         Command::Acquire(args) => commands::acquire::run(&args),
         Command::Track(args) => commands::track::run(&args),
         Command::Run(args) => commands::run::run(&args),
+        Command::Config(args) => commands::config::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

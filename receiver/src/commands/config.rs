@@ -1,0 +1,92 @@
+//! `gpsrx config --default`: print the default configuration file, commented.
+
+use crate::cli::ConfigArgs;
+use gpsrx_tracking::ChannelConfig;
+
+/// Runs `gpsrx config`.
+pub fn run(args: &ConfigArgs) -> anyhow::Result<()> {
+    if !args.default {
+        anyhow::bail!("say what to print: `gpsrx config --default` prints the default gpsrx.toml");
+    }
+    print!("{}", default_toml()?);
+    Ok(())
+}
+
+/// The default configuration as commented TOML (valid input to `--config`).
+pub fn default_toml() -> anyhow::Result<String> {
+    let c = ChannelConfig::default();
+    let loops = |name: &str, l: &gpsrx_tracking::LoopConfig| -> anyhow::Result<String> {
+        Ok(format!(
+            "[tracking.{name}]\n\
+             pll_order = {}            # PLL order 1, 2 or 3 (0: FLL only)\n\
+             pll_bw_hz = {:?}          # PLL noise bandwidth, Hz\n\
+             fll_order = {}            # FLL assist order 0 (none), 1 or 2\n\
+             fll_bw_hz = {:?}          # FLL noise bandwidth, Hz\n\
+             dll_order = {}            # DLL order 1 or 2 (carrier-aided)\n\
+             dll_bw_hz = {:?}          # DLL noise bandwidth, Hz\n\
+             t_coh_s = {:?}            # integration time, s: 0.001 .. 0.020, a divisor of 20 ms\n\
+             el_spacing_chips = {:?}   # early-late spacing, 0.1 .. 1 chip\n\
+             pll_discriminator = \"{}\"  # costas (data) or atan2 (pilot)\n\
+             fll_discriminator = \"{}\"  # data_insensitive or atan2\n\
+             dll_discriminator = \"{}\"  # normalized_envelope or dot_product\n",
+            l.pll_order,
+            l.pll_bw_hz,
+            l.fll_order,
+            l.fll_bw_hz,
+            l.dll_order,
+            l.dll_bw_hz,
+            l.t_coh_s,
+            l.el_spacing_chips,
+            enum_name(&l.pll_discriminator)?,
+            enum_name(&l.fll_discriminator)?,
+            enum_name(&l.dll_discriminator)?,
+        ))
+    };
+    let text = format!(
+        "# gpsrx configuration (gpsrx run/track --config gpsrx.toml).\n\
+         # Every value here can be overridden on the command line (--pll-order, --pll-bw, ...).\n\
+         # Unknown keys are errors.\n\
+         \n\
+         [tracking]\n\
+         min_pull_in_s = {:?}      # minimum pull-in time before the hand-over to [tracking.track], s\n\
+         fll_assist_s = {:?}       # the pull-in FLL assist is switched off after this, s\n\
+         cn0_lost_dbhz = {:?}      # C/N0 below which a channel counts as lost, dB-Hz\n\
+         cn0_window_s = {:?}       # length of one C/N0 estimate (bit-aligned NWPR), s\n\
+         lost_estimates = {}       # consecutive low estimates that release the channel\n\
+         \n\
+         # Pull-in loops: 1 ms, wide, FLL-assisted.\n{}\n\
+         # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n{}",
+        c.min_pull_in_s,
+        c.fll_assist_s,
+        c.cn0_lost_dbhz,
+        c.cn0_window_s,
+        c.lost_estimates,
+        loops("pull_in", &c.pull_in)?,
+        loops("track", &c.track)?,
+    );
+    Ok(text)
+}
+
+fn enum_name<T: serde::Serialize>(v: &T) -> anyhow::Result<String> {
+    Ok(serde_json::to_value(v)?
+        .as_str()
+        .unwrap_or_default()
+        .to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_file_parses_back_to_the_defaults() {
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct File {
+            tracking: ChannelConfig,
+        }
+        let text = default_toml().unwrap_or_else(|e| panic!("{e}"));
+        let f: File = toml::from_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(f.tracking, ChannelConfig::default());
+    }
+}
