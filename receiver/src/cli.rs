@@ -179,27 +179,39 @@ pub struct LoopArgs {
     pub el_spacing: Option<f64>,
 }
 
-/// The `[tracking]` table of a configuration file.
+/// A configuration file: `[tracking]` and `[run]` tables.
 #[derive(Debug, Default, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ConfigFile {
     #[serde(default)]
     tracking: Option<gpsrx_tracking::ChannelConfig>,
+    #[serde(default)]
+    run: Option<crate::commands::run::RunConfig>,
 }
 
 impl LoopArgs {
+    fn config_file(&self) -> anyhow::Result<Option<ConfigFile>> {
+        let Some(path) = &self.config else {
+            return Ok(None);
+        };
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
+        let file: ConfigFile =
+            toml::from_str(&text).map_err(|e| anyhow::anyhow!("config {}: {e}", path.display()))?;
+        Ok(Some(file))
+    }
+
+    /// The `[run]` table of the configuration file, if any.
+    pub fn run_config(&self) -> anyhow::Result<Option<crate::commands::run::RunConfig>> {
+        Ok(self.config_file()?.and_then(|f| f.run))
+    }
+
     /// The channel configuration: defaults, then the config file, then these options.
     pub fn channel_config(&self) -> anyhow::Result<gpsrx_tracking::ChannelConfig> {
-        let mut cfg = match &self.config {
-            Some(path) => {
-                let text = std::fs::read_to_string(path)
-                    .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
-                let file: ConfigFile = toml::from_str(&text)
-                    .map_err(|e| anyhow::anyhow!("config {}: {e}", path.display()))?;
-                file.tracking.unwrap_or_default()
-            }
-            None => gpsrx_tracking::ChannelConfig::default(),
-        };
+        let mut cfg = self
+            .config_file()?
+            .and_then(|f| f.tracking)
+            .unwrap_or_default();
         let t = &mut cfg.track;
         if let Some(v) = self.pll_order {
             t.pll_order = v;

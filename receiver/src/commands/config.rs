@@ -55,7 +55,15 @@ pub fn default_toml() -> anyhow::Result<String> {
          lost_estimates = {}       # consecutive low estimates that release the channel\n\
          \n\
          # Pull-in loops: 1 ms, wide, FLL-assisted.\n{}\n\
-         # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n{}",
+         # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n{}\n\
+         [run]                     # gpsrx run (command-line options override these)\n\
+         rate_hz = 10.0            # observable and fix rate, 1 .. 50 Hz (--rate)\n\
+         elevation_mask_deg = 5.0  # elevation mask, deg (--elevation-mask)\n\
+         iono = \"klobuchar\"        # klobuchar or none (--iono)\n\
+         tropo = \"saastamoinen\"    # saastamoinen or none (--tropo)\n\
+         raim_pfa = 0.001          # RAIM false-alarm probability (--raim-pfa)\n\
+         doppler_max_hz = 5000.0   # acquisition Doppler half-width, Hz (--doppler-max)\n\
+         allow_unhealthy = false   # use satellites flagged unhealthy (--allow-unhealthy)\n",
         c.min_pull_in_s,
         c.fll_assist_s,
         c.cn0_lost_dbhz,
@@ -84,9 +92,12 @@ mod tests {
         #[serde(deny_unknown_fields)]
         struct File {
             tracking: ChannelConfig,
+            run: crate::commands::run::RunConfig,
         }
         let text = default_toml().unwrap_or_else(|e| panic!("{e}"));
         let f: File = toml::from_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
         assert_eq!(f.tracking, ChannelConfig::default());
+        assert_eq!(f.run.rate_hz, Some(10.0));
+        assert_eq!(f.run.iono.as_deref(), Some("klobuchar"));
     }
 }

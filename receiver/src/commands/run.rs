@@ -59,28 +59,29 @@ pub struct RunArgs {
     /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
     #[arg(long, value_name = "FILE")]
     pub nav: Option<PathBuf>,
-    /// Ionosphere correction.
-    #[arg(long, value_enum, default_value_t = IonoModel::Klobuchar)]
-    pub iono: IonoModel,
-    /// Troposphere correction (`none` for simulated files without troposphere).
-    #[arg(long, value_enum, default_value_t = TropoModel::Saastamoinen)]
-    pub tropo: TropoModel,
-    /// Elevation mask, degrees.
-    #[arg(long, value_name = "DEG", default_value_t = 5.0)]
-    pub elevation_mask: f64,
-    /// Observable and fix rate, Hz (1 to 50).
-    #[arg(long, value_name = "HZ", default_value_t = 10.0)]
-    pub rate: f64,
+    /// Ionosphere correction [default: klobuchar].
+    #[arg(long, value_enum)]
+    pub iono: Option<IonoModel>,
+    /// Troposphere correction (`none` for simulated files without troposphere)
+    /// [default: saastamoinen].
+    #[arg(long, value_enum)]
+    pub tropo: Option<TropoModel>,
+    /// Elevation mask, degrees [default: 5].
+    #[arg(long, value_name = "DEG")]
+    pub elevation_mask: Option<f64>,
+    /// Observable and fix rate, Hz, 1 to 50 [default: 10].
+    #[arg(long, value_name = "HZ")]
+    pub rate: Option<f64>,
     /// Full GPS week near the recording, to resolve the broadcast 10-bit week (default: from
     /// SigMF metadata, else the current week).
     #[arg(long, value_name = "WEEK")]
     pub week: Option<u32>,
-    /// Doppler search half-width of the acquisition, Hz.
-    #[arg(long, value_name = "HZ", default_value_t = 5000.0)]
-    pub doppler_max: f64,
-    /// RAIM false-alarm probability.
-    #[arg(long, value_name = "P", default_value_t = 1e-3)]
-    pub raim_pfa: f64,
+    /// Doppler search half-width of the acquisition, Hz [default: 5000].
+    #[arg(long, value_name = "HZ")]
+    pub doppler_max: Option<f64>,
+    /// RAIM false-alarm probability [default: 0.001].
+    #[arg(long, value_name = "P")]
+    pub raim_pfa: Option<f64>,
     /// Landmark range observations, CSV `tow_s,x_m,y_m,z_m,range_m,sigma_m` (seed 001): added to
     /// the fixes without a clock term, so 3 satellites and 1 landmark give a fix.
     #[arg(long, value_name = "FILE")]
@@ -89,6 +90,91 @@ pub struct RunArgs {
     /// flag that the real satellite had at the time).
     #[arg(long)]
     pub allow_unhealthy: bool,
+}
+
+/// The `[run]` table of a configuration file; command-line options override it.
+#[derive(Debug, Clone, Default, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunConfig {
+    /// Observable and fix rate, Hz.
+    pub rate_hz: Option<f64>,
+    /// Elevation mask, degrees.
+    pub elevation_mask_deg: Option<f64>,
+    /// `klobuchar` or `none`.
+    pub iono: Option<String>,
+    /// `saastamoinen` or `none`.
+    pub tropo: Option<String>,
+    /// RAIM false-alarm probability.
+    pub raim_pfa: Option<f64>,
+    /// Acquisition Doppler half-width, Hz.
+    pub doppler_max_hz: Option<f64>,
+    /// Use unhealthy satellites.
+    pub allow_unhealthy: Option<bool>,
+}
+
+/// Run settings after defaults, the config file and the command line.
+#[derive(Debug, Clone, Copy)]
+struct Settings {
+    rate: f64,
+    elevation_mask: f64,
+    iono: IonoModel,
+    tropo: TropoModel,
+    raim_pfa: f64,
+    doppler_max: f64,
+    allow_unhealthy: bool,
+}
+
+impl Settings {
+    fn resolve(args: &RunArgs) -> anyhow::Result<Settings> {
+        let file = args.loops.run_config()?.unwrap_or_default();
+        let iono = match (args.iono, file.iono.as_deref()) {
+            (Some(i), _) => i,
+            (None, None | Some("klobuchar")) => IonoModel::Klobuchar,
+            (None, Some("none")) => IonoModel::None,
+            (None, Some(other)) => {
+                anyhow::bail!("[run] iono = \"{other}\": use \"klobuchar\" or \"none\"")
+            }
+        };
+        let tropo = match (args.tropo, file.tropo.as_deref()) {
+            (Some(t), _) => t,
+            (None, None | Some("saastamoinen")) => TropoModel::Saastamoinen,
+            (None, Some("none")) => TropoModel::None,
+            (None, Some(other)) => {
+                anyhow::bail!("[run] tropo = \"{other}\": use \"saastamoinen\" or \"none\"")
+            }
+        };
+        let s = Settings {
+            rate: args.rate.or(file.rate_hz).unwrap_or(10.0),
+            elevation_mask: args
+                .elevation_mask
+                .or(file.elevation_mask_deg)
+                .unwrap_or(5.0),
+            iono,
+            tropo,
+            raim_pfa: args.raim_pfa.or(file.raim_pfa).unwrap_or(1e-3),
+            doppler_max: args.doppler_max.or(file.doppler_max_hz).unwrap_or(5000.0),
+            allow_unhealthy: args.allow_unhealthy || file.allow_unhealthy.unwrap_or(false),
+        };
+        if !(1.0..=50.0).contains(&s.rate) {
+            anyhow::bail!("rate {} Hz: use 1 to 50 Hz", s.rate);
+        }
+        if !(-10.0..=90.0).contains(&s.elevation_mask) {
+            anyhow::bail!("elevation mask {} deg: use -10 to 90", s.elevation_mask);
+        }
+        if !(s.raim_pfa > 0.0 && s.raim_pfa < 1.0) {
+            anyhow::bail!(
+                "RAIM false-alarm probability {}: use a value in (0, 1)",
+                s.raim_pfa
+            );
+        }
+        if !(s.doppler_max > 0.0 && s.doppler_max <= 100e3) {
+            anyhow::bail!(
+                "Doppler search half-width {} Hz: use (0, 100000]",
+                s.doppler_max
+            );
+        }
+        Ok(s)
+    }
 }
 
 /// What a run produced.
@@ -113,9 +199,7 @@ pub struct RunSummary {
 /// Runs the receiver on a file.
 pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSummary, Vec<Fix>)> {
     let t_wall = std::time::Instant::now();
-    if !(1.0..=50.0).contains(&args.rate) {
-        anyhow::bail!("--rate {} Hz: use 1 to 50 Hz", args.rate);
-    }
+    let set = Settings::resolve(args)?;
     let cfg = args.loops.channel_config()?;
     let src_cfg = args.source.to_config()?;
     let mut src =
@@ -149,7 +233,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
 
     // Cold acquisition on the first samples.
     let acq_cfg = AcqConfig {
-        doppler_max_hz: args.doppler_max,
+        doppler_max_hz: set.doppler_max,
         ..AcqConfig::default()
     };
     let engine = AcquisitionEngine::new(fs, acq_cfg)?;
@@ -211,11 +295,11 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
     );
 
     let mut decoders: BTreeMap<u8, NavDecoder> = BTreeMap::new();
-    let mut builder = ObservableBuilder::new(fs, args.rate);
+    let mut builder = ObservableBuilder::new(fs, set.rate);
     let opts = PvtOptions {
-        tropo: args.tropo == TropoModel::Saastamoinen,
-        elevation_mask_deg: args.elevation_mask,
-        raim_pfa: args.raim_pfa,
+        tropo: set.tropo == TropoModel::Saastamoinen,
+        elevation_mask_deg: set.elevation_mask,
+        raim_pfa: set.raim_pfa,
         ..PvtOptions::default()
     };
     let out = |name: &str| args.out.join(name);
@@ -234,7 +318,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
                             decoders: &BTreeMap<u8, NavDecoder>,
                             builder: &mut ObservableBuilder|
      -> anyhow::Result<()> {
-        let iono = if args.iono == IonoModel::Klobuchar {
+        let iono = if set.iono == IonoModel::Klobuchar {
             decoders
                 .values()
                 .find_map(|d| d.iono)
@@ -261,7 +345,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
             .iter()
             .filter_map(|s| {
                 let (_, eph) = ephs.iter().find(|(p, _)| *p == s.prn)?;
-                (eph.sv_health == 0 || args.allow_unhealthy).then_some(SatMeasurement {
+                (eph.sv_health == 0 || set.allow_unhealthy).then_some(SatMeasurement {
                     prn: s.prn,
                     pseudorange_m: s.smoothed_pseudorange_m,
                     doppler_hz: Some(s.doppler_hz),
@@ -287,7 +371,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         // bias is kept below 0.5 ms, far less than that).
         let landmarks: Vec<gpsrx_nav::pvt::Landmark> = landmark_obs
             .iter()
-            .filter(|l| (l.tow_s - epoch.rx_time.tow_s).abs() <= 0.5 / args.rate)
+            .filter(|l| (l.tow_s - epoch.rx_time.tow_s).abs() <= 0.5 / set.rate)
             .map(|l| l.landmark)
             .collect();
         let solution = if meas.len() + landmarks.len() >= 4 && !meas.is_empty() {
@@ -329,7 +413,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
             (None, Some(sol)) => {
                 let header = ObsHeader {
                     approx_position_m: [sol.pos_ecef_m.x, sol.pos_ecef_m.y, sol.pos_ecef_m.z],
-                    interval_s: Some(1.0 / args.rate),
+                    interval_s: Some(1.0 / set.rate),
                     ..ObsHeader::default()
                 };
                 let mut w = RinexObsWriter::create(&out("observables.rnx"), header)?;
@@ -435,7 +519,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         }
         if last_row_t
             .get(&i)
-            .is_none_or(|&t| e.t_rx_s - t >= 1.0 / args.rate - 1e-9)
+            .is_none_or(|&t| e.t_rx_s - t >= 1.0 / set.rate - 1e-9)
         {
             last_row_t.insert(i, e.t_rx_s);
             let row = ChannelRow {
@@ -497,7 +581,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         None if !obs_backlog.is_empty() => {
             // No fix: the observables still go out, with an unknown approximate position.
             let header = ObsHeader {
-                interval_s: Some(1.0 / args.rate),
+                interval_s: Some(1.0 / set.rate),
                 ..ObsHeader::default()
             };
             let mut w = RinexObsWriter::create(&out("observables.rnx"), header)?;
