@@ -52,6 +52,17 @@ fn start_from_truth(sim: &Simulator, sat: &SimSatellite, fs: f64, df: f64) -> Ch
     }
 }
 
+/// One channel per simulated satellite, started from truth.
+fn channels_from_truth(sim: &Simulator, fs: f64, cfg: &ChannelConfig) -> Vec<Channel> {
+    sim.satellites
+        .iter()
+        .map(|s| {
+            Channel::new(&start_from_truth(sim, s, fs, 0.0), fs, cfg)
+                .unwrap_or_else(|e| panic!("{e}"))
+        })
+        .collect()
+}
+
 fn run(
     sim: &Simulator,
     data: &Path,
@@ -645,14 +656,7 @@ fn a_lost_satellite_is_released_and_reacquired_when_it_returns() {
         dir.path(),
     );
     let cfg = ChannelConfig::default();
-    let channels: Vec<Channel> = sim
-        .satellites
-        .iter()
-        .map(|s| {
-            Channel::new(&start_from_truth(&sim, s, fs, 0.0), fs, &cfg)
-                .unwrap_or_else(|e| panic!("{e}"))
-        })
-        .collect();
+    let channels = channels_from_truth(&sim, fs, &cfg);
     let engine = gpsrx_dsp::acquisition::AcquisitionEngine::new(
         fs,
         gpsrx_dsp::acquisition::AcqConfig::default(),
@@ -718,14 +722,7 @@ fn navigation_message_decodes_from_tracked_bits_and_time_tags_the_code() {
         dir.path(),
     );
     let cfg = ChannelConfig::default();
-    let channels: Vec<Channel> = sim
-        .satellites
-        .iter()
-        .map(|s| {
-            Channel::new(&start_from_truth(&sim, s, fs, 0.0), fs, &cfg)
-                .unwrap_or_else(|e| panic!("{e}"))
-        })
-        .collect();
+    let channels = channels_from_truth(&sim, fs, &cfg);
     let mut decoders: BTreeMap<u8, gpsrx_receiver::pipeline::navdata::NavDecoder> = BTreeMap::new();
     let mut time_errors: BTreeMap<u8, f64> = BTreeMap::new();
     let mut src = open_source(&SourceConfig::new(data)).unwrap_or_else(|e| panic!("{e}"));

@@ -50,6 +50,25 @@ drift_s_s = 5.0e-8
     Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// Simulates a scenario into a temporary directory (kept alive by the returned handle) and
+/// reads the recording back.
+fn simulate_and_read(
+    sc: &Scenario,
+) -> (
+    Simulator,
+    tempfile::TempDir,
+    gpsrx_samples::sim::SimReport,
+    Vec<Complex32>,
+) {
+    let sim = Simulator::new(sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let report = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    let x = read_all(&report.data_path);
+    (sim, dir, report, x)
+}
+
 /// Reads a whole (small) recording back as complex baseband.
 fn read_all(path: &Path) -> Vec<Complex32> {
     let mut src =
@@ -108,12 +127,7 @@ fn correlation_at_truth_gives_the_configured_cn0_and_phase() {
         2.048e6,
         "ci8",
     );
-    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let report = sim
-        .run(dir.path(), &|_| {})
-        .unwrap_or_else(|e| panic!("{e}"));
-    let x = read_all(&report.data_path);
+    let (sim, _dir, _report, x) = simulate_and_read(&sc);
     let fs = 2.048e6;
     let n = (fs * 1e-3) as usize; // 1 ms coherent
     let unused = Prn::new(1).unwrap_or_else(|e| panic!("{e}"));
@@ -168,12 +182,7 @@ fn code_phase_follows_truth_over_time() {
         2.6e6,
         "ci16_le",
     );
-    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let report = sim
-        .run(dir.path(), &|_| {})
-        .unwrap_or_else(|e| panic!("{e}"));
-    let x = read_all(&report.data_path);
+    let (sim, _dir, _report, x) = simulate_and_read(&sc);
     let fs = 2.6e6;
     let n = 2600;
     for sat in &sim.satellites {
@@ -218,12 +227,7 @@ fn navigation_message_decodes_from_the_samples() {
         2.048e6,
         "ci2",
     );
-    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let report = sim
-        .run(dir.path(), &|_| {})
-        .unwrap_or_else(|e| panic!("{e}"));
-    let x = read_all(&report.data_path);
+    let (sim, _dir, _report, x) = simulate_and_read(&sc);
     let fs = 2.048e6;
     let sat = &sim.satellites[0];
     // Find the first bit edge after the start from the truth code phase.
@@ -373,12 +377,7 @@ fn real_if_output_carries_the_configured_cn0() {
         "ri16_le",
         4.092e6,
     );
-    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let report = sim
-        .run(dir.path(), &|_| {})
-        .unwrap_or_else(|e| panic!("{e}"));
-    let x = read_all(&report.data_path);
+    let (sim, _dir, _report, x) = simulate_and_read(&sc);
     let cn0 = measured_cn0(&sim, &sim.satellites[0], (&x, 16.368e6), 10, 500);
     assert!((cn0 - 42.0).abs() < 1.0, "measured {cn0:.2} dB-Hz at IF");
 }
@@ -391,12 +390,7 @@ fn outage_blocks_the_signal_and_it_returns() {
         2.048e6,
         "ci8",
     );
-    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let report = sim
-        .run(dir.path(), &|_| {})
-        .unwrap_or_else(|e| panic!("{e}"));
-    let x = read_all(&report.data_path);
+    let (sim, _dir, report, x) = simulate_and_read(&sc);
     let sat = &sim.satellites[0];
     let before = measured_cn0(&sim, sat, (&x, 2.048e6), 50, 200);
     let during = measured_cn0(&sim, sat, (&x, 2.048e6), 350, 200);
