@@ -33,6 +33,8 @@ pub enum Command {
     Run(crate::commands::run::RunArgs),
     /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
     Config(ConfigArgs),
+    /// Loop studies: steady-state errors, bandwidth vs noise, high dynamics (seed 004).
+    Study(crate::study::StudyArgs),
 }
 
 /// `gpsrx config`.

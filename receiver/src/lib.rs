@@ -9,3 +9,4 @@ pub mod commands;
 pub mod landmarks;
 pub mod output;
 pub mod pipeline;
+pub mod study;

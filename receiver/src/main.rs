@@ -22,6 +22,7 @@ fn main() {
         Command::Track(args) => commands::track::run(&args),
         Command::Run(args) => commands::run::run(&args),
         Command::Config(args) => commands::config::run(&args),
+        Command::Study(args) => gpsrx_receiver::study::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");
