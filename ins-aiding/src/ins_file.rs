@@ -5,10 +5,26 @@
 //! velocity), and optionally `gps_tow_s` as an alternative time base. Rows must be in time
 //! order, at 10 Hz or faster; a gap longer than `max_gap_s` is an error (the aiding would
 //! extrapolate blindly). Between rows, position follows a cubic Hermite curve through the
-//! positions and velocities, and velocity its derivative, so both are continuous.
+//! positions and velocities, and velocity its derivative, so both are continuous; `gps_tow_s` is
+//! interpolated linearly.
+//!
+//! Every row is checked: finite numbers, `|(x, y, z)|` between [`MIN_RADIUS_M`] and
+//! [`MAX_RADIUS_M`] from the Earth's centre (metres, ECEF), speed `|(vx, vy, vz)|` at most
+//! [`MAX_SPEED_MPS`], `gps_tow_s` in `[0, 604800)` and increasing (a week rollover is allowed).
+//! Errors name the file, the line and what to do. [`write_ins_csv`] writes the same format.
 
 use nalgebra::Vector3;
+use std::io::Write;
 use std::path::Path;
+
+/// Smallest accepted distance of an INS position from the Earth's centre, m (6000 km).
+pub const MIN_RADIUS_M: f64 = 6.0e6;
+/// Largest accepted distance of an INS position from the Earth's centre, m (50 000 km).
+pub const MAX_RADIUS_M: f64 = 5.0e7;
+/// Largest accepted INS speed, m/s.
+pub const MAX_SPEED_MPS: f64 = 1.0e4;
+/// Seconds in a GPS week.
+const WEEK_S: f64 = 604_800.0;
 
 /// INS file problems, with the line they were found on.
 #[derive(Debug, thiserror::Error)]
@@ -31,6 +47,17 @@ pub enum InsError {
         /// What is wrong and what to do.
         message: String,
     },
+    /// The file cannot be written.
+    #[error("cannot write INS file {path}: {message}")]
+    Write {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// An INS error-model setting (the simulator's `[ins]` table) or argument is invalid.
+    #[error("INS error model: {0}")]
+    Config(String),
 }
 
 /// One INS output: time, ECEF position and velocity.
@@ -53,9 +80,16 @@ pub struct InsTrack {
 }
 
 /// Reads and validates an INS file: times strictly increasing, no gap above `max_gap_s`
-/// (default choice: 0.5 s, i.e. a 10 Hz file may lose four rows), finite values.
+/// (default choice: 0.5 s, i.e. a 10 Hz file may lose four rows), finite values, positions
+/// within [`MIN_RADIUS_M`]..[`MAX_RADIUS_M`] of the Earth's centre, speeds up to
+/// [`MAX_SPEED_MPS`], `gps_tow_s` (if present) in `[0, 604800)` and increasing modulo the week.
 pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
     let p = path.display().to_string();
+    if max_gap_s.is_nan() || max_gap_s <= 0.0 {
+        return Err(InsError::Config(format!(
+            "the INS gap limit {max_gap_s} s must be positive (0.5 s suits a 10 Hz INS)"
+        )));
+    }
     let row_err = |line: usize, message: String| InsError::Row {
         path: p.clone(),
         line,
@@ -73,45 +107,108 @@ pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
         .headers()
         .map_err(|e| row_err(1, e.to_string()))?
         .clone();
+    let header_line = headers
+        .position()
+        .map_or(1, |pos| usize::try_from(pos.line()).unwrap_or(1));
     let col = |name: &str| headers.iter().position(|h| h == name);
     let names = ["t_s", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps"];
     let mut idx = [0usize; 7];
     for (k, n) in names.iter().enumerate() {
         idx[k] = col(n).ok_or_else(|| {
             row_err(
-                1,
+                header_line,
                 format!(
-                    "no column `{n}`: the header must name t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps"
+                    "no column `{n}`: the header must name t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps (ECEF, metres and m/s; gps_tow_s optional)"
                 ),
             )
         })?;
     }
     let tow_col = col("gps_tow_s");
     let mut samples: Vec<InsSample> = Vec::new();
+    let mut last_line = header_line;
     for (i, rec) in rdr.records().enumerate() {
-        let line = i + 2;
-        let rec = rec.map_err(|e| row_err(line, e.to_string()))?;
-        let num = |c: usize| -> Result<f64, InsError> {
+        let rec = rec.map_err(|e| match e.kind() {
+            csv::ErrorKind::UnequalLengths {
+                pos,
+                expected_len,
+                len,
+            } => row_err(
+                pos.as_ref()
+                    .map_or(i + 2, |p| usize::try_from(p.line()).unwrap_or(i + 2)),
+                format!(
+                    "{len} values but the header has {expected_len} columns: every row needs one value per header column"
+                ),
+            ),
+            _ => row_err(i + 2, format!("{e}")),
+        })?;
+        let line = rec
+            .position()
+            .map_or(i + 2, |pos| usize::try_from(pos.line()).unwrap_or(i + 2));
+        last_line = line;
+        let num = |c: usize, name: &str| -> Result<f64, InsError> {
             let f = rec.get(c).unwrap_or("");
             f.parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| row_err(line, format!("`{f}` is not a finite number")))
+                .ok_or_else(|| {
+                    if f.is_empty() {
+                        row_err(
+                            line,
+                            format!("`{name}` is missing: fill it in or delete the row"),
+                        )
+                    } else {
+                        row_err(
+                            line,
+                            format!("{name} = `{f}` is not a finite number: fix or delete the row"),
+                        )
+                    }
+                })
         };
         let mut v = [0.0; 7];
         for k in 0..7 {
-            v[k] = num(idx[k])?;
+            v[k] = num(idx[k], names[k])?;
         }
         let gps_tow_s = match tow_col {
-            Some(c) => Some(num(c)?),
+            Some(c) => Some(num(c, "gps_tow_s")?),
             None => None,
         };
+        let pos_m = Vector3::new(v[1], v[2], v[3]);
+        let vel_mps = Vector3::new(v[4], v[5], v[6]);
+        let r = pos_m.norm();
+        if !(MIN_RADIUS_M..=MAX_RADIUS_M).contains(&r) {
+            return Err(row_err(
+                line,
+                format!(
+                    "the position is {:.1} km from the Earth's centre, outside {:.0}-{:.0} km: x_m,y_m,z_m must be ECEF in metres (not km, not latitude/longitude)",
+                    r / 1e3,
+                    MIN_RADIUS_M / 1e3,
+                    MAX_RADIUS_M / 1e3
+                ),
+            ));
+        }
+        let speed = vel_mps.norm();
+        if speed > MAX_SPEED_MPS {
+            return Err(row_err(
+                line,
+                format!(
+                    "the speed {speed:.1} m/s is above {MAX_SPEED_MPS} m/s: vx_mps,vy_mps,vz_mps must be ECEF velocity in m/s"
+                ),
+            ));
+        }
+        if let Some(tow) = gps_tow_s {
+            if !(0.0..WEEK_S).contains(&tow) {
+                return Err(row_err(
+                    line,
+                    format!("gps_tow_s = {tow} is outside a GPS week [0, 604800) s: give the time of week in seconds"),
+                ));
+            }
+        }
         if let Some(last) = samples.last() {
             if v[0] <= last.t_s {
                 return Err(row_err(
                     line,
                     format!(
-                        "t_s = {} does not increase (previous {}): sort the file",
+                        "t_s = {} does not increase (previous {}): sort the file by t_s and remove duplicate rows",
                         v[0], last.t_s
                     ),
                 ));
@@ -119,25 +216,107 @@ pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
             if v[0] - last.t_s > max_gap_s {
                 return Err(row_err(line, format!("gap of {:.3} s before this row (limit {max_gap_s} s): the INS must run at 10 Hz or faster without gaps", v[0] - last.t_s)));
             }
+            if let (Some(a), Some(b)) = (last.gps_tow_s, gps_tow_s) {
+                // A decrease by more than half a week is a week rollover, not a step back.
+                if b <= a && a - b < WEEK_S / 2.0 {
+                    return Err(row_err(
+                        line,
+                        format!("gps_tow_s = {b} does not increase (previous {a}): the GPS time of week must advance with t_s"),
+                    ));
+                }
+            }
         }
         samples.push(InsSample {
             t_s: v[0],
             gps_tow_s,
-            pos_m: Vector3::new(v[1], v[2], v[3]),
-            vel_mps: Vector3::new(v[4], v[5], v[6]),
+            pos_m,
+            vel_mps,
         });
     }
     if samples.len() < 2 {
         return Err(InsError::Row {
             path: p,
-            line: samples.len() + 1,
-            message: "an INS file needs at least 2 rows".into(),
+            line: last_line,
+            message: format!(
+                "an INS file needs at least 2 rows (found {}): record the INS over the whole recording",
+                samples.len()
+            ),
         });
     }
     Ok(InsTrack { samples })
 }
 
+/// Writes `samples` as an INS file [`read_ins_csv`] reads back: the header
+/// `t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps` (plus `gps_tow_s` when the samples have it), times to
+/// 1e-9 s, positions to 1e-6 m, velocities to 1e-9 m/s. Either every sample has `gps_tow_s` or
+/// none does.
+pub fn write_ins_csv(path: &Path, samples: &[InsSample]) -> Result<(), InsError> {
+    let p = path.display().to_string();
+    let werr = |message: String| InsError::Write {
+        path: p.clone(),
+        message,
+    };
+    let with_tow = samples.first().is_some_and(|s| s.gps_tow_s.is_some());
+    if let Some(i) = samples
+        .iter()
+        .position(|s| s.gps_tow_s.is_some() != with_tow)
+    {
+        return Err(werr(format!(
+            "sample {i} {} gps_tow_s but the first sample {}: give it to every sample or to none",
+            if with_tow { "has no" } else { "has a" },
+            if with_tow { "has one" } else { "has none" }
+        )));
+    }
+    let f = std::fs::File::create(path).map_err(|e| werr(e.to_string()))?;
+    let mut w = std::io::BufWriter::new(f);
+    let io = |e: std::io::Error| werr(e.to_string());
+    write!(w, "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps").map_err(io)?;
+    if with_tow {
+        write!(w, ",gps_tow_s").map_err(io)?;
+    }
+    writeln!(w).map_err(io)?;
+    for s in samples {
+        write!(
+            w,
+            "{:.9},{:.6},{:.6},{:.6},{:.9},{:.9},{:.9}",
+            s.t_s, s.pos_m.x, s.pos_m.y, s.pos_m.z, s.vel_mps.x, s.vel_mps.y, s.vel_mps.z
+        )
+        .map_err(io)?;
+        if let Some(tow) = s.gps_tow_s {
+            write!(w, ",{tow:.9}").map_err(io)?;
+        }
+        writeln!(w).map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
+
 impl InsTrack {
+    /// The rows of the file, in time order.
+    pub fn samples(&self) -> &[InsSample] {
+        &self.samples
+    }
+
+    /// GPS time of week at `t_s`, interpolated linearly between the two rows around it
+    /// (`tow = tow_a + (tow_b - tow_a) (t - t_a) / (t_b - t_a)`, across a week rollover too);
+    /// None without a `gps_tow_s` column or outside the file's span.
+    pub fn gps_tow_at(&self, t_s: f64) -> Option<f64> {
+        let (t0, t1) = self.span_s();
+        if !(t0..=t1).contains(&t_s) {
+            return None;
+        }
+        let i = self
+            .samples
+            .partition_point(|s| s.t_s <= t_s)
+            .clamp(1, self.samples.len() - 1);
+        let (a, b) = (&self.samples[i - 1], &self.samples[i]);
+        let (ta, mut tb) = (a.gps_tow_s?, b.gps_tow_s?);
+        if tb < ta {
+            tb += WEEK_S;
+        }
+        let u = (t_s - a.t_s) / (b.t_s - a.t_s);
+        Some((ta + (tb - ta) * u).rem_euclid(WEEK_S))
+    }
+
     /// The time span covered, s.
     pub fn span_s(&self) -> (f64, f64) {
         (
@@ -189,7 +368,7 @@ mod tests {
     fn constant_acceleration_is_interpolated_exactly() {
         // p = p0 + v0 t + a t^2 / 2 is a cubic: Hermite through (p, v) at 10 Hz is exact.
         let (p0, v0, a) = (
-            Vector3::new(1e6, 2e6, 3e6),
+            Vector3::new(-3.05e6, 4.04e6, 3.86e6),
             Vector3::new(10.0, -5.0, 1.0),
             Vector3::new(0.5, 2.0, -1.0),
         );
@@ -214,36 +393,85 @@ mod tests {
         assert!(track.at(3.5).is_none());
     }
 
+    const HEADER: &str = "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps\n";
+    /// A valid row body (ECEF point on the equator, 10 m/s) after `t_s,`.
+    const ROW: &str = "6378137,0,0,0,10,0";
+
+    fn error_of(text: &str) -> String {
+        let f = write(text);
+        read_ins_csv(f.path(), 0.5)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    }
+
     #[test]
     fn bad_files_name_the_line() {
         let cases = [
             (
-                "t_s,x_m,y_m,z_m,vx_mps,vy_mps\n0,1,2,3,4,5\n",
+                "t_s,x_m,y_m,z_m,vx_mps,vy_mps\n0,6378137,0,0,0,10\n".to_string(),
                 "no column `vz_mps`",
             ),
             (
-                "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps\n0,1,2,3,4,5,6\n0.1,1,2,x,4,5,6\n",
-                "line 3",
+                format!("{HEADER}0,{ROW}\n0.1,6378137,0,x,0,10,0\n"),
+                "line 3: z_m = `x` is not a finite number",
             ),
             (
-                "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps\n0,1,2,3,4,5,6\n0,1,2,3,4,5,6\n",
-                "does not increase",
+                format!("{HEADER}0,{ROW}\n0,{ROW}\n"),
+                "line 3: t_s = 0 does not increase",
             ),
             (
-                "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps\n0,1,2,3,4,5,6\n2,1,2,3,4,5,6\n",
-                "gap of 2.000 s",
+                format!("{HEADER}0,{ROW}\n0.2,{ROW}\n0.1,{ROW}\n"),
+                "line 4: t_s = 0.1 does not increase",
             ),
             (
-                "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps\n0,1,2,3,4,5,NaN\n",
-                "not a finite number",
+                format!("{HEADER}0,{ROW}\n2,{ROW}\n"),
+                "line 3: gap of 2.000 s",
+            ),
+            (
+                format!("{HEADER}0,6378137,0,0,0,10,NaN\n"),
+                "vz_mps = `NaN` is not a finite number",
+            ),
+            (
+                format!("{HEADER}0,{ROW}\n,{ROW}\n"),
+                "line 3: `t_s` is missing",
+            ),
+            (
+                format!("{HEADER}0,{ROW}\n0.1,6378.137,0,0,0,10,0\n"),
+                "line 3: the position is 6.4 km from the Earth's centre",
+            ),
+            (
+                format!("{HEADER}0,{ROW}\n0.1,6e10,0,0,0,10,0\n"),
+                "outside 6000-50000 km",
+            ),
+            (
+                format!("{HEADER}0,{ROW}\n0.1,6378137,0,0,0,10001,0\n"),
+                "line 3: the speed 10001.0 m/s is above 10000 m/s",
+            ),
+            (
+                format!("{HEADER}0,{ROW}\n0.1,{ROW},9\n"),
+                "line 3: 8 values but the header has 7 columns",
+            ),
+            (format!("{HEADER}0,{ROW}\n"), "at least 2 rows (found 1)"),
+            (
+                format!(
+                    "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,gps_tow_s\n0,{ROW},100\n0.1,{ROW},99.9\n"
+                ),
+                "line 3: gps_tow_s = 99.9 does not increase",
+            ),
+            (
+                format!("t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,gps_tow_s\n0,{ROW},604800\n"),
+                "line 2: gps_tow_s = 604800 is outside a GPS week",
+            ),
+            (
+                format!(
+                    "# a comment line\n{HEADER}0,{ROW}\n# another\n0.1,{ROW}\n0.2,1,2,3,4,5,6\n"
+                ),
+                "line 6: the position",
             ),
         ];
         for (text, needle) in cases {
-            let f = write(text);
-            let e = read_ins_csv(f.path(), 0.5)
-                .err()
-                .map(|e| e.to_string())
-                .unwrap_or_default();
+            let e = error_of(&text);
             assert!(e.contains(needle), "{e} (wanted {needle})");
         }
         let e = read_ins_csv(Path::new("/nonexistent/ins.csv"), 0.5)
@@ -251,5 +479,90 @@ mod tests {
             .map(|e| e.to_string())
             .unwrap_or_default();
         assert!(e.contains("cannot read INS file"), "{e}");
+        let f = write(&format!("{HEADER}0,{ROW}\n0.1,{ROW}\n"));
+        let e = read_ins_csv(f.path(), 0.0)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("gap limit 0 s must be positive"), "{e}");
+    }
+
+    /// Samples of a constant-acceleration motion with a GPS time of week that crosses the end
+    /// of the week.
+    fn accelerating_samples(with_tow: bool) -> Vec<InsSample> {
+        let (p0, v0, a) = (
+            Vector3::new(-3_052_000.123_456_7, 4_043_000.987_654_3, 3_858_000.5),
+            Vector3::new(29.123_456_789, -5.5, 0.25),
+            Vector3::new(0.5, 2.0, -1.0),
+        );
+        (0..50)
+            .map(|i| {
+                let t = 0.02 * f64::from(i);
+                InsSample {
+                    t_s: t,
+                    gps_tow_s: with_tow.then(|| (604_799.5 + t) % 604_800.0),
+                    pos_m: p0 + v0 * t + a * (0.5 * t * t),
+                    vel_mps: v0 + a * t,
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn written_files_read_back_to_the_stated_precision() {
+        for with_tow in [false, true] {
+            let samples = accelerating_samples(with_tow);
+            let f = tempfile::NamedTempFile::new().unwrap_or_else(|e| panic!("{e}"));
+            write_ins_csv(f.path(), &samples).unwrap_or_else(|e| panic!("{e}"));
+            let text = std::fs::read_to_string(f.path()).unwrap_or_else(|e| panic!("{e}"));
+            let header = text.lines().next().unwrap_or_default();
+            let expected = if with_tow {
+                "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,gps_tow_s"
+            } else {
+                "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps"
+            };
+            assert_eq!(header, expected);
+            let track = read_ins_csv(f.path(), 0.5).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(track.samples().len(), samples.len());
+            for (r, s) in track.samples().iter().zip(&samples) {
+                assert!((r.t_s - s.t_s).abs() <= 1e-9);
+                assert!((r.pos_m - s.pos_m).amax() <= 1e-6);
+                assert!((r.vel_mps - s.vel_mps).amax() <= 1e-9);
+                match (r.gps_tow_s, s.gps_tow_s) {
+                    (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-9),
+                    (None, None) => {}
+                    other => panic!("gps_tow_s {other:?}"),
+                }
+            }
+            if with_tow {
+                // Linear interpolation of the time of week, across the week rollover at t = 0.5 s.
+                for &t in &[0.0, 0.13, 0.49, 0.51, 0.777, 0.98] {
+                    let tow = track.gps_tow_at(t).unwrap_or_else(|| panic!("t {t}"));
+                    let want = (604_799.5 + t) % 604_800.0;
+                    assert!((tow - want).abs() < 1e-8, "t {t}: {tow} vs {want}");
+                }
+                assert!(track.gps_tow_at(0.99).is_none());
+                assert!(track.gps_tow_at(-0.01).is_none());
+            } else {
+                assert!(track.gps_tow_at(0.5).is_none());
+            }
+        }
+    }
+
+    #[test]
+    fn writer_refuses_mixed_time_bases() {
+        let mut samples = accelerating_samples(true);
+        samples[3].gps_tow_s = None;
+        let f = tempfile::NamedTempFile::new().unwrap_or_else(|e| panic!("{e}"));
+        let e = write_ins_csv(f.path(), &samples)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("sample 3 has no gps_tow_s"), "{e}");
+        let e = write_ins_csv(Path::new("/nonexistent/dir/ins.csv"), &samples[..2])
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("cannot write INS file"), "{e}");
     }
 }

@@ -179,6 +179,15 @@ pub struct LoopArgs {
     /// Early-late spacing, chips (0.1 to 1).
     #[arg(long, value_name = "CHIPS")]
     pub el_spacing: Option<f64>,
+    /// PLL noise bandwidth while the loop is aided by an INS feed-forward (`run --ins`), Hz:
+    /// the aid removes the dynamics, so a narrower loop lets through less noise
+    /// (default: the same loops aided or not).
+    #[arg(long, value_name = "HZ")]
+    pub aided_pll_bw: Option<f64>,
+    /// PLL order while aided: 1, 2 or 3 (default: as unaided). Seed 004: use 2 or more, a
+    /// 1st-order aided loop drifts with the INS bias.
+    #[arg(long, value_name = "N")]
+    pub aided_pll_order: Option<u8>,
 }
 
 /// A configuration file: `[tracking]` and `[run]` tables.
@@ -238,6 +247,16 @@ impl LoopArgs {
         }
         if let Some(v) = self.el_spacing {
             t.el_spacing_chips = v;
+        }
+        if self.aided_pll_bw.is_some() || self.aided_pll_order.is_some() {
+            let mut a = cfg.aided_track.unwrap_or(cfg.track);
+            if let Some(v) = self.aided_pll_bw {
+                a.pll_bw_hz = v;
+            }
+            if let Some(v) = self.aided_pll_order {
+                a.pll_order = v;
+            }
+            cfg.aided_track = Some(a);
         }
         cfg.validate()
             .map_err(|e| anyhow::anyhow!("tracking configuration: {e}"))?;

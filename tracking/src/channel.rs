@@ -35,6 +35,11 @@ pub struct ChannelConfig {
     pub pull_in: LoopConfig,
     /// Loops after pull-in: the user's order, bandwidth and integration time.
     pub track: LoopConfig,
+    /// Loops after pull-in while the aiding port has a feed-forward (`None`: the same as
+    /// `track`). The feed-forward removes the dynamics from the loop (seed 004 eq. 7), so an aided
+    /// loop can be much narrower than an unaided one and let through less noise; the channel
+    /// switches between `track` and these at a data-bit edge whenever the aid comes or goes.
+    pub aided_track: Option<LoopConfig>,
     /// Minimum time in pull-in before the hand-over to tracking, s.
     pub min_pull_in_s: f64,
     /// Time after which the FLL assist of the pull-in loop is switched off, s: the
@@ -65,6 +70,7 @@ impl Default for ChannelConfig {
                 el_spacing_chips: 1.0,
                 ..LoopConfig::default()
             },
+            aided_track: None,
             min_pull_in_s: 0.5,
             fll_assist_s: 0.3,
             cn0_lost_dbhz: 25.0,
@@ -78,14 +84,16 @@ impl ChannelConfig {
     /// Checks both loop configurations and the thresholds.
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.pull_in.validate()?;
-        self.track.validate()?;
-        let ms = (self.track.t_coh_s * 1e3).round() as usize;
-        if ms == 0 || MS_PER_BIT % ms != 0 {
-            return Err(ConfigError::OutOfRange {
-                field: "t_coh_s",
-                value: self.track.t_coh_s,
-                valid: "1, 2, 4, 5, 10 or 20 ms (a divisor of the 20 ms data bit)".into(),
-            });
+        for l in std::iter::once(&self.track).chain(self.aided_track.as_ref()) {
+            l.validate()?;
+            let ms = (l.t_coh_s * 1e3).round() as usize;
+            if ms == 0 || MS_PER_BIT % ms != 0 {
+                return Err(ConfigError::OutOfRange {
+                    field: "t_coh_s",
+                    value: l.t_coh_s,
+                    valid: "1, 2, 4, 5, 10 or 20 ms (a divisor of the 20 ms data bit)".into(),
+                });
+            }
         }
         if !(self.min_pull_in_s.is_finite() && self.min_pull_in_s >= 0.0) {
             return Err(ConfigError::OutOfRange {
@@ -189,6 +197,8 @@ pub struct ChannelEpoch {
     pub code_error_chips: f64,
     /// Integration time of the interval, s.
     pub t_coh_s: f64,
+    /// The feed-forward Doppler the carrier NCO held over the interval, Hz (None: unaided).
+    pub feedforward_hz: Option<f64>,
     /// Milliseconds since the channel started (count of code periods).
     pub ms_count: u64,
     /// Whether the interval starts on a data-bit edge (known after bit sync).
@@ -227,6 +237,10 @@ pub struct Channel {
     aid: Option<(DopplerAid, f64)>,
     /// The feed-forward contained in the current NCO frequency, Hz (None: unaided).
     ff_applied_hz: Option<f64>,
+    /// Whether the tracking loops are the aided ones ([`ChannelConfig::aided_track`]).
+    aided_loops: bool,
+    /// The feed-forward held over the interval being accumulated.
+    acc_feedforward_hz: Option<f64>,
     ms_count: u64,
     /// `ms_count` of the first prompt the bit synchroniser saw since its last reset.
     bit_sync_origin_ms: u64,
@@ -288,6 +302,8 @@ impl Channel {
             carrier_freq_hz: start.doppler_hz,
             aid: None,
             ff_applied_hz: None,
+            aided_loops: false,
+            acc_feedforward_hz: None,
             ms_count: 0,
             bit_sync_origin_ms: 0,
             pull_in_ms: 0,
@@ -390,6 +406,7 @@ impl Channel {
                 self.carrier_phase_cycles,
                 self.carrier_freq_hz,
             );
+            self.acc_feedforward_hz = self.ff_applied_hz;
         }
         let mut out = [Complex32::new(0.0, 0.0); 3];
         correlate(
@@ -531,6 +548,7 @@ impl Channel {
             freq_error_hz: co.freq_error_hz,
             code_error_chips: cl.code_error_chips,
             t_coh_s: self.carrier.t_coh_s(),
+            feedforward_hz: self.acc_feedforward_hz,
             ms_count: ms_index + 1 - self.acc_ms as u64,
             bit_edge: edge_phase.is_some_and(|edge| {
                 (ms_index + 1 - self.acc_ms as u64) % MS_PER_BIT as u64
@@ -542,6 +560,7 @@ impl Channel {
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
         self.maybe_hand_over(next_is_edge);
+        self.maybe_switch_aiding(next_is_edge);
         Some(epoch)
     }
 
@@ -557,9 +576,10 @@ impl Channel {
             return;
         }
         let ff = self.ff_applied_hz.unwrap_or(0.0);
+        let loops = self.tracking_loops();
         let (Ok(carrier), Ok(code_loop)) = (
-            CarrierLoop::new(&self.cfg.track, self.carrier_freq_hz - ff),
-            CodeLoop::new(&self.cfg.track),
+            CarrierLoop::new(&loops, self.carrier_freq_hz - ff),
+            CodeLoop::new(&loops),
         ) else {
             return; // validated at construction; keep pulling in otherwise
         };
@@ -570,8 +590,50 @@ impl Channel {
             self.carrier.preset_doppler_rate((n * stf - st * sf) / den);
         }
         self.code_loop = code_loop;
-        let d = self.cfg.track.el_spacing_chips;
+        let d = loops.el_spacing_chips;
         self.taps = [d / 2.0, 0.0, -d / 2.0];
         self.state = ChannelState::Track;
+        self.aided_loops = self.ff_applied_hz.is_some() && self.cfg.aided_track.is_some();
+    }
+
+    /// The loops the tracking state should run now: the aided ones while a feed-forward is
+    /// applied (if configured), else the unaided ones.
+    fn tracking_loops(&self) -> LoopConfig {
+        match (self.ff_applied_hz, self.cfg.aided_track) {
+            (Some(_), Some(a)) => a,
+            _ => self.cfg.track,
+        }
+    }
+
+    /// In tracking, switches between the unaided and aided loops when the aid has come or gone
+    /// (at a data-bit edge, so that the integrations stay aligned). The carrier NCO frequency
+    /// is kept: the new loop starts from the current base frequency; the code loop restarts
+    /// from the current code rate (carrier-aided, so only the DLL's small correction resets).
+    fn maybe_switch_aiding(&mut self, at_edge: bool) {
+        if self.state != ChannelState::Track || !at_edge || self.cfg.aided_track.is_none() {
+            return;
+        }
+        let want_aided = self.ff_applied_hz.is_some();
+        if want_aided == self.aided_loops {
+            return;
+        }
+        let loops = self.tracking_loops();
+        let ff = self.ff_applied_hz.unwrap_or(0.0);
+        let (Ok(carrier), Ok(code_loop)) = (
+            CarrierLoop::new(&loops, self.carrier_freq_hz - ff),
+            CodeLoop::new(&loops),
+        ) else {
+            return;
+        };
+        self.carrier = carrier;
+        self.code_loop = code_loop;
+        let d = loops.el_spacing_chips;
+        self.taps = [d / 2.0, 0.0, -d / 2.0];
+        self.aided_loops = want_aided;
+    }
+
+    /// Whether the channel is running its aided tracking loops.
+    pub fn aided_loops(&self) -> bool {
+        self.aided_loops
     }
 }

@@ -56,6 +56,13 @@ pub fn default_toml() -> anyhow::Result<String> {
          \n\
          # Pull-in loops: 1 ms, wide, FLL-assisted.\n{}\n\
          # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n{}\n\
+         # Tracking loops while an INS feed-forward aids the channel (gpsrx run --ins; optional,\n\
+         # default: the same as [tracking.track]; --aided-pll-bw, --aided-pll-order):\n\
+         # [tracking.aided_track]\n\
+         # pll_order = 2\n\
+         # pll_bw_hz = 3.0\n\
+         # ... (give every key of [tracking.track]: missing ones take the pull-in defaults)\n\
+         \n\
          [run]                     # gpsrx run (command-line options override these)\n\
          rate_hz = 10.0            # observable and fix rate, 1 .. 50 Hz (--rate)\n\
          elevation_mask_deg = 5.0  # elevation mask, deg (--elevation-mask)\n\

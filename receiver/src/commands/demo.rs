@@ -60,6 +60,10 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         raim_pfa: None,
         allow_unhealthy: false,
         landmarks: None,
+        ins: None,
+        no_aiding: false,
+        ins_band_limit: None,
+        ins_max_gap: 0.5,
     };
     let (summary, fixes) = run_file(&run_args, true)?;
     println!(

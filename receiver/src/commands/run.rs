@@ -12,7 +12,9 @@ use crate::output::{
 };
 use crate::pipeline::navdata::{current_gps_week, NavDecoder, NavEvent};
 use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
-use crate::pipeline::tracker::{track_with_reacquisition, Reacquisition};
+use crate::pipeline::aiding::InsFeedForward;
+use crate::pipeline::tracker::{track_with_reacquisition, AidSource, Reacquisition};
+use gpsrx_ins_aiding::read_ins_csv;
 use anyhow::Context;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
 use gpsrx_nav::ephemeris::Ephemeris;
@@ -90,6 +92,21 @@ pub struct RunArgs {
     /// flag that the real satellite had at the time).
     #[arg(long)]
     pub allow_unhealthy: bool,
+    /// INS output, CSV `t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps[,gps_tow_s]` (ECEF; `t_s` from
+    /// the first IF sample; >= 10 Hz): its velocity is fed forward into every carrier and code
+    /// loop (seed 004). Give `--nav` too for aiding before the ephemerides are decoded.
+    #[arg(long, value_name = "FILE")]
+    pub ins: Option<PathBuf>,
+    /// Read `--ins` but do not aid the loops (to compare aided and unaided runs).
+    #[arg(long, requires = "ins")]
+    pub no_aiding: bool,
+    /// First-order band limiter alpha/(s+alpha) on the feed-forward, rad/s (seed 004 eq. 8):
+    /// reproduces an INS of limited dynamic range.
+    #[arg(long, value_name = "RAD_S", requires = "ins")]
+    pub ins_band_limit: Option<f64>,
+    /// Longest gap allowed between INS rows, s.
+    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    pub ins_max_gap: f64,
 }
 
 /// The `[run]` table of a configuration file; command-line options override it.
@@ -230,6 +247,36 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
                 .map(|e| e.toe.week)
         })
         .unwrap_or_else(current_gps_week);
+    let feedforward = match &args.ins {
+        Some(path) => {
+            if let Some(a) = args.ins_band_limit {
+                if !(a.is_finite() && a > 0.0) {
+                    anyhow::bail!("--ins-band-limit {a}: give a corner frequency > 0 rad/s");
+                }
+            }
+            let track = read_ins_csv(path, args.ins_max_gap)?;
+            let (a, b) = track.span_s();
+            tracing::info!(
+                "INS {}: {} rows from {a:.2} to {b:.2} s{}",
+                path.display(),
+                track.samples().len(),
+                if args.no_aiding { " (aiding off: --no-aiding)" } else { "" }
+            );
+            (!args.no_aiding).then(|| {
+                InsFeedForward::new(
+                    track,
+                    nav_assist.clone(),
+                    reference_week,
+                    args.ins_band_limit,
+                )
+                .allow_unhealthy(set.allow_unhealthy)
+            })
+        }
+        None => None,
+    };
+    let feedforward = feedforward.as_ref();
+    let aid_fn = |prn: u8, t_s: f64| feedforward.and_then(|f| f.aid(prn, t_s));
+    let aid_source: Option<AidSource<'_>> = feedforward.map(|_| &aid_fn as AidSource<'_>);
 
     // Cold acquisition on the first samples.
     let acq_cfg = AcqConfig {
@@ -486,6 +533,13 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
             quality: FixQuality::Gnss,
             sats_in_view,
         };
+        if let Some(ff) = feedforward {
+            ff.set_fix(
+                t_file,
+                sol.pos_ecef_m,
+                sol.clock_drift_mps,
+            );
+        }
         pvt_csv.write_fix(&fix)?;
         nmea.write_fix(&fix)?;
         fixes.push(fix);
@@ -494,7 +548,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
     };
 
     let mut processed = 0u64;
-    track_with_reacquisition(src.as_mut(), channels, None, Some(&reacq), |i, e| {
+    track_with_reacquisition(src.as_mut(), channels, aid_source, Some(&reacq), |i, e| {
         if err.is_some() {
             return;
         }
@@ -508,7 +562,10 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
                         tracing::info!("G{:02}: frame sync, TOW {tow_s} s", e.prn)
                     }
                     NavEvent::Ephemeris(eph) => {
-                        tracing::info!("G{:02}: ephemeris decoded (IODE {})", e.prn, eph.iode)
+                        tracing::info!("G{:02}: ephemeris decoded (IODE {})", e.prn, eph.iode);
+                        if let Some(ff) = feedforward {
+                            ff.set_ephemeris(&eph);
+                        }
                     }
                     _ => {}
                 }
@@ -550,6 +607,9 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
             Some(d) => builder.push(e, d),
             None => Vec::new(),
         };
+        if let (Some(ff), Some(t0)) = (feedforward, builder.rx_time_origin()) {
+            ff.set_time_origin(t0);
+        }
         for epoch in ready {
             if let Err(x) = handle_epoch(epoch, &decoders, &mut builder) {
                 err = Some(x);

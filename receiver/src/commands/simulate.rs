@@ -1,7 +1,10 @@
-//! `gpsrx simulate`: scenario file -> IF recording + truth files.
+//! `gpsrx simulate`: scenario file -> IF recording + truth files (+ `ins.csv` when the scenario
+//! has an `[ins]` table: the truth through the INS error models of
+//! [`gpsrx_ins_aiding::error_model`]).
 
 use crate::cli::SimulateArgs;
 use anyhow::Context;
+use gpsrx_ins_aiding::{simulate_ins, write_ins_csv, InsErrorConfig, TruthState};
 use gpsrx_samples::sim::{Scenario, SimReport, Simulator};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -27,22 +30,104 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     if let Some(fs) = args.fs {
         scenario.output.fs_hz = fs;
     }
-    let report = simulate(&scenario, &base, &args.out, !args.json)?;
+    let (report, ins) = simulate_with_ins(&scenario, &base, &args.out, !args.json)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        let mut v = serde_json::to_value(&report)?;
+        if let (Some(ins), Some(map)) = (&ins, v.as_object_mut()) {
+            map.insert("ins".into(), serde_json::to_value(ins)?);
+        }
+        println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        print_report(&report);
+        print_report_with_ins(&report, ins.as_ref());
     }
     Ok(())
 }
 
-/// Prepares and runs a scenario into `out`, with a progress bar when `progress` is set.
+/// The file name of the simulated INS, written beside `truth.csv`.
+pub const INS_FILE_NAME: &str = "ins.csv";
+
+/// The simulated INS file a run wrote.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct InsOutput {
+    /// `ins.csv`.
+    pub path: PathBuf,
+    /// Rows written.
+    pub rows: usize,
+    /// Its error models (the scenario's `[ins]` table with defaults filled in).
+    pub config: InsErrorConfig,
+}
+
+/// Parses and checks a scenario's `[ins]` table (None without one). Errors name the bad key:
+/// an unknown key, a value of the wrong type, or a value out of range.
+pub fn ins_config(scenario: &Scenario) -> anyhow::Result<Option<InsErrorConfig>> {
+    let Some(table) = &scenario.ins else {
+        return Ok(None);
+    };
+    let parse = |t: toml::Table| -> Result<InsErrorConfig, toml::de::Error> {
+        toml::Value::Table(t).try_into()
+    };
+    // Every key has a default, so each key alone is a valid table: parsing them one by one
+    // finds the key a type error belongs to.
+    for (key, value) in table {
+        let mut one = toml::Table::new();
+        one.insert(key.clone(), value.clone());
+        if let Err(e) = parse(one) {
+            anyhow::bail!(
+                "scenario [ins] `{key}`: {} (the keys are documented in samples/scenarios/README.md)",
+                e.message().trim()
+            );
+        }
+    }
+    let cfg = parse(table.clone()).map_err(|e| {
+        anyhow::anyhow!(
+            "scenario [ins]: {} (see samples/scenarios/README.md)",
+            e.message().trim()
+        )
+    })?;
+    cfg.validate().context("scenario [ins]")?;
+    Ok(Some(cfg))
+}
+
+/// Writes the INS of `cfg` for the simulation `sim` to `path` (see
+/// [`gpsrx_ins_aiding::error_model`]) and returns the number of rows. Truth at sample time `t`
+/// (seconds since the first IF sample) is [`Simulator::receiver_truth`], as in `truth.csv`:
+/// position and velocity at the true time `t_true` solving `t_true + b(t_true) = t`, and
+/// `gps_tow_s` the GPS time of week of `t_true`.
+pub fn write_ins_for(sim: &Simulator, cfg: &InsErrorConfig, path: &Path) -> anyhow::Result<usize> {
+    let truth = |t_s: f64| {
+        let (tow_s, s) = sim.receiver_truth(t_s);
+        TruthState {
+            t_s,
+            gps_tow_s: Some(tow_s),
+            pos_m: s.pos_m,
+            vel_mps: s.vel_mps,
+        }
+    };
+    let samples = simulate_ins(&truth, sim.duration_s(), cfg)?;
+    write_ins_csv(path, &samples)?;
+    Ok(samples.len())
+}
+
+/// Prepares and runs a scenario into `out`, with a progress bar when `progress` is set; with an
+/// `[ins]` table it also writes `ins.csv` (see [`simulate_with_ins`]).
 pub fn simulate(
     scenario: &Scenario,
     base: &Path,
     out: &Path,
     progress: bool,
 ) -> anyhow::Result<SimReport> {
+    Ok(simulate_with_ins(scenario, base, out, progress)?.0)
+}
+
+/// [`simulate`], also returning the `ins.csv` written when the scenario has an `[ins]` table
+/// (checked before anything is simulated).
+pub fn simulate_with_ins(
+    scenario: &Scenario,
+    base: &Path,
+    out: &Path,
+    progress: bool,
+) -> anyhow::Result<(SimReport, Option<InsOutput>)> {
+    let ins_cfg = ins_config(scenario)?;
     let sim = Simulator::new(scenario, base).context("cannot prepare the scenario")?;
     let bar = if progress {
         ProgressBar::new(1000)
@@ -57,11 +142,25 @@ pub fn simulate(
         .run(out, &|f| bar.set_position((f * 1000.0) as u64))
         .with_context(|| format!("simulation into {} failed", out.display()))?;
     bar.finish_and_clear();
-    Ok(report)
+    let ins = match ins_cfg {
+        Some(config) => {
+            let path = report.truth_path.with_file_name(INS_FILE_NAME);
+            let rows = write_ins_for(&sim, &config, &path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            Some(InsOutput { path, rows, config })
+        }
+        None => None,
+    };
+    Ok((report, ins))
 }
 
 /// Prints a human summary of a run.
 pub fn print_report(r: &SimReport) {
+    print_report_with_ins(r, None);
+}
+
+/// Prints a human summary of a run and of the `ins.csv` it wrote, if any.
+pub fn print_report_with_ins(r: &SimReport, ins: Option<&InsOutput>) {
     println!("satellites ({}):", r.satellites.len());
     println!("  PRN  elev(deg)  C/N0(dB-Hz)");
     for (prn, el, cn0) in &r.satellites {
@@ -83,6 +182,24 @@ pub fn print_report(r: &SimReport) {
         r.truth_path.display(),
         r.truth_sv_path.display()
     );
+    if let Some(ins) = ins {
+        let c = &ins.config;
+        let b = c.accel_bias_enu_mps2;
+        println!(
+            "ins:       {} ({} rows at {} Hz; accel bias ENU [{}, {}, {}] m/s^2, VRW {} m/s/sqrt(s), scale factor {}, latency {} s, band limit {})",
+            ins.path.display(),
+            ins.rows,
+            c.rate_hz,
+            b[0],
+            b[1],
+            b[2],
+            c.velocity_random_walk_mps_per_sqrt_s,
+            c.scale_factor,
+            c.latency_s,
+            c.band_limit_alpha_rad_s
+                .map_or("none".to_string(), |a| format!("{a} rad/s"))
+        );
+    }
     println!(
         "simulated {:.1} s in {:.2} s: {:.1}x real time ({:.1} Msamples/s)",
         r.duration_s,

@@ -260,6 +260,23 @@ impl Simulator {
         self.total_samples
     }
 
+    /// Length of the recording in receiver (sample) time, s: `total_samples / fs`.
+    pub fn duration_s(&self) -> f64 {
+        self.total_samples as f64 / self.fs_hz
+    }
+
+    /// The receiver's truth at receiver-clock time `t_rcv_s` (seconds since the first sample),
+    /// as `truth.csv` gives it: the true time `t` solves `t + b(t) = t_rcv` (receiver clock bias
+    /// `b`), and the result is the GPS time of week of `start + t` and the trajectory's state
+    /// (ECEF position, velocity, acceleration) at `t`.
+    pub fn receiver_truth(&self, t_rcv_s: f64) -> (f64, trajectory::RxState) {
+        let t = self.env.clock.true_time(t_rcv_s);
+        (
+            self.env.start.add_seconds(t).tow_s,
+            self.env.trajectory.state(t),
+        )
+    }
+
     /// Samples per parallel work unit.
     pub fn chunk_samples(&self) -> usize {
         self.node_samples * NODES_PER_CHUNK

@@ -54,6 +54,10 @@ pub struct Scenario {
     /// Truth output options.
     #[serde(default)]
     pub truth: TruthConfig,
+    /// The `[ins]` table: INS error models, parsed by `gpsrx_ins_aiding::InsErrorConfig` (the
+    /// simulator itself ignores it; `gpsrx simulate` writes ins.csv from it).
+    #[serde(default)]
+    pub ins: Option<toml::Table>,
 }
 
 /// Start time: either `week` + `tow_s`, or a GPS-time calendar string `"2022-01-01 05:30:00"`.
@@ -527,4 +531,52 @@ fn parse_calendar(c: &str) -> Result<GpsTime, SimError> {
         return Err(err());
     }
     Ok(GpsTime::from_calendar(y, mo, da, h, mi, s))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const WITH_INS: &str = r#"
+duration_s = 2.0
+nav = "builtin:brdc0010.22n"
+[start]
+week = 2190
+tow_s = 538194.0
+[output]
+format = "ci8"
+fs_hz = 2.048e6
+[receiver]
+kind = "static"
+llh_deg = [37.5665, 126.9780, 40.0]
+[ins]
+rate_hz = 50.0
+accel_bias_enu_mps2 = [0.01, 0.01, 0.0]
+band_limit_alpha_rad_s = 2.0
+"#;
+
+    #[test]
+    fn ins_table_is_kept_as_given_and_round_trips() {
+        let sc = Scenario::from_toml(WITH_INS).unwrap_or_else(|e| panic!("{e}"));
+        let ins = sc.ins.clone().unwrap_or_else(|| panic!("no [ins]"));
+        assert_eq!(ins.get("rate_hz").and_then(|v| v.as_float()), Some(50.0));
+        assert_eq!(
+            ins.get("accel_bias_enu_mps2")
+                .and_then(|v| v.as_array())
+                .map(|a| a.len()),
+            Some(3)
+        );
+        // TOML and JSON round trips keep the table.
+        let text = toml::to_string(&sc).unwrap_or_else(|e| panic!("{e}"));
+        let back = Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(back.ins, sc.ins);
+        let json = serde_json::to_string(&sc).unwrap_or_else(|e| panic!("{e}"));
+        let back: Scenario = serde_json::from_str(&json).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(back.ins, sc.ins);
+        // Without the table the field is None, and the rest of the scenario is unchanged.
+        let plain = WITH_INS.split("[ins]").next().unwrap_or_default();
+        let sc2 = Scenario::from_toml(plain).unwrap_or_else(|e| panic!("{e}"));
+        assert!(sc2.ins.is_none());
+        assert_eq!(sc2.duration_s, sc.duration_s);
+    }
 }

@@ -1,0 +1,307 @@
+//! The INS-velocity Doppler feed-forward that drives the tracking channels' aiding port
+//! (seed 004, Fig. 4).
+//!
+//! For satellite `k` at receive time `t` (seconds from the first IF sample):
+//!
+//! 1. receive time in GPS time: `t_gps = t0 + t`, with `t0` the GPS time of the first sample
+//!    (from the first decoded time of week, or from the INS file's `gps_tow_s` column);
+//! 2. satellite position, velocity and clock drift from the ephemeris (decoded, or from
+//!    `--nav`) at the transmit time `t_gps - r/c`, rotated by the Earth's rotation during the
+//!    flight `OmegaE r / c` into the frame of reception (IS-GPS-200 20.3.3.4.3.3.2);
+//! 3. receiver position: the INS position before the first fix; after it, the fix propagated
+//!    by the INS displacement since the fix (the INS position may carry a bias, its velocity is
+//!    what matters); receiver velocity from the INS;
+//! 4. Doppler, seed 004 eq. 6 written with the unit vector `u` from receiver to satellite:
+//!    `f = -((v_sv - v_rx) . u) / lambda + f_L1 d_sv - f_L1 (d_rx - d_ref)`, with `d_sv` the
+//!    satellite clock drift and `d_rx` the receiver clock drift (s/s) from the fixes, smoothed
+//!    with a 1 s time constant (`pseudorange rate = range rate + c d_rx - c d_sv`,
+//!    `f = -pseudorange rate / lambda`). Only the *change* of the receiver clock drift since
+//!    its first estimate `d_ref` is fed forward: a channel keeps its NCO frequency when the aid
+//!    comes on (the loop's base frequency takes up the difference, see
+//!    `gpsrx_tracking::Channel::set_aid`), so the drift at that moment is already in the loop,
+//!    whereas putting the whole drift in when the first fix arrives would step every NCO by
+//!    `f_L1 d_rx` (63 Hz for 4e-8) and throw narrow aided loops out of lock;
+//! 5. optionally the band limiter `alpha / (s + alpha)` (seed 004 eq. 8) on each satellite's
+//!    feed-forward, so that the effect of an INS of limited dynamic range can be reproduced on
+//!    real recordings;
+//! 6. the Doppler rate over the next interval from the same computation 10 ms later (or, with
+//!    the band limiter, its output slope `alpha (f - y)`).
+//!
+//! Until a satellite's ephemeris and the GPS time are known it gets no feed-forward (logged
+//! once per satellite), and outside the INS file's time span no satellite does.
+
+use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
+use gpsrx_ins_aiding::{los_doppler_hz, BandLimiter, InsTrack};
+use gpsrx_nav::constants::OMEGA_E_DOT_RAD_S;
+use gpsrx_nav::ephemeris::Ephemeris;
+use gpsrx_nav::rinex_nav::NavData;
+use gpsrx_nav::time::GpsTime;
+use gpsrx_tracking::DopplerAid;
+use nalgebra::Vector3;
+use std::collections::{BTreeMap, BTreeSet};
+use std::sync::{Mutex, RwLock};
+
+/// Step used for the Doppler rate, s.
+const RATE_STEP_S: f64 = 0.01;
+/// A band limiter that has not been stepped for this long restarts from its input, s.
+const LIMITER_RESTART_S: f64 = 1.0;
+/// Time constant of the receiver clock drift smoothing, s.
+pub const DRIFT_SMOOTHING_S: f64 = 1.0;
+/// Maximum age of a `--nav` ephemeris used for aiding, s (its fit interval is 4 h).
+const MAX_EPHEMERIS_AGE_S: f64 = 7200.0;
+
+/// What the receiver has learned that the feed-forward needs; updated as the run goes.
+#[derive(Debug, Clone, Default)]
+struct Knowledge {
+    /// GPS time of the first IF sample.
+    t0: Option<GpsTime>,
+    /// Ephemerides in use, per PRN.
+    ephemerides: BTreeMap<u8, Ephemeris>,
+    /// Latest fix: receive time (s from the first sample), ECEF position.
+    fix: Option<(f64, Vector3<f64>)>,
+    /// Receiver clock drift from the fixes, smoothed, s/s.
+    rx_clock_drift_s_s: Option<f64>,
+    /// The first receiver clock drift estimate, s/s, and the time of the latest, s.
+    rx_clock_drift_ref: Option<(f64, f64)>,
+}
+
+/// The INS feed-forward for all satellites (`gpsrx run --ins`). Shared by the tracking threads
+/// (reads) and the navigation thread (updates).
+#[derive(Debug)]
+pub struct InsFeedForward {
+    ins: InsTrack,
+    nav: Option<NavData>,
+    band_limit_alpha_rad_s: Option<f64>,
+    allow_unhealthy: bool,
+    know: RwLock<Knowledge>,
+    limiters: Mutex<BTreeMap<u8, (BandLimiter, f64)>>,
+    logged: Mutex<BTreeSet<(u8, &'static str)>>,
+}
+
+impl InsFeedForward {
+    /// A feed-forward from an INS track, optional `--nav` ephemerides (used until a satellite's
+    /// own are decoded), the GPS week to place the INS file's `gps_tow_s` in, and an optional
+    /// band limiter corner (rad/s).
+    pub fn new(
+        ins: InsTrack,
+        nav: Option<NavData>,
+        reference_week: u32,
+        band_limit_alpha_rad_s: Option<f64>,
+    ) -> Self {
+        let t0 = ins
+            .gps_tow_at(ins.span_s().0)
+            .map(|tow| GpsTime::new(reference_week, tow).add_seconds(-ins.span_s().0));
+        if let Some(t) = t0 {
+            tracing::info!(
+                "INS aiding: GPS time from the INS file (first sample at TOW {:.3} s)",
+                t.tow_s
+            );
+        }
+        Self {
+            ins,
+            nav,
+            band_limit_alpha_rad_s,
+            allow_unhealthy: false,
+            know: RwLock::new(Knowledge {
+                t0,
+                ..Knowledge::default()
+            }),
+            limiters: Mutex::new(BTreeMap::new()),
+            logged: Mutex::new(BTreeSet::new()),
+        }
+    }
+
+    /// Also aids satellites whose `--nav` ephemeris is flagged unhealthy (as `run
+    /// --allow-unhealthy` uses them); decoded ephemerides are used whatever their flag.
+    pub fn allow_unhealthy(mut self, allow: bool) -> Self {
+        self.allow_unhealthy = allow;
+        self
+    }
+
+    /// Sets the GPS time of the first sample (from the first decoded time of week), unless it is
+    /// already known.
+    pub fn set_time_origin(&self, t0: GpsTime) {
+        if self.know.read().is_ok_and(|k| k.t0.is_some()) {
+            return;
+        }
+        if let Ok(mut k) = self.know.write() {
+            if k.t0.is_none() {
+                tracing::info!("INS aiding: GPS time known (TOW {:.3} s at the first sample)", t0.tow_s);
+                k.t0 = Some(t0);
+            }
+        }
+    }
+
+    /// Uses a decoded ephemeris from now on.
+    pub fn set_ephemeris(&self, eph: &Ephemeris) {
+        if let Ok(mut k) = self.know.write() {
+            k.ephemerides.insert(eph.prn, eph.clone());
+        }
+    }
+
+    /// Records a fix: receive time (s from the first sample), ECEF position and the receiver
+    /// clock drift (m/s, as the velocity solution gives it). The drift is smoothed by a
+    /// first-order filter of time constant [`DRIFT_SMOOTHING_S`].
+    pub fn set_fix(&self, t_s: f64, pos_m: Vector3<f64>, clock_drift_mps: Option<f64>) {
+        if let Ok(mut k) = self.know.write() {
+            k.fix = Some((t_s, pos_m));
+            if let Some(d) = clock_drift_mps.filter(|d| d.is_finite()) {
+                let d = d / SPEED_OF_LIGHT_MPS;
+                match (k.rx_clock_drift_s_s, k.rx_clock_drift_ref) {
+                    (Some(prev), Some((d_ref, t_prev))) => {
+                        let g = 1.0 - (-(t_s - t_prev).max(0.0) / DRIFT_SMOOTHING_S).exp();
+                        k.rx_clock_drift_s_s = Some(prev + g * (d - prev));
+                        k.rx_clock_drift_ref = Some((d_ref, t_s));
+                    }
+                    _ => {
+                        k.rx_clock_drift_s_s = Some(d);
+                        k.rx_clock_drift_ref = Some((d, t_s));
+                    }
+                }
+            }
+        }
+    }
+
+    /// The receiver clock drift fed forward now: its change since the first estimate, s/s.
+    pub fn clock_drift_fed_forward_s_s(&self) -> f64 {
+        self.know
+            .read()
+            .ok()
+            .and_then(|k| Some(k.rx_clock_drift_s_s? - k.rx_clock_drift_ref?.0))
+            .unwrap_or(0.0)
+    }
+
+    fn log_once(&self, prn: u8, what: &'static str, msg: impl FnOnce() -> String) {
+        if let Ok(mut l) = self.logged.lock() {
+            if l.insert((prn, what)) {
+                tracing::info!("{}", msg());
+            }
+        }
+    }
+
+    /// The ephemeris for `prn` at `t`: the decoded one, else one from `--nav` (cached).
+    fn ephemeris(&self, prn: u8, t: GpsTime) -> Option<Ephemeris> {
+        if let Some(e) = self.know.read().ok()?.ephemerides.get(&prn) {
+            if e.is_within_s(t, MAX_EPHEMERIS_AGE_S) {
+                return Some(e.clone());
+            }
+        }
+        let nav = self.nav.as_ref()?;
+        let e = if self.allow_unhealthy {
+            // Nearest toe within the fit interval, whatever the health flag.
+            nav.ephemerides
+                .iter()
+                .filter(|e| e.prn == prn && e.is_within_s(t, MAX_EPHEMERIS_AGE_S))
+                .min_by(|a, b| {
+                    t.diff_s(a.toe).abs().total_cmp(&t.diff_s(b.toe).abs())
+                })?
+                .clone()
+        } else {
+            nav.select(prn, t)?.clone()
+        };
+        if let Ok(mut k) = self.know.write() {
+            k.ephemerides.insert(prn, e.clone());
+        }
+        Some(e)
+    }
+
+    /// The unfiltered feed-forward Doppler (Hz) of `prn` at receive time `t_s`.
+    fn doppler_hz(&self, eph: &Ephemeris, k: &Knowledge, t0: GpsTime, t_s: f64) -> Option<f64> {
+        let (ins_pos, ins_vel) = self.ins.at(t_s)?;
+        let rx_pos = match k.fix {
+            Some((t_fix, p_fix)) => {
+                let (p_then, _) = self.ins.at(t_fix).unwrap_or((ins_pos, ins_vel));
+                p_fix + (ins_pos - p_then)
+            }
+            None => ins_pos,
+        };
+        let t_rx = t0.add_seconds(t_s);
+        // Transmit time from the geometric range (one iteration: 1 m of range error is 3 ns).
+        let guess = eph.sv_state(t_rx.add_seconds(-0.075));
+        let tau = (guess.pos_m - rx_pos).norm() / SPEED_OF_LIGHT_MPS;
+        let sv = eph.sv_state(t_rx.add_seconds(-tau));
+        // Earth rotation during the flight, about z by OmegaE tau.
+        let th = OMEGA_E_DOT_RAD_S * tau;
+        let (s, c) = th.sin_cos();
+        let rot = |v: &Vector3<f64>| Vector3::new(c * v.x + s * v.y, -s * v.x + c * v.y, v.z);
+        let f = los_doppler_hz(
+            &rot(&sv.pos_m),
+            &rot(&sv.vel_mps),
+            &rx_pos,
+            &ins_vel,
+            match (k.rx_clock_drift_s_s, k.rx_clock_drift_ref) {
+                (Some(d), Some((d_ref, _))) => d - d_ref,
+                _ => 0.0,
+            },
+        ) + F_L1_HZ * sv.clock_drift_s_s;
+        f.is_finite().then_some(f)
+    }
+
+    /// The aid for `prn` at receive time `t_s` (seconds from the first sample), or None when it
+    /// cannot be computed yet (no GPS time, no ephemeris, outside the INS file).
+    pub fn aid(&self, prn: u8, t_s: f64) -> Option<DopplerAid> {
+        let (t0, know) = {
+            let k = self.know.read().ok()?;
+            (k.t0, k.clone_light())
+        };
+        let Some(t0) = t0 else {
+            self.log_once(0, "time", || {
+                "INS aiding waits for the GPS time (the first decoded time of week, or a gps_tow_s column in the INS file)".to_string()
+            });
+            return None;
+        };
+        let Some(eph) = self.ephemeris(prn, t0.add_seconds(t_s)) else {
+            self.log_once(prn, "eph", || {
+                format!("G{prn:02}: no ephemeris yet (decoded or --nav), no INS feed-forward")
+            });
+            return None;
+        };
+        let Some(f) = self.doppler_hz(&eph, &know, t0, t_s) else {
+            let (a, b) = self.ins.span_s();
+            self.log_once(prn, "span", || {
+                format!("G{prn:02}: {t_s:.2} s is outside the INS file ({a:.2} to {b:.2} s), no feed-forward")
+            });
+            return None;
+        };
+        self.log_once(prn, "on", || {
+            format!("G{prn:02}: INS feed-forward on at {t_s:.2} s ({f:.1} Hz)")
+        });
+        let aid = match self.band_limit_alpha_rad_s {
+            None => {
+                let f2 = self.doppler_hz(&eph, &know, t0, t_s + RATE_STEP_S).unwrap_or(f);
+                DopplerAid {
+                    doppler_hz: f,
+                    doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
+                }
+            }
+            Some(alpha) => {
+                let mut l = self.limiters.lock().ok()?;
+                let (lim, t_last) = l.entry(prn).or_insert((BandLimiter::new(alpha), t_s));
+                let dt = t_s - *t_last;
+                if !(0.0..=LIMITER_RESTART_S).contains(&dt) {
+                    lim.reset(None);
+                }
+                let y = lim.step(f, dt.max(0.0));
+                *t_last = t_s;
+                DopplerAid {
+                    doppler_hz: y,
+                    doppler_rate_hz_s: alpha * (f - y),
+                }
+            }
+        };
+        Some(aid)
+    }
+}
+
+impl Knowledge {
+    /// The parts the Doppler computation needs (not the ephemeris map).
+    fn clone_light(&self) -> Knowledge {
+        Knowledge {
+            t0: self.t0,
+            ephemerides: BTreeMap::new(),
+            fix: self.fix,
+            rx_clock_drift_s_s: self.rx_clock_drift_s_s,
+            rx_clock_drift_ref: self.rx_clock_drift_ref,
+        }
+    }
+}
