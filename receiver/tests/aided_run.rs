@@ -107,15 +107,22 @@ fn feedforward_doppler_matches_truth_for_a_perfect_ins() {
 
     // The drift rises by 1e-9 (1.58 Hz): after 5 s of 10 Hz fixes (5 smoothing time constants)
     // every feed-forward is 1.58 Hz lower (to 1 %).
-    let before = ff.aid(sim.satellites[0].prn.get(), 6.0).map(|a| a.doppler_hz);
+    let before = ff
+        .aid(sim.satellites[0].prn.get(), 6.0)
+        .map(|a| a.doppler_hz);
     for k in 1..=50 {
         let t = 0.5 + 0.1 * f64::from(k);
         let (_, rx) = sim.receiver_truth(t);
         ff.set_fix(t, rx.pos_m, Some(drift_mps + 1e-9 * 299_792_458.0));
     }
-    let after = ff.aid(sim.satellites[0].prn.get(), 6.0).map(|a| a.doppler_hz);
+    let after = ff
+        .aid(sim.satellites[0].prn.get(), 6.0)
+        .map(|a| a.doppler_hz);
     let step = after.unwrap_or(f64::NAN) - before.unwrap_or(f64::NAN);
-    assert!((step + 1.57542).abs() < 0.02, "drift change fed forward: {step} Hz");
+    assert!(
+        (step + 1.57542).abs() < 0.02,
+        "drift change fed forward: {step} Hz"
+    );
 }
 
 /// Without the GPS time or the ephemeris there is no feed-forward (never a made-up one).
@@ -184,7 +191,9 @@ fn truth(dir: &Path) -> Vec<(f64, [f64; 3])> {
 /// 3D error of a fix against truth interpolated at its time.
 fn error_3d_m(f: &Fix, truth: &[(f64, [f64; 3])]) -> f64 {
     let t = f.time.tow_s;
-    let i = truth.partition_point(|r| r.0 <= t).clamp(1, truth.len() - 1);
+    let i = truth
+        .partition_point(|r| r.0 <= t)
+        .clamp(1, truth.len() - 1);
     let (a, b) = (&truth[i - 1], &truth[i]);
     let u = (t - a.0) / (b.0 - a.0);
     (0..3)
@@ -207,7 +216,9 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
             .unwrap_or_else(|e| panic!("{e}")),
     );
     let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
-    let report = sim.run(dir.path(), &|_| {}).unwrap_or_else(|e| panic!("{e}"));
+    let report = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
     let ins_path: PathBuf = dir.path().join("ins.csv");
     let cfg: InsErrorConfig = toml::Value::Table(sc.ins.clone().unwrap_or_default())
         .try_into()
@@ -238,7 +249,10 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
     let (fu, nu) = locked_fraction(&unaided_out);
     eprintln!("phase-locked rows in the turn: aided {fa:.3} of {na}, unaided {fu:.3} of {nu}");
     assert!(fa > 0.97, "aided channels keep phase lock ({fa})");
-    assert!(fu < 0.7, "unaided 3 Hz loops lose lock in a 5 g turn ({fu})");
+    assert!(
+        fu < 0.7,
+        "unaided 3 Hz loops lose lock in a 5 g turn ({fu})"
+    );
 
     let truth = truth(dir.path());
     let in_turn = |f: &&Fix| (t0..=t1).contains(&f.time.tow_s);
@@ -253,6 +267,10 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
         unaided_turn.len()
     );
     // 10 Hz fixes over the 8 s turn.
-    assert!(aided_turn.len() >= 75, "aided fixes through the turn: {}", aided_turn.len());
+    assert!(
+        aided_turn.len() >= 75,
+        "aided fixes through the turn: {}",
+        aided_turn.len()
+    );
     assert!(rms < 2.0, "aided fix error in the turn {rms} m RMS");
 }

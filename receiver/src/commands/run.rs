@@ -10,13 +10,13 @@ use crate::output::{
     self, create_file, ChannelCsvWriter, ChannelRow, Fix, FixQuality, NavHeader, NavRecord,
     NmeaOptions, NmeaWriter, ObsEpoch, ObsHeader, PvtCsvWriter, RinexObsWriter, SatObs, SatView,
 };
+use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::navdata::{current_gps_week, NavDecoder, NavEvent};
 use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
-use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::tracker::{track_with_reacquisition, AidSource, Reacquisition};
-use gpsrx_ins_aiding::read_ins_csv;
 use anyhow::Context;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
+use gpsrx_ins_aiding::read_ins_csv;
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::frames::azimuth_elevation;
 use gpsrx_nav::pvt::{solve, PvtOptions, PvtSolution, RaimStatus, SatMeasurement};
@@ -260,7 +260,11 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
                 "INS {}: {} rows from {a:.2} to {b:.2} s{}",
                 path.display(),
                 track.samples().len(),
-                if args.no_aiding { " (aiding off: --no-aiding)" } else { "" }
+                if args.no_aiding {
+                    " (aiding off: --no-aiding)"
+                } else {
+                    ""
+                }
             );
             (!args.no_aiding).then(|| {
                 InsFeedForward::new(
@@ -534,11 +538,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
             sats_in_view,
         };
         if let Some(ff) = feedforward {
-            ff.set_fix(
-                t_file,
-                sol.pos_ecef_m,
-                sol.clock_drift_mps,
-            );
+            ff.set_fix(t_file, sol.pos_ecef_m, sol.clock_drift_mps);
         }
         pvt_csv.write_fix(&fix)?;
         nmea.write_fix(&fix)?;

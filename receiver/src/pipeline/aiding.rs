@@ -126,7 +126,10 @@ impl InsFeedForward {
         }
         if let Ok(mut k) = self.know.write() {
             if k.t0.is_none() {
-                tracing::info!("INS aiding: GPS time known (TOW {:.3} s at the first sample)", t0.tow_s);
+                tracing::info!(
+                    "INS aiding: GPS time known (TOW {:.3} s at the first sample)",
+                    t0.tow_s
+                );
                 k.t0 = Some(t0);
             }
         }
@@ -192,9 +195,7 @@ impl InsFeedForward {
             nav.ephemerides
                 .iter()
                 .filter(|e| e.prn == prn && e.is_within_s(t, MAX_EPHEMERIS_AGE_S))
-                .min_by(|a, b| {
-                    t.diff_s(a.toe).abs().total_cmp(&t.diff_s(b.toe).abs())
-                })?
+                .min_by(|a, b| t.diff_s(a.toe).abs().total_cmp(&t.diff_s(b.toe).abs()))?
                 .clone()
         } else {
             nav.select(prn, t)?.clone()
@@ -268,7 +269,9 @@ impl InsFeedForward {
         });
         let aid = match self.band_limit_alpha_rad_s {
             None => {
-                let f2 = self.doppler_hz(&eph, &know, t0, t_s + RATE_STEP_S).unwrap_or(f);
+                let f2 = self
+                    .doppler_hz(&eph, &know, t0, t_s + RATE_STEP_S)
+                    .unwrap_or(f);
                 DopplerAid {
                     doppler_hz: f,
                     doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
