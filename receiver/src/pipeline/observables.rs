@@ -32,8 +32,11 @@ pub struct SatObservable {
     pub smoothed_pseudorange_m: f64,
     /// Accumulated carrier phase, cycles (RINEX sign: grows as the range grows).
     pub carrier_cycles: f64,
-    /// Doppler, Hz (positive when approaching): the carrier phase change since the previous
-    /// epoch over the epoch interval when both are in lock, else the NCO frequency.
+    /// Doppler, Hz (positive when approaching): the carrier phase change from the previous to
+    /// the next epoch over twice the epoch interval (a central difference, so that the Doppler
+    /// belongs to the epoch itself and not half an interval earlier: at 10 Hz under a 5 g
+    /// turn a backward difference lags the velocity by 2.5 m/s), or the backward difference
+    /// when the next epoch is not in lock, else the NCO frequency.
     pub doppler_hz: f64,
     /// C/N0, dB-Hz.
     pub cn0_dbhz: f64,
@@ -76,6 +79,9 @@ pub struct ObservableBuilder {
     /// Per PRN: the previous epoch's index, carrier phase (cycles) and smoothed pseudorange
     /// with its number of averaged epochs (Hatch filter state), and the clock steps (ms) so far.
     smoothing: BTreeMap<u8, (i64, f64, f64, u32, i64, f64)>,
+    /// Backward carrier-phase Doppler `-(L(n) - L(n-1)) / dt` per (epoch, PRN), for the central
+    /// difference at emission.
+    phase_rate: BTreeMap<(i64, u8), f64>,
     /// Hatch filter length, epochs.
     hatch_epochs: u32,
 }
@@ -93,6 +99,7 @@ impl ObservableBuilder {
             lli: BTreeMap::new(),
             newest: i64::MIN,
             smoothing: BTreeMap::new(),
+            phase_rate: BTreeMap::new(),
             hatch_epochs: (rate_hz * 10.0).round().max(1.0) as u32,
         }
     }
@@ -179,6 +186,7 @@ impl ObservableBuilder {
                     // Over the elapsed sample time (an epoch after a clock step is not 1/rate
                     // after the previous one).
                     let dt = t_epoch - t0.tow_s - ts_prev;
+                    self.phase_rate.insert((n, e.prn), -dl_signal / dt);
                     (ps, -dl_signal / dt, m)
                 }
                 _ => (pseudorange_m, e.doppler_hz, 1),
@@ -220,6 +228,16 @@ impl ObservableBuilder {
             if let Some(mut sats) = self.pending.remove(&k) {
                 sats.sort_by_key(|s| s.prn);
                 sats.dedup_by_key(|s| s.prn);
+                // Central difference: the mean of the backward differences into k and k+1.
+                for s in &mut sats {
+                    if let (Some(a), Some(b)) = (
+                        self.phase_rate.get(&(k, s.prn)),
+                        self.phase_rate.get(&(k + 1, s.prn)),
+                    ) {
+                        s.doppler_hz = 0.5 * (a + b);
+                    }
+                }
+                self.phase_rate = self.phase_rate.split_off(&(k + 1, 0));
                 let t = k as f64 / self.rate_hz;
                 out.push(ObservableEpoch {
                     rx_time: GpsTime::new(t0.week, t),
