@@ -77,6 +77,8 @@ pub struct InsSample {
 #[derive(Debug, Clone)]
 pub struct InsTrack {
     samples: Vec<InsSample>,
+    /// With no `t_s` column: the `gps_tow_s` of the first row, from which `t_s` was counted.
+    gps_time_base_tow_s: Option<f64>,
 }
 
 /// Reads and validates an INS file: times strictly increasing, no gap above `max_gap_s`
@@ -112,19 +114,26 @@ pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
         .map_or(1, |pos| usize::try_from(pos.line()).unwrap_or(1));
     let col = |name: &str| headers.iter().position(|h| h == name);
     let names = ["t_s", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps"];
+    let tow_col = col("gps_tow_s");
+    // `t_s` may be left out when `gps_tow_s` is given (the GPS time base): t_s then counts from
+    // the first row's time of week, and the receiver maps it once it knows the GPS time.
+    let gps_time_base = col("t_s").is_none() && tow_col.is_some();
     let mut idx = [0usize; 7];
     for (k, n) in names.iter().enumerate() {
+        if k == 0 && gps_time_base {
+            continue;
+        }
         idx[k] = col(n).ok_or_else(|| {
             row_err(
                 header_line,
                 format!(
-                    "no column `{n}`: the header must name t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps (ECEF, metres and m/s; gps_tow_s optional)"
+                    "no column `{n}`: the header must name t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps (ECEF, metres and m/s; gps_tow_s optional, or gps_tow_s instead of t_s)"
                 ),
             )
         })?;
     }
-    let tow_col = col("gps_tow_s");
     let mut samples: Vec<InsSample> = Vec::new();
+    let mut first_tow: Option<f64> = None;
     let mut last_line = header_line;
     for (i, rec) in rdr.records().enumerate() {
         let rec = rec.map_err(|e| match e.kind() {
@@ -165,13 +174,18 @@ pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
                 })
         };
         let mut v = [0.0; 7];
-        for k in 0..7 {
+        for k in usize::from(gps_time_base)..7 {
             v[k] = num(idx[k], names[k])?;
         }
         let gps_tow_s = match tow_col {
             Some(c) => Some(num(c, "gps_tow_s")?),
             None => None,
         };
+        if let (true, Some(tow)) = (gps_time_base, gps_tow_s) {
+            // Seconds since the first row, across a week rollover.
+            let t0 = *first_tow.get_or_insert(tow);
+            v[0] = (tow - t0).rem_euclid(WEEK_S);
+        }
         let pos_m = Vector3::new(v[1], v[2], v[3]);
         let vel_mps = Vector3::new(v[4], v[5], v[6]);
         let r = pos_m.norm();
@@ -243,7 +257,10 @@ pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
             ),
         });
     }
-    Ok(InsTrack { samples })
+    Ok(InsTrack {
+        samples,
+        gps_time_base_tow_s: first_tow,
+    })
 }
 
 /// Writes `samples` as an INS file [`read_ins_csv`] reads back: the header
@@ -291,6 +308,48 @@ pub fn write_ins_csv(path: &Path, samples: &[InsSample]) -> Result<(), InsError>
 }
 
 impl InsTrack {
+    /// A track from samples already in memory (e.g. [`crate::error_model::simulate_ins`]),
+    /// checked like a file: at least 2 rows, `t_s` strictly increasing, finite values.
+    pub fn from_samples(samples: Vec<InsSample>) -> Result<InsTrack, InsError> {
+        if samples.len() < 2 {
+            return Err(InsError::Config(
+                "an INS track needs at least 2 samples".into(),
+            ));
+        }
+        for (i, w) in samples.windows(2).enumerate() {
+            let finite = |s: &InsSample| {
+                s.t_s.is_finite()
+                    && s.pos_m.iter().all(|v| v.is_finite())
+                    && s.vel_mps.iter().all(|v| v.is_finite())
+            };
+            if !(finite(&w[0]) && finite(&w[1]) && w[1].t_s > w[0].t_s) {
+                return Err(InsError::Config(format!(
+                    "INS samples {i} and {}: times must increase and every value be finite",
+                    i + 1
+                )));
+            }
+        }
+        Ok(InsTrack {
+            samples,
+            gps_time_base_tow_s: None,
+        })
+    }
+
+    /// For a file without `t_s` (GPS time base): the time of week its `t_s` counts from. The
+    /// receiver must then map its own time to the file's, see [`InsTrack::t_s_from_tow`].
+    pub fn gps_time_base_tow_s(&self) -> Option<f64> {
+        self.gps_time_base_tow_s
+    }
+
+    /// The track time `t_s` of a GPS time of week, for a file in the GPS time base (None for a
+    /// file with a `t_s` column).
+    pub fn t_s_from_tow(&self, tow_s: f64) -> Option<f64> {
+        let base = self.gps_time_base_tow_s?;
+        let mut dt = tow_s - base;
+        dt -= (dt / WEEK_S).round() * WEEK_S;
+        Some(dt)
+    }
+
     /// The rows of the file, in time order.
     pub fn samples(&self) -> &[InsSample] {
         &self.samples
@@ -564,5 +623,51 @@ mod tests {
             .map(|e| e.to_string())
             .unwrap_or_default();
         assert!(e.contains("cannot write INS file"), "{e}");
+    }
+
+    #[test]
+    fn gps_time_base_without_t_s() {
+        // 10 Hz rows across the week rollover, no t_s column.
+        let mut text = String::from("x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,gps_tow_s\n");
+        for i in 0..10 {
+            let tow = (604_799.75 + 0.1 * f64::from(i)) % 604_800.0;
+            text += &format!("{},0,0,0,10,0,{tow}\n", 6_378_137.0 + f64::from(i));
+        }
+        let f = write(&text);
+        let track = read_ins_csv(f.path(), 0.5).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(track.gps_time_base_tow_s(), Some(604_799.75));
+        let (t0, t1) = track.span_s();
+        assert!(t0.abs() < 1e-9 && (t1 - 0.9).abs() < 1e-9, "{t0} {t1}");
+        // 0.35 s after the first row is TOW 0.1 of the next week.
+        let t = track.t_s_from_tow(0.1).unwrap_or(f64::NAN);
+        assert!((t - 0.35).abs() < 1e-9, "{t}");
+        let (p, _) = track.at(t).unwrap_or_else(|| panic!("inside"));
+        assert!((p.x - (6_378_137.0 + 3.5)).abs() < 1e-6, "{}", p.x);
+        // A file with t_s is not in the GPS time base.
+        let f = write(&format!(
+            "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps\n0,{ROW}\n0.1,{ROW}\n"
+        ));
+        let track = read_ins_csv(f.path(), 0.5).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(track.t_s_from_tow(1.0), None);
+        // Neither t_s nor gps_tow_s: the error names t_s.
+        let f = write(&format!("x_m,y_m,z_m,vx_mps,vy_mps,vz_mps\n{ROW}\n{ROW}\n"));
+        let e = read_ins_csv(f.path(), 0.5)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no column `t_s`"), "{e}");
+    }
+
+    #[test]
+    fn from_samples_checks_order() {
+        let s = |t: f64| InsSample {
+            t_s: t,
+            gps_tow_s: None,
+            pos_m: Vector3::new(6.4e6, 0.0, 0.0),
+            vel_mps: Vector3::zeros(),
+        };
+        assert!(InsTrack::from_samples(vec![s(0.0), s(0.1)]).is_ok());
+        assert!(InsTrack::from_samples(vec![s(0.1), s(0.1)]).is_err());
+        assert!(InsTrack::from_samples(vec![s(0.0)]).is_err());
     }
 }

@@ -88,8 +88,13 @@ impl InsFeedForward {
         reference_week: u32,
         band_limit_alpha_rad_s: Option<f64>,
     ) -> Self {
+        // A file with `t_s` and `gps_tow_s` tells the GPS time of the first IF sample; a file in
+        // the GPS time base (no `t_s`) needs the receiver's own time first.
         let t0 = ins
-            .gps_tow_at(ins.span_s().0)
+            .gps_time_base_tow_s()
+            .is_none()
+            .then(|| ins.gps_tow_at(ins.span_s().0))
+            .flatten()
             .map(|tow| GpsTime::new(reference_week, tow).add_seconds(-ins.span_s().0));
         if let Some(t) = t0 {
             tracing::info!(
@@ -206,12 +211,22 @@ impl InsFeedForward {
         Some(e)
     }
 
+    /// The INS state at receive time `t_s` (seconds from the first IF sample), through the GPS
+    /// time when the INS file is in the GPS time base.
+    fn ins_at(&self, t0: GpsTime, t_s: f64) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let t_ins = match self.ins.gps_time_base_tow_s() {
+            Some(_) => self.ins.t_s_from_tow(t0.add_seconds(t_s).tow_s)?,
+            None => t_s,
+        };
+        self.ins.at(t_ins)
+    }
+
     /// The unfiltered feed-forward Doppler (Hz) of `prn` at receive time `t_s`.
     fn doppler_hz(&self, eph: &Ephemeris, k: &Knowledge, t0: GpsTime, t_s: f64) -> Option<f64> {
-        let (ins_pos, ins_vel) = self.ins.at(t_s)?;
+        let (ins_pos, ins_vel) = self.ins_at(t0, t_s)?;
         let rx_pos = match k.fix {
             Some((t_fix, p_fix)) => {
-                let (p_then, _) = self.ins.at(t_fix).unwrap_or((ins_pos, ins_vel));
+                let (p_then, _) = self.ins_at(t0, t_fix).unwrap_or((ins_pos, ins_vel));
                 p_fix + (ins_pos - p_then)
             }
             None => ins_pos,
