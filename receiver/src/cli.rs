@@ -103,7 +103,8 @@ pub struct SimulateArgs {
     /// Use the built-in default scenario.
     #[arg(long, conflicts_with = "scenario")]
     pub default: bool,
-    /// Output directory: the recording, its .sigmf-meta, truth.csv and truth_sv.csv go there.
+    /// Output directory: the recording, its .sigmf-meta, truth.csv and truth_sv.csv go there
+    /// (and ins.csv when the scenario has an `[ins]` table).
     #[arg(short, long, value_name = "DIR")]
     pub out: PathBuf,
     /// Override the scenario's duration, s.
