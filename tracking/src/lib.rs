@@ -14,6 +14,7 @@
 //! - [`lock_detector`]: phase lock (`cos 2 phi`) and code lock (C/N0) with hysteresis.
 //! - [`cn0`]: NWPR and M2M4 C/N0 estimators.
 //! - [`bit_sync`]: histogram bit synchronisation and bit decisions.
+//! - [`phase_sim`]: a phase-domain closed-loop simulator (correlator-level prompts) for studies.
 //!
 //! Measured closed-loop behaviour (noise bandwidth, stability limits, dynamic and thermal errors,
 //! aiding) is in `tracking/README.md` and the `closed_loop` integration test.
@@ -29,6 +30,7 @@ pub mod discriminator;
 pub mod lock_detector;
 pub mod loop_analysis;
 pub mod loop_filter;
+pub mod phase_sim;
 
 pub use aiding::DopplerAid;
 pub use bit_sync::{Bit, BitSync, BitSyncConfig, BitSyncState};
