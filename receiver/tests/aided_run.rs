@@ -274,3 +274,89 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
     );
     assert!(rms < 2.0, "aided fix error in the turn {rms} m RMS");
 }
+
+/// `aided_track`: while the aid is on, the channel runs the narrower aided loops (Doppler noise
+/// of a 2 Hz loop), and when the aid goes it returns to its unaided 15 Hz loops, in lock.
+#[test]
+fn aided_loops_are_used_while_the_aid_is_on() {
+    use gpsrx_receiver::pipeline::tracker::track;
+    use gpsrx_samples::{open_source, SourceConfig};
+    use gpsrx_tracking::{Channel, ChannelConfig, ChannelStart, ChannelState, DopplerAid};
+
+    let dir = tmp();
+    let mut sc = turn_scenario(8.0, 60.0, 1.0); // straight at 30 m/s throughout
+    sc.satellites.cn0_all_dbhz = Some(45.0);
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let report = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    let fs = 2.048e6;
+    let truth_doppler = |prn: u8, t: f64| -> Option<f64> {
+        let sat = sim.satellites.iter().find(|s| s.prn.get() == prn)?;
+        let (a, _) = sim.observe(sat, t - 0.5e-3);
+        let (b, _) = sim.observe(sat, t + 0.5e-3);
+        Some((b.carrier_cycles - a.carrier_cycles) / 1e-3)
+    };
+    let mut cfg = ChannelConfig::default();
+    cfg.track.pll_bw_hz = 15.0;
+    let mut aided = cfg.track;
+    aided.pll_bw_hz = 2.0;
+    cfg.aided_track = Some(aided);
+    let sat = &sim.satellites[0];
+    let (o, _) = sim.observe(sat, 0.0);
+    let (o2, _) = sim.observe(sat, 1e-3);
+    let to_start = (1023.0 - o.chips.rem_euclid(1023.0)) / ((o2.chips - o.chips) / 1e-3) * fs;
+    let start = ChannelStart {
+        prn: sat.prn,
+        code_start_sample: to_start.round() as u64,
+        doppler_hz: truth_doppler(sat.prn.get(), 0.0).unwrap_or(0.0),
+        cn0_dbhz: f64::NAN,
+    };
+    let ch = Channel::new(&start, fs, &cfg).unwrap_or_else(|e| panic!("{e}"));
+    let aid = |prn: u8, t: f64| {
+        (t < 5.0).then(|| DopplerAid {
+            doppler_hz: truth_doppler(prn, t).unwrap_or(0.0),
+            doppler_rate_hz_s: 0.0,
+        })
+    };
+    let mut src =
+        open_source(&SourceConfig::new(report.data_path.clone())).unwrap_or_else(|e| panic!("{e}"));
+    let mut err_aided = Vec::new();
+    let mut err_unaided = Vec::new();
+    let out = track(src.as_mut(), vec![ch], Some(&aid), |_, e| {
+        if e.state != ChannelState::Track {
+            return;
+        }
+        let Some(truth) = truth_doppler(e.prn, e.t_rx_s + 0.5e-3) else {
+            return;
+        };
+        // The hand-over (bit sync) comes at about 2 s; the 2 Hz loop settles within 1 s.
+        if (3.5..4.9).contains(&e.t_rx_s) {
+            err_aided.push(e.doppler_hz - truth);
+        } else if e.t_rx_s > 6.0 {
+            err_unaided.push(e.doppler_hz - truth);
+        }
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    let std = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / v.len().max(1) as f64;
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len().max(1) as f64).sqrt()
+    };
+    let (sa, su) = (std(&err_aided), std(&err_unaided));
+    eprintln!(
+        "NCO Doppler noise: aided 2 Hz loop {sa:.3} Hz ({} epochs), unaided 15 Hz loop {su:.3} Hz ({} epochs)",
+        err_aided.len(),
+        err_unaided.len()
+    );
+    assert!(err_aided.len() > 1000 && err_unaided.len() > 1000);
+    assert!(
+        su > 4.0 * sa,
+        "the aided loop is the narrow one ({sa} vs {su} Hz)"
+    );
+    assert_eq!(
+        out[0].state(),
+        ChannelState::Track,
+        "in lock after the aid went"
+    );
+    assert!(!out[0].aided_loops(), "back on the unaided loops");
+}
