@@ -575,10 +575,9 @@ impl Channel {
         if self.pull_in_ms < min_ms || !self.pll_lock.locked() {
             return;
         }
-        let ff = self.ff_applied_hz.unwrap_or(0.0);
         let loops = self.tracking_loops();
         let (Ok(carrier), Ok(code_loop)) = (
-            CarrierLoop::new(&loops, self.carrier_freq_hz - ff),
+            CarrierLoop::new(&loops, self.carrier.frequency_memory_hz()),
             CodeLoop::new(&loops),
         ) else {
             return; // validated at construction; keep pulling in otherwise
@@ -618,9 +617,8 @@ impl Channel {
             return;
         }
         let loops = self.tracking_loops();
-        let ff = self.ff_applied_hz.unwrap_or(0.0);
         let (Ok(carrier), Ok(code_loop)) = (
-            CarrierLoop::new(&loops, self.carrier_freq_hz - ff),
+            CarrierLoop::new(&loops, self.carrier.frequency_memory_hz()),
             CodeLoop::new(&loops),
         ) else {
             return;

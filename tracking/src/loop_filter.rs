@@ -263,6 +263,11 @@ impl LoopFilter {
         self.x_prev = [0.0; 2];
     }
 
+    /// Whether the filter has an integrator (order >= 2, or an FLL assist).
+    pub fn has_integrator(&self) -> bool {
+        self.n_int > 0
+    }
+
     /// The last integrator's output (the filter's frequency or rate memory), Hz or chips/s; zero
     /// for a 1st-order loop.
     pub fn integrator(&self) -> f64 {
