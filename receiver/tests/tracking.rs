@@ -2,9 +2,15 @@
 
 use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
 use gpsrx_receiver::pipeline::tracker::track;
+use gpsrx_receiver::study::bandwidth::{
+    dll_jitter_chips as dll_sigma_chips, pll_jitter_deg as pll_sigma_deg,
+};
+use gpsrx_receiver::study::if_sim::{
+    self, start_from_truth, std_dev, track_config, ChannelSpec, Truth,
+};
 use gpsrx_samples::sim::{Scenario, SimSatellite, Simulator};
 use gpsrx_samples::{open_source, SourceConfig};
-use gpsrx_tracking::{Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState};
+use gpsrx_tracking::{Channel, ChannelConfig, ChannelEpoch, ChannelState};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -37,30 +43,9 @@ rate_hz = 10.0
     (sim, report.data_path)
 }
 
-/// A channel start from truth: the first code period after sample 0, Doppler off by `df`.
-fn start_from_truth(sim: &Simulator, sat: &SimSatellite, fs: f64, df: f64) -> ChannelStart {
-    let (o, _) = sim.observe(sat, 0.0);
-    let (o2, _) = sim.observe(sat, 1e-3);
-    let rate = (o2.chips - o.chips) / 1e-3;
-    let to_start = (1023.0 - o.chips.rem_euclid(1023.0)) / rate * fs;
-    let doppler = (o2.carrier_cycles - o.carrier_cycles) / 1e-3;
-    ChannelStart {
-        prn: sat.prn,
-        code_start_sample: to_start.round() as u64,
-        doppler_hz: doppler + df,
-        cn0_dbhz: f64::NAN,
-    }
-}
-
-/// One channel per simulated satellite, started from truth.
+/// One channel per simulated satellite, started from truth (the library's helper).
 fn channels_from_truth(sim: &Simulator, fs: f64, cfg: &ChannelConfig) -> Vec<Channel> {
-    sim.satellites
-        .iter()
-        .map(|s| {
-            Channel::new(&start_from_truth(sim, s, fs, 0.0), fs, cfg)
-                .unwrap_or_else(|e| panic!("{e}"))
-        })
-        .collect()
+    if_sim::channels_from_truth(sim, fs, cfg).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn run(
@@ -211,119 +196,61 @@ fn bit_edges_and_bits_match_truth() {
 /// Per (PRN, loop setting): carrier phase errors, code errors, last channel state.
 type ErrorSeries = BTreeMap<(u8, usize), (Vec<f64>, Vec<f64>, ChannelState, Vec<f64>)>;
 
-/// Thermal-noise PLL jitter, degrees (oracles.md, Kaplan eq. 5.6).
-fn pll_sigma_deg(bn_hz: f64, cn0_dbhz: f64, t_s: f64) -> f64 {
-    let cn0 = 10f64.powf(cn0_dbhz / 10.0);
-    (360.0 / (2.0 * std::f64::consts::PI)) * (bn_hz / cn0 * (1.0 + 1.0 / (2.0 * t_s * cn0))).sqrt()
-}
-
-/// DLL jitter for non-coherent early-minus-late power with spacing d, chips (oracles.md).
-fn dll_sigma_chips(bn_hz: f64, d: f64, cn0_dbhz: f64, t_s: f64) -> f64 {
-    let cn0 = 10f64.powf(cn0_dbhz / 10.0);
-    (bn_hz * d / (2.0 * cn0) * (1.0 + 2.0 / (t_s * cn0 * (2.0 - d)))).sqrt()
-}
-
-fn std_dev(v: &[f64]) -> f64 {
-    let m = v.iter().sum::<f64>() / v.len() as f64;
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() as f64 - 1.0)).sqrt()
-}
-
 /// Tracks every satellite of `sim` with each loop configuration (all channels in one pass over
-/// the recording) and returns, per (PRN, config index), the carrier phase error (deg, mean
-/// removed, Costas half-cycle folded) and the code error (chips) against truth after `settle_s`.
+/// the recording, [`if_sim::track_vs_truth`]) and returns, per (PRN, config index), the carrier
+/// phase error (deg, offset and Costas half cycle removed, linear trend removed:
+/// [`if_sim::folded_phase_deg`]), the code error (chips), the last channel state and the
+/// Doppler error (Hz) against truth after `settle_s`.
 fn errors_vs_truth(
     sim: &Simulator,
     data: &Path,
-    fs: f64,
     configs: &[ChannelConfig],
     settle_s: &[f64],
     aid: Option<gpsrx_receiver::pipeline::tracker::AidSource<'_>>,
 ) -> ErrorSeries {
-    let mut channels = Vec::new();
-    let mut ids = Vec::new();
-    for sat in &sim.satellites {
-        for (k, cfg) in configs.iter().enumerate() {
-            channels.push(
-                Channel::new(&start_from_truth(sim, sat, fs, 0.0), fs, cfg)
-                    .unwrap_or_else(|e| panic!("{e}")),
-            );
-            ids.push((sat.prn.get(), k));
-        }
-    }
+    let truth = Truth::new(sim);
+    let specs: Vec<ChannelSpec> = sim
+        .satellites
+        .iter()
+        .flat_map(|sat| {
+            configs.iter().map(move |cfg| ChannelSpec {
+                prn: sat.prn.get(),
+                config: *cfg,
+                doppler_offset_hz: 0.0,
+            })
+        })
+        .collect();
     let mut src =
         open_source(&SourceConfig::new(data.to_path_buf())).unwrap_or_else(|e| panic!("{e}"));
-    let mut raw: ErrorSeries = BTreeMap::new();
-    track(src.as_mut(), channels, aid, |i, e| {
-        let entry = raw
-            .entry(ids[i])
-            .or_insert_with(|| (Vec::new(), Vec::new(), ChannelState::PullIn, Vec::new()));
-        entry.2 = e.state;
-        if e.t_rx_s < settle_s[ids[i].1] || e.state != ChannelState::Track {
-            return;
-        }
-        let sat = sim
-            .satellites
-            .iter()
-            .find(|s| s.prn.get() == e.prn)
-            .unwrap_or_else(|| panic!("prn"));
-        let (o, _) = sim.observe(sat, e.t_rx_s);
-        entry.0.push(e.carrier_phase_cycles - o.carrier_cycles);
-        // Doppler (the NCO frequency over the interval) against the truth carrier rate.
-        let (o2, _) = sim.observe(sat, e.t_rx_s + e.t_coh_s);
-        entry
-            .3
-            .push(e.doppler_hz - (o2.carrier_cycles - o.carrier_cycles) / e.t_coh_s);
-        let mut dcp = e.code_phase_chips - o.chips.rem_euclid(1023.0);
-        if dcp > 511.5 {
-            dcp -= 1023.0;
-        } else if dcp < -511.5 {
-            dcp += 1023.0;
-        }
-        entry.1.push(dcp);
-    })
-    .unwrap_or_else(|e| panic!("{e}"));
-    for v in raw.values_mut() {
-        if v.0.is_empty() {
+    let traces = if_sim::track_vs_truth(src.as_mut(), sim, &truth, &specs, aid)
+        .unwrap_or_else(|e| panic!("{e:#}"));
+    let mut out: ErrorSeries = BTreeMap::new();
+    for tr in traces {
+        let k = tr.spec_index % configs.len();
+        let Some(last) = tr.epochs.last() else {
             continue;
-        }
-        // Remove the mean phase offset (fold into +-0.25 cycle for the Costas ambiguity) and
-        // the slow steady-state error of the satellite's own LOS acceleration (a linear trend).
-        let n = v.0.len() as f64;
-        let m = v.0.iter().sum::<f64>() / n;
-        let folded: Vec<f64> =
-            v.0.iter()
-                .map(|d| (d - m + 0.25).rem_euclid(0.5) - 0.25)
-                .collect();
-        let tm = (n - 1.0) / 2.0;
-        let sxx: f64 = (0..folded.len()).map(|i| (i as f64 - tm).powi(2)).sum();
-        let sxy: f64 = folded
+        };
+        let sel: Vec<_> = tr
+            .epochs
             .iter()
-            .enumerate()
-            .map(|(i, y)| (i as f64 - tm) * y)
-            .sum();
-        let slope = sxy / sxx;
-        let mean = folded.iter().sum::<f64>() / n;
-        v.0 = folded
-            .iter()
-            .enumerate()
-            .map(|(i, y)| (y - mean - slope * (i as f64 - tm)) * 360.0)
+            .filter(|e| e.t_s >= settle_s[k] && e.state == ChannelState::Track)
             .collect();
+        let d: Vec<f64> = sel.iter().map(|e| e.phase_diff_cycles).collect();
+        out.insert(
+            (tr.prn, k),
+            (
+                if_sim::folded_phase_deg(&d, true),
+                sel.iter().map(|e| e.code_error_chips).collect(),
+                last.state,
+                sel.iter().map(|e| e.doppler_error_hz).collect(),
+            ),
+        );
     }
-    raw
+    out
 }
 
 fn loop_cfg(order: u8, bn: f64, t_ms: f64, dll_bn: f64) -> ChannelConfig {
-    let base = ChannelConfig::default();
-    ChannelConfig {
-        track: gpsrx_tracking::LoopConfig {
-            pll_order: order,
-            pll_bw_hz: bn,
-            dll_bw_hz: dll_bn,
-            t_coh_s: t_ms * 1e-3,
-            ..base.track
-        },
-        ..base
-    }
+    track_config(order, bn, t_ms * 1e-3, dll_bn)
 }
 
 #[test]
@@ -360,7 +287,7 @@ fn pll_and_dll_jitter_match_the_thermal_noise_formulas_on_simulated_if() {
         .iter()
         .map(|s| if s.0 == 3 { 8.0 } else { 3.0 })
         .collect();
-    let res = errors_vs_truth(&sim, &report.data_path, fs, &configs, &settle, None);
+    let res = errors_vs_truth(&sim, &report.data_path, &configs, &settle, None);
     let mut table = String::new();
     for ((prn, k), (phase, code, state, doppler)) in &res {
         let (order, bn, t_ms, dll_bn) = settings[*k];
