@@ -6,6 +6,7 @@
 
 pub mod bandwidth;
 pub mod dynamics;
+pub mod if_sim;
 pub mod report;
 pub mod steady_state;
 
