@@ -179,10 +179,16 @@ impl InsFeedForward {
             .unwrap_or(0.0)
     }
 
+    /// Logs `msg` the first time `(prn, what)` happens: why a satellite has no feed-forward at
+    /// info level, the start of a feed-forward at debug level (`-v`).
     fn log_once(&self, prn: u8, what: &'static str, msg: impl FnOnce() -> String) {
         if let Ok(mut l) = self.logged.lock() {
             if l.insert((prn, what)) {
-                tracing::info!("{}", msg());
+                if what == "on" {
+                    tracing::debug!("{}", msg());
+                } else {
+                    tracing::info!("{}", msg());
+                }
             }
         }
     }
