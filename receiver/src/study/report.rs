@@ -203,7 +203,9 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     }
 }
 
-fn plot_err<E: std::error::Error + Send + Sync + 'static>(path: &Path) -> impl FnOnce(E) -> anyhow::Error + '_ {
+fn plot_err<E: std::error::Error + Send + Sync + 'static>(
+    path: &Path,
+) -> impl FnOnce(E) -> anyhow::Error + '_ {
     move |e| anyhow::anyhow!("cannot draw {}: {e}", path.display())
 }
 
@@ -212,8 +214,14 @@ pub fn draw_line_plot(plot: &LinePlot, path: &Path) -> anyhow::Result<()> {
     register_font();
     let root = BitMapBackend::new(path, (1000, 640)).into_drawing_area();
     root.fill(&WHITE).map_err(plot_err(path))?;
-    let xs = plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.0));
-    let ys = plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
+    let xs = plot
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0));
+    let ys = plot
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1));
     let (x0, x1) = range(xs, plot.log_x);
     let (y0, y1) = range(ys, plot.log_y);
     let mut builder = ChartBuilder::on(&root);
@@ -340,7 +348,10 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&w.csv)?, "a,b\n1,-\n");
         let png = std::fs::read(&w.plots[0])?;
         assert_eq!(&png[1..4], b"PNG");
-        assert!(png.len() > 5000, "a plot with text and lines, not a blank image");
+        assert!(
+            png.len() > 5000,
+            "a plot with text and lines, not a blank image"
+        );
         Ok(())
     }
 }
