@@ -1,12 +1,11 @@
 //! INS aiding end to end: the feed-forward Doppler against the simulator's truth, and
 //! `gpsrx run --ins` through a 5 g turn with narrow loops, aided and unaided.
 
-use clap::Parser;
+mod common;
+use common::run;
 use gpsrx_ins_aiding::error_model::InsErrorConfig;
 use gpsrx_ins_aiding::read_ins_csv;
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
-use gpsrx_receiver::cli::{Cli, Command};
-use gpsrx_receiver::commands::run::run_file;
 use gpsrx_receiver::commands::simulate::write_ins_for;
 use gpsrx_receiver::output::Fix;
 use gpsrx_receiver::pipeline::aiding::InsFeedForward;
@@ -137,22 +136,6 @@ fn no_feedforward_without_time_or_ephemeris() {
     assert!(ff.aid(5, 0.05).is_none(), "no GPS time yet");
     ff.set_time_origin(gpsrx_nav::time::GpsTime::new(2190, 538194.0));
     assert!(ff.aid(5, 0.05).is_none(), "no ephemeris for G05");
-}
-
-fn run(data: &Path, out: &Path, extra: &[&str]) -> Vec<Fix> {
-    let mut argv = vec![
-        "gpsrx",
-        "run",
-        data.to_str().unwrap_or_default(),
-        "--out",
-        out.to_str().unwrap_or_default(),
-    ];
-    argv.extend_from_slice(extra);
-    let cli = Cli::try_parse_from(argv).unwrap_or_else(|e| panic!("{e}"));
-    let Command::Run(args) = cli.command else {
-        panic!("not run")
-    };
-    run_file(&args, false).unwrap_or_else(|e| panic!("{e:#}")).1
 }
 
 /// (state, carrier_lock) of every channels.csv row within [t0, t1] s of receive time.

@@ -1,8 +1,7 @@
 //! `gpsrx run` end to end on simulated recordings, against the simulator's truth files.
 
-use clap::Parser;
-use gpsrx_receiver::cli::{Cli, Command};
-use gpsrx_receiver::commands::run::run_file;
+mod common;
+use common::run;
 use gpsrx_receiver::output::Fix;
 use gpsrx_samples::sim::{Scenario, Simulator};
 use std::path::{Path, PathBuf};
@@ -37,22 +36,6 @@ rate_hz = 50.0
     sim.run(dir, &|_| {})
         .unwrap_or_else(|e| panic!("{e}"))
         .data_path
-}
-
-fn run(data: &Path, out: &Path, extra: &[&str]) -> Vec<Fix> {
-    let mut argv = vec![
-        "gpsrx",
-        "run",
-        data.to_str().unwrap_or_default(),
-        "--out",
-        out.to_str().unwrap_or_default(),
-    ];
-    argv.extend_from_slice(extra);
-    let cli = Cli::try_parse_from(argv).unwrap_or_else(|e| panic!("{e}"));
-    let Command::Run(args) = cli.command else {
-        panic!("not run")
-    };
-    run_file(&args, false).unwrap_or_else(|e| panic!("{e:#}")).1
 }
 
 /// Truth rows: (GPS TOW, ECEF position, ECEF velocity).
