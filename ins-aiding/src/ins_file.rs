@@ -359,6 +359,17 @@ impl InsTrack {
     /// (`tow = tow_a + (tow_b - tow_a) (t - t_a) / (t_b - t_a)`, across a week rollover too);
     /// None without a `gps_tow_s` column or outside the file's span.
     pub fn gps_tow_at(&self, t_s: f64) -> Option<f64> {
+        let (a, b) = self.rows_around(t_s)?;
+        let (ta, mut tb) = (a.gps_tow_s?, b.gps_tow_s?);
+        if tb < ta {
+            tb += WEEK_S;
+        }
+        let u = (t_s - a.t_s) / (b.t_s - a.t_s);
+        Some((ta + (tb - ta) * u).rem_euclid(WEEK_S))
+    }
+
+    /// The two rows whose times enclose `t_s`, or None outside the span.
+    fn rows_around(&self, t_s: f64) -> Option<(&InsSample, &InsSample)> {
         let (t0, t1) = self.span_s();
         if !(t0..=t1).contains(&t_s) {
             return None;
@@ -367,13 +378,7 @@ impl InsTrack {
             .samples
             .partition_point(|s| s.t_s <= t_s)
             .clamp(1, self.samples.len() - 1);
-        let (a, b) = (&self.samples[i - 1], &self.samples[i]);
-        let (ta, mut tb) = (a.gps_tow_s?, b.gps_tow_s?);
-        if tb < ta {
-            tb += WEEK_S;
-        }
-        let u = (t_s - a.t_s) / (b.t_s - a.t_s);
-        Some((ta + (tb - ta) * u).rem_euclid(WEEK_S))
+        Some((&self.samples[i - 1], &self.samples[i]))
     }
 
     /// The time span covered, s.
@@ -386,15 +391,7 @@ impl InsTrack {
 
     /// Position and velocity at `t_s`, or None outside the file's span.
     pub fn at(&self, t_s: f64) -> Option<(Vector3<f64>, Vector3<f64>)> {
-        let (t0, t1) = self.span_s();
-        if !(t0..=t1).contains(&t_s) {
-            return None;
-        }
-        let i = self
-            .samples
-            .partition_point(|s| s.t_s <= t_s)
-            .clamp(1, self.samples.len() - 1);
-        let (a, b) = (&self.samples[i - 1], &self.samples[i]);
+        let (a, b) = self.rows_around(t_s)?;
         let h = b.t_s - a.t_s;
         let u = (t_s - a.t_s) / h;
         // Cubic Hermite basis and derivatives.

@@ -2,7 +2,7 @@
 //! `gpsrx run --ins` through a 5 g turn with narrow loops, aided and unaided.
 
 mod common;
-use common::run;
+use common::{run, truth};
 use gpsrx_ins_aiding::error_model::InsErrorConfig;
 use gpsrx_ins_aiding::read_ins_csv;
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
@@ -160,19 +160,8 @@ fn channel_rows(out: &Path, t0_tow: f64, t1_tow: f64) -> Vec<(String, bool)> {
         .collect()
 }
 
-/// Truth rows: (GPS TOW, ECEF position).
-fn truth(dir: &Path) -> Vec<(f64, [f64; 3])> {
-    let mut rdr = csv::Reader::from_path(dir.join("truth.csv")).unwrap_or_else(|e| panic!("{e}"));
-    rdr.deserialize::<std::collections::HashMap<String, f64>>()
-        .map(|r| {
-            let r = r.unwrap_or_else(|e| panic!("{e}"));
-            (r["tow_s"], [r["x_m"], r["y_m"], r["z_m"]])
-        })
-        .collect()
-}
-
 /// 3D error of a fix against truth interpolated at its time.
-fn error_3d_m(f: &Fix, truth: &[(f64, [f64; 3])]) -> f64 {
+fn error_3d_m(f: &Fix, truth: &[(f64, [f64; 3], [f64; 3])]) -> f64 {
     let t = f.time.tow_s;
     let i = truth
         .partition_point(|r| r.0 <= t)

@@ -1,7 +1,7 @@
 //! `gpsrx run` end to end on simulated recordings, against the simulator's truth files.
 
 mod common;
-use common::run;
+use common::{run, truth};
 use gpsrx_receiver::output::Fix;
 use gpsrx_samples::sim::{Scenario, Simulator};
 use std::path::{Path, PathBuf};
@@ -36,22 +36,6 @@ rate_hz = 50.0
     sim.run(dir, &|_| {})
         .unwrap_or_else(|e| panic!("{e}"))
         .data_path
-}
-
-/// Truth rows: (GPS TOW, ECEF position, ECEF velocity).
-fn truth(dir: &Path) -> Vec<(f64, [f64; 3], [f64; 3])> {
-    let mut rdr = csv::Reader::from_path(dir.join("truth.csv")).unwrap_or_else(|e| panic!("{e}"));
-    rdr.deserialize::<std::collections::HashMap<String, f64>>()
-        .map(|r| {
-            let r = r.unwrap_or_else(|e| panic!("{e}"));
-            let g = |k: &str| r[k];
-            (
-                g("tow_s"),
-                [g("x_m"), g("y_m"), g("z_m")],
-                [g("vx_mps"), g("vy_mps"), g("vz_mps")],
-            )
-        })
-        .collect()
 }
 
 /// Horizontal and vertical RMS position error and 3D velocity RMS of the fixes against truth

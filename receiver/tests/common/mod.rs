@@ -22,3 +22,19 @@ pub fn run(data: &Path, out: &Path, extra: &[&str]) -> Vec<Fix> {
     };
     run_file(&args, false).unwrap_or_else(|e| panic!("{e:#}")).1
 }
+
+/// `truth.csv` rows: (GPS TOW, ECEF position, ECEF velocity).
+pub fn truth(dir: &Path) -> Vec<(f64, [f64; 3], [f64; 3])> {
+    let mut rdr = csv::Reader::from_path(dir.join("truth.csv")).unwrap_or_else(|e| panic!("{e}"));
+    rdr.deserialize::<std::collections::HashMap<String, f64>>()
+        .map(|r| {
+            let r = r.unwrap_or_else(|e| panic!("{e}"));
+            let g = |k: &str| r[k];
+            (
+                g("tow_s"),
+                [g("x_m"), g("y_m"), g("z_m")],
+                [g("vx_mps"), g("vy_mps"), g("vz_mps")],
+            )
+        })
+        .collect()
+}
