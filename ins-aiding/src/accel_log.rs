@@ -1,0 +1,117 @@
+//! The accelerometer log (`--accel FILE.csv`): longitudinal specific force at any rate (seed 002).
+//!
+//! Header required, columns in any order, extra columns ignored: `t_s` (seconds from the first IF
+//! sample, strictly increasing) and `a_long_mps2` (longitudinal accelerometer output, m/s^2,
+//! forward positive; on a slope it includes `g sin(pitch)`). Every value must be a finite number;
+//! errors name the file, the line and what to do.
+
+use crate::csv_table::CsvTable;
+use crate::dr_error::DrError;
+use std::io::Write;
+use std::path::Path;
+
+const WHAT: &str = "accelerometer log";
+
+/// One accelerometer output.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct AccelSample {
+    /// Seconds from the first IF sample.
+    pub t_s: f64,
+    /// Longitudinal accelerometer output (specific force), m/s^2.
+    pub a_long_mps2: f64,
+}
+
+/// A validated accelerometer log: at least 2 rows, finite values, `t_s` strictly increasing.
+#[derive(Debug, Clone)]
+pub struct AccelLog {
+    samples: Vec<AccelSample>,
+}
+
+impl AccelLog {
+    /// Checks samples already in memory (e.g. from [`crate::simulate_accel`]) like a file.
+    pub fn from_samples(samples: Vec<AccelSample>) -> Result<AccelLog, DrError> {
+        if samples.len() < 2 {
+            return Err(DrError::Config(format!(
+                "an accelerometer log needs at least 2 samples (found {})",
+                samples.len()
+            )));
+        }
+        for (i, s) in samples.iter().enumerate() {
+            if !(s.t_s.is_finite() && s.a_long_mps2.is_finite()) {
+                return Err(DrError::Config(format!(
+                    "accelerometer sample {i}: t_s and a_long_mps2 must be finite"
+                )));
+            }
+            if i > 0 && s.t_s <= samples[i - 1].t_s {
+                return Err(DrError::Config(format!(
+                    "accelerometer sample {i}: t_s = {} does not increase",
+                    s.t_s
+                )));
+            }
+        }
+        Ok(AccelLog { samples })
+    }
+
+    /// The samples, in time order.
+    pub fn samples(&self) -> &[AccelSample] {
+        &self.samples
+    }
+}
+
+/// Reads and validates an accelerometer log (see the module documentation).
+pub fn read_accel_csv(path: &Path) -> Result<AccelLog, DrError> {
+    let mut table = CsvTable::open(path, WHAT)?;
+    let t_col = table.column("t_s");
+    let a_col = table.column("a_long_mps2");
+    let (Some(t_col), Some(a_col)) = (t_col, a_col) else {
+        return Err(table.header_error(
+            "the header must name t_s and a_long_mps2 (longitudinal acceleration, m/s^2)".into(),
+        ));
+    };
+    let mut samples: Vec<AccelSample> = Vec::new();
+    let mut last_line = table.header_line();
+    table.for_each_row(|row| {
+        last_line = row.line;
+        let t_s = row.number(t_col, "t_s")?;
+        let a_long_mps2 = row.number(a_col, "a_long_mps2")?;
+        if let Some(last) = samples.last() {
+            if t_s <= last.t_s {
+                return Err(row.error(format!(
+                    "t_s = {t_s} does not increase (previous {}): sort the file by t_s and remove duplicate rows",
+                    last.t_s
+                )));
+            }
+        }
+        samples.push(AccelSample { t_s, a_long_mps2 });
+        Ok(())
+    })?;
+    if samples.len() < 2 {
+        return Err(table.error(
+            last_line,
+            format!(
+                "an accelerometer log needs at least 2 rows (found {})",
+                samples.len()
+            ),
+        ));
+    }
+    Ok(AccelLog { samples })
+}
+
+/// Writes samples as an accelerometer log [`read_accel_csv`] reads back (`t_s,a_long_mps2`, to
+/// 1e-9).
+pub fn write_accel_csv(path: &Path, samples: &[AccelSample]) -> Result<(), DrError> {
+    let p = path.display().to_string();
+    let werr = |message: String| DrError::Write {
+        what: WHAT,
+        path: p.clone(),
+        message,
+    };
+    let f = std::fs::File::create(path).map_err(|e| werr(e.to_string()))?;
+    let mut w = std::io::BufWriter::new(f);
+    let io = |e: std::io::Error| werr(e.to_string());
+    writeln!(w, "t_s,a_long_mps2").map_err(io)?;
+    for s in samples {
+        writeln!(w, "{:.9},{:.9}", s.t_s, s.a_long_mps2).map_err(io)?;
+    }
+    w.flush().map_err(io)
+}

@@ -1,0 +1,252 @@
+//! The dead-reckoning log (`--dr FILE.csv`): a yaw-rate gyro and an odometer (seed 000).
+//!
+//! Header required, columns in any order, extra columns ignored. `t_s` (seconds from the first IF
+//! sample, strictly increasing) and either
+//! - raw sensor outputs as in seed 000: `gyro_v` (gyro output voltage averaged over the interval
+//!   since the previous row, V) and `odo_pulses` (odometer pulses counted since the previous row,
+//!   `>= 0`; a fraction is allowed for interpolated logs), or
+//! - engineering units: `yaw_rate_dps` (heading rate, clockwise positive, mean over the interval
+//!   since the previous row, deg/s) and `speed_mps` (mean speed over that interval, m/s, `>= 0`).
+//!
+//! Which one is detected from the header; a file with both sets is refused (say which you mean by
+//! deleting the other pair). The first row's interval values are not used (there is no previous
+//! row). Every value must be a finite number; errors name the file, the line and what to do.
+//! The nominal sensor parameters (`Sf_G` deg/s/V, `V_nom` V, `Sf_N` m/pulse) are not in the file:
+//! they come from the configuration ([`crate::DrParams`]).
+
+use crate::csv_table::CsvTable;
+use crate::dr_error::DrError;
+use std::io::Write;
+use std::path::Path;
+
+const WHAT: &str = "DR log";
+
+/// One DR sensor reading, for the interval since the previous sample.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum DrReading {
+    /// Raw outputs (seed 000 eqs. 2-3).
+    Raw {
+        /// Gyro output voltage, mean over the interval, V.
+        gyro_v: f64,
+        /// Odometer pulses counted over the interval.
+        odo_pulses: f64,
+    },
+    /// Engineering units.
+    Engineering {
+        /// Heading rate (clockwise from north positive), mean over the interval, deg/s.
+        yaw_rate_dps: f64,
+        /// Speed, mean over the interval, m/s.
+        speed_mps: f64,
+    },
+}
+
+impl DrReading {
+    /// True for [`DrReading::Raw`].
+    pub fn is_raw(&self) -> bool {
+        matches!(self, DrReading::Raw { .. })
+    }
+
+    fn check(&self) -> Result<(), String> {
+        match *self {
+            DrReading::Raw { gyro_v, odo_pulses } => {
+                if !gyro_v.is_finite() || !odo_pulses.is_finite() {
+                    return Err("gyro_v and odo_pulses must be finite numbers".into());
+                }
+                if odo_pulses < 0.0 {
+                    return Err(format!(
+                        "odo_pulses = {odo_pulses} is negative: give the pulse count since the previous row (>= 0)"
+                    ));
+                }
+            }
+            DrReading::Engineering {
+                yaw_rate_dps,
+                speed_mps,
+            } => {
+                if !yaw_rate_dps.is_finite() || !speed_mps.is_finite() {
+                    return Err("yaw_rate_dps and speed_mps must be finite numbers".into());
+                }
+                if speed_mps < 0.0 {
+                    return Err(format!(
+                        "speed_mps = {speed_mps} is negative: the odometer speed is a magnitude (>= 0)"
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One row of a DR log.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DrSample {
+    /// Seconds from the first IF sample (end of the interval the reading covers).
+    pub t_s: f64,
+    /// The sensor outputs over the interval since the previous row.
+    pub reading: DrReading,
+}
+
+/// A validated DR log: at least 2 rows, `t_s` finite and strictly increasing, one kind of reading
+/// (all raw or all engineering), finite values, no negative pulse count or speed.
+#[derive(Debug, Clone)]
+pub struct DrLog {
+    samples: Vec<DrSample>,
+}
+
+impl DrLog {
+    /// Checks samples already in memory (e.g. from [`crate::simulate_dr`]) like a file.
+    pub fn from_samples(samples: Vec<DrSample>) -> Result<DrLog, DrError> {
+        if samples.len() < 2 {
+            return Err(DrError::Config(format!(
+                "a DR log needs at least 2 samples (found {})",
+                samples.len()
+            )));
+        }
+        let raw = samples[0].reading.is_raw();
+        for (i, s) in samples.iter().enumerate() {
+            let bad = |m: String| Err(DrError::Config(format!("DR sample {i}: {m}")));
+            if !s.t_s.is_finite() {
+                return bad(format!("t_s = {} is not finite", s.t_s));
+            }
+            if let Err(m) = s.reading.check() {
+                return bad(m);
+            }
+            if s.reading.is_raw() != raw {
+                return bad("raw and engineering readings are mixed: use one kind".into());
+            }
+            if i > 0 && s.t_s <= samples[i - 1].t_s {
+                return bad(format!(
+                    "t_s = {} does not increase (previous {})",
+                    s.t_s,
+                    samples[i - 1].t_s
+                ));
+            }
+        }
+        Ok(DrLog { samples })
+    }
+
+    /// The samples, in time order.
+    pub fn samples(&self) -> &[DrSample] {
+        &self.samples
+    }
+
+    /// True when the log holds raw `gyro_v`/`odo_pulses` readings.
+    pub fn is_raw(&self) -> bool {
+        self.samples[0].reading.is_raw()
+    }
+
+    /// First and last `t_s`.
+    pub fn time_span_s(&self) -> (f64, f64) {
+        (
+            self.samples[0].t_s,
+            self.samples[self.samples.len() - 1].t_s,
+        )
+    }
+}
+
+/// Reads and validates a DR log (see the module documentation for the format).
+pub fn read_dr_csv(path: &Path) -> Result<DrLog, DrError> {
+    let mut table = CsvTable::open(path, WHAT)?;
+    let t_col = table.column("t_s").ok_or_else(|| {
+        table.header_error(
+            "no column `t_s`: the header must name t_s and either gyro_v,odo_pulses (raw) or yaw_rate_dps,speed_mps (engineering units)".into(),
+        )
+    })?;
+    let raw_cols = (table.column("gyro_v"), table.column("odo_pulses"));
+    let eng_cols = (table.column("yaw_rate_dps"), table.column("speed_mps"));
+    let (raw, a, b) = match (raw_cols, eng_cols) {
+        ((Some(_), Some(_)), (Some(_), _) | (_, Some(_))) => {
+            return Err(table.header_error(
+                "both raw (gyro_v, odo_pulses) and engineering (yaw_rate_dps, speed_mps) columns: keep one pair".into(),
+            ))
+        }
+        ((Some(g), Some(o)), _) => (true, g, o),
+        (_, (Some(y), Some(s))) => (false, y, s),
+        _ => {
+            return Err(table.header_error(
+                "the header needs gyro_v and odo_pulses (raw sensor outputs) or yaw_rate_dps and speed_mps (engineering units)".into(),
+            ))
+        }
+    };
+    let (na, nb) = if raw {
+        ("gyro_v", "odo_pulses")
+    } else {
+        ("yaw_rate_dps", "speed_mps")
+    };
+    let mut samples: Vec<DrSample> = Vec::new();
+    let mut last_line = table.header_line();
+    table.for_each_row(|row| {
+        last_line = row.line;
+        let t_s = row.number(t_col, "t_s")?;
+        let x = row.number(a, na)?;
+        let y = row.number(b, nb)?;
+        let reading = if raw {
+            DrReading::Raw {
+                gyro_v: x,
+                odo_pulses: y,
+            }
+        } else {
+            DrReading::Engineering {
+                yaw_rate_dps: x,
+                speed_mps: y,
+            }
+        };
+        reading.check().map_err(|m| row.error(m))?;
+        if let Some(last) = samples.last() {
+            if t_s <= last.t_s {
+                return Err(row.error(format!(
+                    "t_s = {t_s} does not increase (previous {}): sort the file by t_s and remove duplicate rows",
+                    last.t_s
+                )));
+            }
+        }
+        samples.push(DrSample { t_s, reading });
+        Ok(())
+    })?;
+    if samples.len() < 2 {
+        return Err(table.error(
+            last_line,
+            format!(
+                "a DR log needs at least 2 rows (found {}): log the sensors over the whole drive",
+                samples.len()
+            ),
+        ));
+    }
+    Ok(DrLog { samples })
+}
+
+/// Writes samples as a DR log [`read_dr_csv`] reads back: `t_s,gyro_v,odo_pulses` or
+/// `t_s,yaw_rate_dps,speed_mps` after the kind of the first sample (all must be of that kind);
+/// times to 1e-9 s, voltages to 1e-9 V, pulses and rates to 1e-9.
+pub fn write_dr_csv(path: &Path, samples: &[DrSample]) -> Result<(), DrError> {
+    let p = path.display().to_string();
+    let werr = |message: String| DrError::Write {
+        what: WHAT,
+        path: p.clone(),
+        message,
+    };
+    let raw = samples.first().is_none_or(|s| s.reading.is_raw());
+    if let Some(i) = samples.iter().position(|s| s.reading.is_raw() != raw) {
+        return Err(werr(format!(
+            "sample {i} is of another kind (raw/engineering) than the first: a log holds one kind"
+        )));
+    }
+    let f = std::fs::File::create(path).map_err(|e| werr(e.to_string()))?;
+    let mut w = std::io::BufWriter::new(f);
+    let io = |e: std::io::Error| werr(e.to_string());
+    if raw {
+        writeln!(w, "t_s,gyro_v,odo_pulses").map_err(io)?;
+    } else {
+        writeln!(w, "t_s,yaw_rate_dps,speed_mps").map_err(io)?;
+    }
+    for s in samples {
+        let (a, b) = match s.reading {
+            DrReading::Raw { gyro_v, odo_pulses } => (gyro_v, odo_pulses),
+            DrReading::Engineering {
+                yaw_rate_dps,
+                speed_mps,
+            } => (yaw_rate_dps, speed_mps),
+        };
+        writeln!(w, "{:.9},{a:.9},{b:.9}", s.t_s).map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
