@@ -22,6 +22,16 @@
 //!   [`AccelSensorConfig`] (bias, vibration, slope `g sin(pitch)`) and [`simulate_accel`];
 //! - [`dr_mechanization`]: [`DrParams`] (`Sf_G`, `V_nom`, `Sf_N`; `load`/`save` as TOML) and
 //!   [`DrMechanization`] (seed 000 eqs. 1-3) producing [`DrState`];
+//! - [`dr_filter`]: [`DrFusion`] with [`DrFilterKind::Proposed8`] (seed 000 eqs. 5-14: position,
+//!   velocity, heading, `Sf_G`, `V_nom`, `Sf_N` errors; GNSS position and velocity updates) or
+//!   [`DrFilterKind::Conventional4`] (eq. 7: position, heading, `Sf_N`; position updates only),
+//!   closed loop: `new(kind, params, east_m, north_m, heading_rad, DrFilterConfig)`,
+//!   `propagate(&DrSample)`, `update_position(e, n, cov)`, `update_velocity(ve, vn, cov)`,
+//!   `state()`, `params()`, `covariance()`, `fix_source(max_age_s)` -> [`FixSource`];
+//!   [`heading_from_velocity`] initialises the heading from the GNSS course;
+//! - [`speed_filter`]: seed 002's [`AccelSmoother`] (KF1) and [`SpeedFilter`] (KF2:
+//!   `predict(a_long_mps2, dt)`, `update_speed(v_mps, sigma)`, `speed_mps()`), and the
+//!   [`HoldLastSpeed`] baseline.
 //!
 //! Errors of all the DR parts are [`DrError`]; every log error names its file and line.
 //! This crate depends on no other gpsrx crate: satellite states come in as plain vectors.
@@ -30,17 +40,23 @@ pub mod accel_log;
 pub mod band_limiter;
 mod csv_table;
 pub mod dr_error;
+pub mod dr_filter;
 pub mod dr_log;
 pub mod dr_mechanization;
 pub mod dr_sensors;
 pub mod error_model;
 pub mod feedforward;
 pub mod ins_file;
+pub mod speed_filter;
 pub mod vehicle;
 
 pub use accel_log::{read_accel_csv, write_accel_csv, AccelLog, AccelSample};
 pub use band_limiter::BandLimiter;
 pub use dr_error::DrError;
+pub use dr_filter::{
+    heading_from_velocity, row_model, DrFilterConfig, DrFilterKind, DrFusion, FixSource,
+    MIN_COURSE_SPEED_MPS,
+};
 pub use dr_log::{read_dr_csv, write_dr_csv, DrLog, DrReading, DrSample};
 pub use dr_mechanization::{dr_step, DrMechanization, DrParams, DrState, DrStep};
 pub use dr_sensors::{
@@ -50,4 +66,5 @@ pub use dr_sensors::{
 pub use error_model::{simulate_ins, InsErrorConfig, TruthState};
 pub use feedforward::{los_doppler_hz, LAMBDA_L1_M};
 pub use ins_file::{read_ins_csv, write_ins_csv, InsError, InsSample, InsTrack};
+pub use speed_filter::{AccelSmoother, HoldLastSpeed, SpeedFilter, SpeedFilterConfig};
 pub use vehicle::{interpolate_truth, validate_truth, wrap_pi, VehicleTruth};
