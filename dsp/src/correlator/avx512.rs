@@ -1,0 +1,443 @@
+//! AVX-512 (F+BW) kernels: 16 samples per vector step; the structure of [`super::avx2`].
+//!
+//! Differences: the code-phase carry is an unsigned compare into a mask register and a masked
+//! subtract; the f32 sign flip and the XOR fuse into one `vpternlogd`; the int16 kernel selects
+//! `w` or `-w` per lane with the chip mask instead of the XOR/count correction.
+
+use super::kernel::{Arithmetic, SampleSlice};
+use super::packed::PackedCode;
+use super::plan::{code_window, natural, CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
+use super::scalar::Q14;
+use super::ReplicaState;
+use num_complex::Complex32;
+use std::arch::x86_64::*;
+
+const L: usize = 16;
+const CF32: u8 = 0;
+const CI16: u8 = 1;
+const CI8: u8 = 2;
+/// Lane order of the cf32 deinterleave (`vshufps` within each 128-bit quarter).
+const CF32_ORDER: [usize; L] = [0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15];
+
+const fn bytes_per_sample(f: u8) -> usize {
+    match f {
+        CF32 => 8,
+        CI16 => 4,
+        _ => 2,
+    }
+}
+
+/// Proof that the CPU runs AVX-512 F and BW (and AVX2, FMA): only [`Avx512Kernel::new`]
+/// makes one.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Avx512Kernel(());
+
+/// Everything a kernel needs besides the samples.
+struct Job<'a> {
+    code: &'a PackedCode,
+    nco: CodeNco,
+    lane_lo: [u32; L],
+    lane_hi: [u32; L],
+    carrier: CarrierNco,
+    order: [usize; L],
+}
+
+macro_rules! by_taps {
+    ($nt:expr, $f:ident::<$fmt:ident>($($arg:expr),*)) => {
+        match $nt {
+            1 => $f::<$fmt, 1>($($arg),*),
+            2 => $f::<$fmt, 2>($($arg),*),
+            3 => $f::<$fmt, 3>($($arg),*),
+            4 => $f::<$fmt, 4>($($arg),*),
+            5 => $f::<$fmt, 5>($($arg),*),
+            6 => $f::<$fmt, 6>($($arg),*),
+            7 => $f::<$fmt, 7>($($arg),*),
+            _ => $f::<$fmt, 8>($($arg),*),
+        }
+    };
+}
+
+impl Avx512Kernel {
+    /// The kernel if this CPU has AVX-512 F and BW, AVX2 and FMA.
+    pub fn new() -> Option<Self> {
+        (is_x86_feature_detected!("avx512f")
+            && is_x86_feature_detected!("avx512bw")
+            && is_x86_feature_detected!("avx2")
+            && is_x86_feature_detected!("fma"))
+        .then_some(Self(()))
+    }
+
+    /// Runs the kernel for `taps.len()` (1..=8) taps; `false` (nothing written) if the code
+    /// step is too large for the 32-bit code window, and the caller must fall back.
+    #[allow(clippy::too_many_arguments)]
+    pub fn correlate(
+        self,
+        arithmetic: Arithmetic,
+        samples: SampleSlice<'_>,
+        fs_hz: f64,
+        code: &PackedCode,
+        state: &ReplicaState,
+        taps: &[f64],
+        out: &mut [Complex32],
+    ) -> bool {
+        let nt = taps.len();
+        if nt == 0 {
+            return true;
+        }
+        let order = match samples {
+            SampleSlice::Cf32(_) => CF32_ORDER,
+            _ => natural::<L>(),
+        };
+        let nco = CodeNco::new(state, fs_hz, taps);
+        let Some((lane_lo, lane_hi)) = nco.lanes(&order) else {
+            return false;
+        };
+        let job = Job {
+            code,
+            nco,
+            lane_lo,
+            lane_hi,
+            carrier: CarrierNco::new(state, fs_hz),
+            order,
+        };
+        // SAFETY (all calls): `self` exists only if AVX-512 F/BW, AVX2 and FMA were detected at
+        // run time; the pointer and length come from one slice of the named format.
+        unsafe {
+            match (arithmetic, samples) {
+                (Arithmetic::I16, SampleSlice::Ci16(x)) => {
+                    by_taps!(
+                        nt,
+                        i16_kernel::<CI16>(x.as_ptr().cast(), x.len(), &job, out)
+                    )
+                }
+                (Arithmetic::I16, SampleSlice::Ci8(x)) => {
+                    by_taps!(nt, i16_kernel::<CI8>(x.as_ptr().cast(), x.len(), &job, out))
+                }
+                (_, SampleSlice::Cf32(x)) => {
+                    by_taps!(
+                        nt,
+                        f32_kernel::<CF32>(x.as_ptr().cast(), x.len(), &job, out)
+                    )
+                }
+                (Arithmetic::F32, SampleSlice::Ci16(x)) => {
+                    by_taps!(
+                        nt,
+                        f32_kernel::<CI16>(x.as_ptr().cast(), x.len(), &job, out)
+                    )
+                }
+                (Arithmetic::F32, SampleSlice::Ci8(x)) => {
+                    by_taps!(nt, f32_kernel::<CI8>(x.as_ptr().cast(), x.len(), &job, out))
+                }
+            }
+        }
+        true
+    }
+}
+
+/// Sign-extends the low and high i16 halves of each 32-bit lane (ci16 I/Q) to f32.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+fn ci16_to_f32(v: __m512i) -> (__m512, __m512) {
+    let re = _mm512_srai_epi32::<16>(_mm512_slli_epi32::<16>(v));
+    let im = _mm512_srai_epi32::<16>(v);
+    (_mm512_cvtepi32_ps(re), _mm512_cvtepi32_ps(im))
+}
+
+/// Loads 16 samples as f32 re and im vectors (lane order of the format).
+///
+/// # Safety
+/// `p` must point to 16 readable samples of format `F`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+unsafe fn load_f32<const F: u8>(p: *const u8) -> (__m512, __m512) {
+    // SAFETY: the caller guarantees 16 samples (128, 64 or 32 bytes) at p; loads are unaligned.
+    unsafe {
+        match F {
+            CF32 => {
+                let a = _mm512_loadu_ps(p.cast());
+                let b = _mm512_loadu_ps(p.cast::<f32>().add(16));
+                (
+                    _mm512_shuffle_ps::<0x88>(a, b),
+                    _mm512_shuffle_ps::<0xDD>(a, b),
+                )
+            }
+            CI16 => ci16_to_f32(_mm512_loadu_si512(p.cast())),
+            _ => ci16_to_f32(_mm512_cvtepi8_epi16(_mm256_loadu_si256(p.cast()))),
+        }
+    }
+}
+
+/// Loads 16 samples as 32 interleaved i16 (sample order).
+///
+/// # Safety
+/// `p` must point to 16 readable samples of format `F` (ci16 or ci8).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+unsafe fn load_i16<const F: u8>(p: *const u8) -> __m512i {
+    // SAFETY: as for `load_f32`.
+    unsafe {
+        if F == CI16 {
+            _mm512_loadu_si512(p.cast())
+        } else {
+            _mm512_cvtepi8_epi16(_mm256_loadu_si256(p.cast()))
+        }
+    }
+}
+
+/// The rotator state: phasors `p` and step phasors `d` (re, im vectors).
+struct Rotator {
+    pr: __m512,
+    pi: __m512,
+    dr: __m512,
+    di: __m512,
+}
+
+impl Rotator {
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+    fn seed(c: &CarrierNco, k0: usize, order: &[usize; L], scale: f64) -> Self {
+        let s = c.seed::<L>(k0, order, scale);
+        // SAFETY: each array holds exactly 16 f32.
+        unsafe {
+            Self {
+                pr: _mm512_loadu_ps(s.p_re.as_ptr()),
+                pi: _mm512_loadu_ps(s.p_im.as_ptr()),
+                dr: _mm512_loadu_ps(s.d_re.as_ptr()),
+                di: _mm512_loadu_ps(s.d_im.as_ptr()),
+            }
+        }
+    }
+
+    /// `p *= d`, and `d *= q` when chirping.
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+    fn advance(&mut self, chirp: bool, qr: __m512, qi: __m512) {
+        let pr = _mm512_fmsub_ps(self.pr, self.dr, _mm512_mul_ps(self.pi, self.di));
+        self.pi = _mm512_fmadd_ps(self.pr, self.di, _mm512_mul_ps(self.pi, self.dr));
+        self.pr = pr;
+        if chirp {
+            let dr = _mm512_fmsub_ps(self.dr, qr, _mm512_mul_ps(self.di, qi));
+            self.di = _mm512_fmadd_ps(self.dr, qi, _mm512_mul_ps(self.di, qr));
+            self.dr = dr;
+        }
+    }
+}
+
+/// Per-lane code constants: `(o_j S) mod 2^32` and the shift base `31 - (o_j S >> 32)`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+fn code_lanes(job: &Job<'_>) -> (__m512i, __m512i) {
+    let mut base = [0i32; L];
+    for (b, &h) in base.iter_mut().zip(&job.lane_hi) {
+        *b = 31 - h as i32;
+    }
+    // SAFETY: both arrays hold exactly 16 i32/u32.
+    unsafe {
+        (
+            _mm512_loadu_si512(job.lane_lo.as_ptr().cast()),
+            _mm512_loadu_si512(base.as_ptr().cast()),
+        )
+    }
+}
+
+/// Each lane's chip bit of the tap at phase `b` (2^-32 chip), shifted into bit 31 (lower bits
+/// are other chips).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+fn chip_bits(bits: &PackedCode, b: u64, lane_lo: __m512i, sh_base: __m512i) -> __m512i {
+    // SAFETY: b < 1023 * 2^32, so the chip index is < 1023 and the packed code is long enough.
+    let w = unsafe { code_window(bits.bits().as_ptr(), (b >> 32) as usize) };
+    let sum = _mm512_add_epi32(_mm512_set1_epi32(b as u32 as i32), lane_lo);
+    let carry = _mm512_cmplt_epu32_mask(sum, lane_lo);
+    let shift = _mm512_mask_sub_epi32(sh_base, carry, sh_base, _mm512_set1_epi32(1));
+    _mm512_sllv_epi32(_mm512_set1_epi32(w as i32), shift)
+}
+
+/// The samples of step `s` (`full` whole steps in `data`, then the zero-padded tail).
+///
+/// # Safety
+/// `data` must hold `full * L` samples of `bps` bytes.
+#[inline(always)]
+unsafe fn step_ptr(data: *const u8, s: usize, full: usize, bps: usize, tail: &[u8]) -> *const u8 {
+    if s < full {
+        // SAFETY: step s < full lies inside the slice.
+        unsafe { data.add(s * L * bps) }
+    } else {
+        tail.as_ptr()
+    }
+}
+
+/// The zero-padded copy of the last `n % L` samples.
+///
+/// # Safety
+/// `data` must hold `n` samples of `bps` bytes.
+#[inline(always)]
+unsafe fn tail_copy(data: *const u8, n: usize, bps: usize) -> [u8; L * 8] {
+    let mut tail = [0u8; L * 8];
+    let full = n / L;
+    // SAFETY: the last n % L samples lie inside the slice; the buffer holds 16 cf32 samples.
+    unsafe {
+        std::ptr::copy_nonoverlapping(data.add(full * L * bps), tail.as_mut_ptr(), (n % L) * bps)
+    };
+    tail
+}
+
+/// The f32 kernel for format `F` and `NT` taps.
+///
+/// # Safety
+/// `data` must hold `n` samples of format `F`; `out.len() >= NT`.
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+unsafe fn f32_kernel<const F: u8, const NT: usize>(
+    data: *const u8,
+    n: usize,
+    job: &Job<'_>,
+    out: &mut [Complex32],
+) {
+    let bps = bytes_per_sample(F);
+    let (full, total) = (n / L, n.div_ceil(L));
+    // SAFETY: forwarded from the caller.
+    let tail = unsafe { tail_copy(data, n, bps) };
+    let (lane_lo, sh_base) = code_lanes(job);
+    let sign = _mm512_set1_epi32(i32::MIN);
+    let chirp = job.carrier.chirps();
+    let (q_re, q_im) = job.carrier.chirp::<L>();
+    let (qr, qi) = (_mm512_set1_ps(q_re), _mm512_set1_ps(q_im));
+    let step = job.nco.step * L as u64;
+    let mut base = [0u64; NT];
+    base.copy_from_slice(&job.nco.phases[..NT]);
+    let mut acc_re = [_mm512_setzero_ps(); NT];
+    let mut acc_im = [_mm512_setzero_ps(); NT];
+    let mut rot = Rotator::seed(&job.carrier, 0, &job.order, 1.0);
+    for s in 0..total {
+        if s % RESEED_STEPS == 0 && s > 0 {
+            rot = Rotator::seed(&job.carrier, s * L, &job.order, 1.0);
+        }
+        // SAFETY: step_ptr yields 16 readable samples (slice or tail buffer).
+        let (xr, xi) = unsafe { load_f32::<F>(step_ptr(data, s, full, bps, &tail)) };
+        let wr = _mm512_castps_si512(_mm512_fmsub_ps(xr, rot.pr, _mm512_mul_ps(xi, rot.pi)));
+        let wi = _mm512_castps_si512(_mm512_fmadd_ps(xr, rot.pi, _mm512_mul_ps(xi, rot.pr)));
+        rot.advance(chirp, qr, qi);
+        for t in 0..NT {
+            let bits = chip_bits(job.code, base[t], lane_lo, sh_base);
+            // w ^ (bits & sign): imm 0x78 is a ^ (b & c).
+            let fr = _mm512_ternarylogic_epi32::<0x78>(wr, bits, sign);
+            let fi = _mm512_ternarylogic_epi32::<0x78>(wi, bits, sign);
+            acc_re[t] = _mm512_add_ps(acc_re[t], _mm512_castsi512_ps(fr));
+            acc_im[t] = _mm512_add_ps(acc_im[t], _mm512_castsi512_ps(fi));
+            let b = base[t] + step;
+            base[t] = if b >= CODE_LEN_FIX {
+                b - CODE_LEN_FIX
+            } else {
+                b
+            };
+        }
+    }
+    for t in 0..NT {
+        out[t] = Complex32::new(hsum(acc_re[t]) as f32, hsum(acc_im[t]) as f32);
+    }
+}
+
+/// Sum of the 16 lanes in f64.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+fn hsum(v: __m512) -> f64 {
+    let mut a = [0f32; L];
+    // SAFETY: `a` holds 16 f32.
+    unsafe { _mm512_storeu_ps(a.as_mut_ptr(), v) };
+    a.iter().map(|&x| f64::from(x)).sum()
+}
+
+/// Sum of the 16 i32 lanes.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+fn hsum_i(v: __m512i) -> i64 {
+    let mut a = [0i32; L];
+    // SAFETY: `a` holds 16 i32.
+    unsafe { _mm512_storeu_si512(a.as_mut_ptr().cast(), v) };
+    a.iter().map(|&x| i64::from(x)).sum()
+}
+
+/// The int16 kernel for format `F` (ci16 or ci8) and `NT` taps; the scaling of
+/// [`super::avx2`]'s (|w| <= 2^22, ci16 rounded to multiples of 2^8), i32 sums flushed to i64
+/// every 256 steps.
+///
+/// # Safety
+/// `data` must hold `n` samples of format `F`; `out.len() >= NT`.
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+unsafe fn i16_kernel<const F: u8, const NT: usize>(
+    data: *const u8,
+    n: usize,
+    job: &Job<'_>,
+    out: &mut [Complex32],
+) {
+    let bps = bytes_per_sample(F);
+    let (full, total) = (n / L, n.div_ceil(L));
+    // SAFETY: forwarded from the caller.
+    let tail = unsafe { tail_copy(data, n, bps) };
+    let (lane_lo, sh_base) = code_lanes(job);
+    let chirp = job.carrier.chirps();
+    let (q_re, q_im) = job.carrier.chirp::<L>();
+    let (qr, qi) = (_mm512_set1_ps(q_re), _mm512_set1_ps(q_im));
+    // packs_epi32(c, s) holds [c0 c1 c2 c3 s0 s1 s2 s3] per 128-bit quarter.
+    let to_cs = _mm512_broadcast_i32x4(_mm_setr_epi8(
+        0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15,
+    ));
+    let to_sc = _mm512_broadcast_i32x4(_mm_setr_epi8(
+        8, 9, 0, 1, 10, 11, 2, 3, 12, 13, 4, 5, 14, 15, 6, 7,
+    ));
+    let round = _mm512_set1_epi32(128);
+    let step = job.nco.step * L as u64;
+    let mut base = [0u64; NT];
+    base.copy_from_slice(&job.nco.phases[..NT]);
+    let zero = _mm512_setzero_si512();
+    let (mut acc_re, mut acc_im) = ([zero; NT], [zero; NT]);
+    let mut sums = [(0i64, 0i64); NT];
+    let scale = f64::from(Q14);
+    let mut rot = Rotator::seed(&job.carrier, 0, &job.order, scale);
+    for s in 0..total {
+        if s % RESEED_STEPS == 0 && s > 0 {
+            rot = Rotator::seed(&job.carrier, s * L, &job.order, scale);
+            for t in 0..NT {
+                sums[t].0 += hsum_i(acc_re[t]);
+                sums[t].1 += hsum_i(acc_im[t]);
+                (acc_re[t], acc_im[t]) = (zero, zero);
+            }
+        }
+        // SAFETY: step_ptr yields 16 readable samples (slice or tail buffer).
+        let x = unsafe { load_i16::<F>(step_ptr(data, s, full, bps, &tail)) };
+        let cs = _mm512_packs_epi32(_mm512_cvtps_epi32(rot.pr), _mm512_cvtps_epi32(rot.pi));
+        let cs_pairs = _mm512_shuffle_epi8(cs, to_cs);
+        // Negate the odd i16 (the sine): [c, -s] pairs.
+        let pair_re = _mm512_mask_sub_epi16(cs_pairs, 0xAAAA_AAAA, zero, cs_pairs);
+        let pair_im = _mm512_shuffle_epi8(cs, to_sc);
+        let mut wr = _mm512_madd_epi16(x, pair_re);
+        let mut wi = _mm512_madd_epi16(x, pair_im);
+        if F == CI16 {
+            wr = _mm512_srai_epi32::<8>(_mm512_add_epi32(wr, round));
+            wi = _mm512_srai_epi32::<8>(_mm512_add_epi32(wi, round));
+        }
+        let (nwr, nwi) = (_mm512_sub_epi32(zero, wr), _mm512_sub_epi32(zero, wi));
+        rot.advance(chirp, qr, qi);
+        for t in 0..NT {
+            let neg = _mm512_cmplt_epi32_mask(chip_bits(job.code, base[t], lane_lo, sh_base), zero);
+            acc_re[t] = _mm512_add_epi32(acc_re[t], _mm512_mask_mov_epi32(wr, neg, nwr));
+            acc_im[t] = _mm512_add_epi32(acc_im[t], _mm512_mask_mov_epi32(wi, neg, nwi));
+            let b = base[t] + step;
+            base[t] = if b >= CODE_LEN_FIX {
+                b - CODE_LEN_FIX
+            } else {
+                b
+            };
+        }
+    }
+    let unit = if F == CI16 {
+        256.0 / scale
+    } else {
+        1.0 / scale
+    };
+    for t in 0..NT {
+        let re = sums[t].0 + hsum_i(acc_re[t]);
+        let im = sums[t].1 + hsum_i(acc_im[t]);
+        out[t] = Complex32::new((re as f64 * unit) as f32, (im as f64 * unit) as f32);
+    }
+}

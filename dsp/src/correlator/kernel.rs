@@ -1,0 +1,228 @@
+//! The run-time chosen correlator: [`Isa`] x [`Arithmetic`], sample formats read directly.
+//!
+//! As in RustFFT, a SIMD kernel is a distinct private type that only its CPU check constructs,
+//! so every call into `#[target_feature]` code rests on a fact the type proves; a [`Correlator`]
+//! holds one of them and can only be made by [`Correlator::new`], [`Correlator::best`] or
+//! [`Correlator::available`].
+
+use super::packed::PackedCode;
+use super::{scalar, ReplicaState, MAX_TAPS};
+use crate::constants::CA_CODE_LENGTH;
+use num_complex::Complex32;
+
+#[cfg(target_arch = "x86_64")]
+use super::{avx2::Avx2Kernel, avx512::Avx512Kernel};
+
+/// A block of complex baseband samples in one of the supported formats, read in place.
+#[derive(Debug, Clone, Copy)]
+pub enum SampleSlice<'a> {
+    /// Complex f32 (`re`, `im`).
+    Cf32(&'a [Complex32]),
+    /// Interleaved 16-bit I/Q.
+    Ci16(&'a [[i16; 2]]),
+    /// Interleaved 8-bit I/Q.
+    Ci8(&'a [[i8; 2]]),
+}
+
+impl SampleSlice<'_> {
+    /// Number of complex samples.
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Cf32(s) => s.len(),
+            Self::Ci16(s) => s.len(),
+            Self::Ci8(s) => s.len(),
+        }
+    }
+
+    /// Whether the block holds no sample.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Instruction set of a kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    /// Portable scalar code (the reference; every CPU).
+    Scalar,
+    /// x86-64 AVX2 and FMA: 8 samples per vector step.
+    Avx2Fma,
+    /// x86-64 AVX-512 F+BW: 16 samples per vector step.
+    Avx512,
+}
+
+/// Arithmetic of a kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Arithmetic {
+    /// f32 wipe-off and accumulation.
+    F32,
+    /// Integer samples times a Q14 (2^14-scaled) int16 carrier replica, i32 products and
+    /// accumulation, scaled back by 2^-14 on output. Cf32 input has no integer scale to
+    /// quantise to: with it, an I16 correlator runs the F32 kernel of the same ISA.
+    I16,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Kernel {
+    Scalar,
+    #[cfg(target_arch = "x86_64")]
+    Avx2(Avx2Kernel),
+    #[cfg(target_arch = "x86_64")]
+    Avx512(Avx512Kernel),
+}
+
+/// A correlator kernel the running CPU supports; see the module doc of [`super`] for the sums.
+#[derive(Clone, Copy, Debug)]
+pub struct Correlator {
+    kernel: Kernel,
+    arithmetic: Arithmetic,
+}
+
+impl Correlator {
+    /// The fastest f32 kernel this CPU runs (AVX-512, else AVX2+FMA, else scalar).
+    pub fn best() -> Self {
+        [Isa::Avx512, Isa::Avx2Fma]
+            .into_iter()
+            .find_map(|isa| Self::new(isa, Arithmetic::F32))
+            .unwrap_or(Self {
+                kernel: Kernel::Scalar,
+                arithmetic: Arithmetic::F32,
+            })
+    }
+
+    /// The kernel for `isa` and `arithmetic`; `None` if this CPU lacks the instruction set.
+    pub fn new(isa: Isa, arithmetic: Arithmetic) -> Option<Self> {
+        let kernel = match isa {
+            Isa::Scalar => Some(Kernel::Scalar),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2Fma => Avx2Kernel::new().map(Kernel::Avx2),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => Avx512Kernel::new().map(Kernel::Avx512),
+            #[cfg(not(target_arch = "x86_64"))]
+            Isa::Avx2Fma | Isa::Avx512 => None,
+        }?;
+        Some(Self { kernel, arithmetic })
+    }
+
+    /// Every kernel this CPU runs, scalar first.
+    pub fn available() -> Vec<Self> {
+        [Isa::Scalar, Isa::Avx2Fma, Isa::Avx512]
+            .into_iter()
+            .flat_map(|isa| {
+                [Arithmetic::F32, Arithmetic::I16]
+                    .into_iter()
+                    .filter_map(move |a| Self::new(isa, a))
+            })
+            .collect()
+    }
+
+    /// The instruction set.
+    pub fn isa(&self) -> Isa {
+        match self.kernel {
+            Kernel::Scalar => Isa::Scalar,
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx2(_) => Isa::Avx2Fma,
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx512(_) => Isa::Avx512,
+        }
+    }
+
+    /// The arithmetic.
+    pub fn arithmetic(&self) -> Arithmetic {
+        self.arithmetic
+    }
+
+    /// A short name, e.g. `"avx512/f32"`, `"avx2+fma/i16"`.
+    pub fn name(&self) -> String {
+        let isa = match self.isa() {
+            Isa::Scalar => "scalar",
+            Isa::Avx2Fma => "avx2+fma",
+            Isa::Avx512 => "avx512",
+        };
+        let arith = match self.arithmetic {
+            Arithmetic::F32 => "f32",
+            Arithmetic::I16 => "i16",
+        };
+        format!("{isa}/{arith}")
+    }
+
+    /// Correlates `samples` with the replica of `code` described by `state`, one sum per entry
+    /// of `tap_offsets_chips`, into `out` (same length). Packs the code on the stack first (about
+    /// 1 us); hold a [`PackedCode`] and call [`Correlator::correlate_packed`] in a loop instead.
+    pub fn correlate(
+        &self,
+        samples: SampleSlice<'_>,
+        fs_hz: f64,
+        code: &[i8; CA_CODE_LENGTH],
+        state: &ReplicaState,
+        tap_offsets_chips: &[f64],
+        out: &mut [Complex32],
+    ) {
+        let packed = PackedCode::new(code);
+        self.correlate_packed(samples, fs_hz, &packed, state, tap_offsets_chips, out);
+    }
+
+    /// [`Correlator::correlate`] with a prepared code. Allocates nothing; more than
+    /// [`MAX_TAPS`] taps are processed in chunks of [`MAX_TAPS`] (one pass each). The SIMD
+    /// kernels need a code step of at most 2 chips per sample (`fs >= rc / 2`); below that
+    /// they fall back to the scalar kernel.
+    ///
+    /// Panics only if `out.len() != tap_offsets_chips.len()` (a programming error).
+    pub fn correlate_packed(
+        &self,
+        samples: SampleSlice<'_>,
+        fs_hz: f64,
+        code: &PackedCode,
+        state: &ReplicaState,
+        tap_offsets_chips: &[f64],
+        out: &mut [Complex32],
+    ) {
+        assert_eq!(out.len(), tap_offsets_chips.len(), "one output per tap");
+        for (taps, out) in tap_offsets_chips
+            .chunks(MAX_TAPS)
+            .zip(out.chunks_mut(MAX_TAPS))
+        {
+            let done = match self.kernel {
+                Kernel::Scalar => false,
+                #[cfg(target_arch = "x86_64")]
+                Kernel::Avx2(k) => {
+                    k.correlate(self.arithmetic, samples, fs_hz, code, state, taps, out)
+                }
+                #[cfg(target_arch = "x86_64")]
+                Kernel::Avx512(k) => {
+                    k.correlate(self.arithmetic, samples, fs_hz, code, state, taps, out)
+                }
+            };
+            if !done {
+                scalar_kernel(self.arithmetic, samples, fs_hz, code, state, taps, out);
+            }
+        }
+    }
+}
+
+fn scalar_kernel(
+    arithmetic: Arithmetic,
+    samples: SampleSlice<'_>,
+    fs_hz: f64,
+    code: &PackedCode,
+    state: &ReplicaState,
+    taps: &[f64],
+    out: &mut [Complex32],
+) {
+    let chips = code.chips();
+    match (arithmetic, samples) {
+        (_, SampleSlice::Cf32(x)) => scalar::correlate_f32(x, fs_hz, chips, state, taps, out),
+        (Arithmetic::F32, SampleSlice::Ci16(x)) => {
+            scalar::correlate_f32(x, fs_hz, chips, state, taps, out)
+        }
+        (Arithmetic::F32, SampleSlice::Ci8(x)) => {
+            scalar::correlate_f32(x, fs_hz, chips, state, taps, out)
+        }
+        (Arithmetic::I16, SampleSlice::Ci16(x)) => {
+            scalar::correlate_i16(x, fs_hz, chips, state, taps, out)
+        }
+        (Arithmetic::I16, SampleSlice::Ci8(x)) => {
+            scalar::correlate_i16(x, fs_hz, chips, state, taps, out)
+        }
+    }
+}
