@@ -19,6 +19,10 @@ pub const BUILTIN_NAV_TEXT: &str = include_str!("../../data/brdc0010.22n");
 /// The default scenario (static receiver in Seoul, 2022-01-01, 40 s, 4 MHz ci8).
 pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../../scenarios/default.toml");
 
+/// A 25-minute urban drive with intersections, stops and hills (`samples/scenarios/urban-drive.toml`),
+/// the vehicle trajectory of `gpsrx study dr`.
+pub const URBAN_DRIVE_TOML: &str = include_str!("../../scenarios/urban-drive.toml");
+
 /// A complete simulation scenario.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -58,6 +62,14 @@ pub struct Scenario {
     /// simulator itself ignores it; `gpsrx simulate` writes ins.csv from it).
     #[serde(default)]
     pub ins: Option<toml::Table>,
+    /// The `[dr]` table: gyro and odometer error models of a vehicle, parsed by
+    /// `gpsrx_ins_aiding::DrSensorConfig` (`gpsrx simulate` writes dr.csv from it).
+    #[serde(default)]
+    pub dr: Option<toml::Table>,
+    /// The `[accel]` table: longitudinal accelerometer error model, parsed by
+    /// `gpsrx_ins_aiding::AccelSensorConfig` (`gpsrx simulate` writes accel.csv from it).
+    #[serde(default)]
+    pub accel: Option<toml::Table>,
 }
 
 /// Start time: either `week` + `tow_s`, or a GPS-time calendar string `"2022-01-01 05:30:00"`.
@@ -128,6 +140,14 @@ pub enum ReceiverConfig {
         /// (linear ramps, so the jerk is bounded), seconds. 0 gives acceleration steps.
         #[serde(default = "default_transition")]
         transition_s: f64,
+        /// Road grade at the start, percent (rise over horizontal run x 100; positive uphill).
+        #[serde(default)]
+        grade_percent: f64,
+        /// Time over which the road grade changes between segments that set a new
+        /// `grade_percent` (a smoothstep `3w^2 - 2w^3`, so the vertical acceleration stays
+        /// continuous), seconds.
+        #[serde(default = "default_grade_transition")]
+        grade_transition_s: f64,
         /// Motion segments, one after the other; after the last, the motion continues at
         /// constant velocity.
         segments: Vec<Segment>,
@@ -138,26 +158,57 @@ fn default_transition() -> f64 {
     0.5
 }
 
+fn default_grade_transition() -> f64 {
+    3.0
+}
+
+/// Default braking deceleration of a `stop` segment, m/s^2.
+pub const DEFAULT_STOP_DECEL_MPS2: f64 = 2.0;
+
+/// Steepest road grade a segment may set, percent (Baldwin Street, the steepest street in the
+/// world, is 35 %).
+pub const MAX_GRADE_PERCENT: f64 = 40.0;
+
 /// One segment of a built-in motion.
+///
+/// Every segment takes an optional `grade_percent`: the road grade it drives on (reached over
+/// `grade_transition_s` from the segment start); without it the grade of the previous segment
+/// continues.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Segment {
-    /// Constant velocity.
+    /// Constant speed.
     Cruise {
         /// Length, s.
         duration_s: f64,
+        /// Road grade, percent (default: unchanged).
+        grade_percent: Option<f64>,
     },
-    /// Constant longitudinal acceleration (negative to brake).
+    /// Constant longitudinal acceleration (negative to brake), either for `duration_s` or until
+    /// the speed reaches `to_speed_mps`.
     Accelerate {
-        /// Length, s.
-        duration_s: f64,
-        /// Longitudinal acceleration, m/s^2.
+        /// Length, s (give this or `to_speed_mps`).
+        duration_s: Option<f64>,
+        /// Longitudinal acceleration, m/s^2. With `to_speed_mps` this is the largest magnitude:
+        /// the plateau is rounded to the table step, which lowers it slightly.
         accel_mps2: f64,
+        /// Target speed, m/s: the segment lasts until the acceleration, ramped back to zero over
+        /// `transition_s` at the start of the next segment, leaves exactly this speed (the next
+        /// segment must start with zero acceleration, as cruise, turn and stop do, and last at
+        /// least `transition_s`). `0` brings the vehicle to rest without reversing.
+        to_speed_mps: Option<f64>,
+        /// Road grade, percent (default: unchanged).
+        grade_percent: Option<f64>,
     },
-    /// A turn at the current speed with a given radius or centripetal acceleration.
+    /// A turn at the current speed with a given radius or centripetal acceleration, for a time
+    /// or through an angle.
     Turn {
-        /// Length, s.
-        duration_s: f64,
+        /// Length, s (give this or `angle_deg`).
+        duration_s: Option<f64>,
+        /// Heading change, degrees (e.g. 90 at an intersection): the segment lasts
+        /// `angle / turn rate`, the turn rate ramping in over `transition_s` at its start and out
+        /// at the start of the next segment.
+        angle_deg: Option<f64>,
         /// Turn radius, m (give this or `accel_g`).
         radius_m: Option<f64>,
         /// Centripetal acceleration in g (9.80665 m/s^2), instead of a radius.
@@ -165,6 +216,8 @@ pub enum Segment {
         /// `"left"` or `"right"` (default right).
         #[serde(default)]
         direction: TurnDirection,
+        /// Road grade, percent (default: unchanged).
+        grade_percent: Option<f64>,
     },
     /// Longitudinal acceleration ramping at a constant jerk from its current value.
     Jerk {
@@ -172,7 +225,110 @@ pub enum Segment {
         duration_s: f64,
         /// Jerk, m/s^3.
         jerk_mps3: f64,
+        /// Road grade, percent (default: unchanged).
+        grade_percent: Option<f64>,
     },
+    /// Brake to rest at `decel_mps2` (jerk-limited over `transition_s`, never reversing), then
+    /// stand still for `duration_s` (the braking time comes on top).
+    Stop {
+        /// Time at rest, s (0: drive off at once).
+        duration_s: f64,
+        /// Braking deceleration, m/s^2, positive (default 2).
+        decel_mps2: Option<f64>,
+        /// Road grade, percent (default: unchanged).
+        grade_percent: Option<f64>,
+    },
+}
+
+impl Segment {
+    /// The road grade this segment sets, percent (None: unchanged).
+    pub fn grade_percent(&self) -> Option<f64> {
+        match self {
+            Self::Cruise { grade_percent, .. }
+            | Self::Accelerate { grade_percent, .. }
+            | Self::Turn { grade_percent, .. }
+            | Self::Jerk { grade_percent, .. }
+            | Self::Stop { grade_percent, .. } => *grade_percent,
+        }
+    }
+
+    /// Checks the values TOML types cannot (positive durations, one of two alternatives, grades
+    /// within [`MAX_GRADE_PERCENT`]); `k` numbers the segment from 1 in the messages.
+    pub fn validate(&self, k: usize) -> Result<(), String> {
+        let bad = |m: String| Err(format!("segment {k}: {m}"));
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("segment {k}: {name} = {v} must be positive"))
+            }
+        };
+        if let Some(g) = self.grade_percent() {
+            if !(g.is_finite() && g.abs() <= MAX_GRADE_PERCENT) {
+                return bad(format!(
+                    "grade_percent = {g} must be within +-{MAX_GRADE_PERCENT}"
+                ));
+            }
+        }
+        match self {
+            Self::Cruise { duration_s, .. } | Self::Jerk { duration_s, .. } => {
+                positive("duration_s", *duration_s)
+            }
+            Self::Turn {
+                duration_s,
+                angle_deg,
+                radius_m,
+                accel_g,
+                ..
+            } => {
+                match (duration_s, angle_deg) {
+                    (Some(d), None) => positive("duration_s", *d)?,
+                    (None, Some(a)) => positive("angle_deg", *a)?,
+                    _ => return bad("a turn needs exactly one of duration_s or angle_deg".into()),
+                }
+                if radius_m.is_some() == accel_g.is_some() {
+                    return bad("a turn segment needs exactly one of radius_m or accel_g".into());
+                }
+                Ok(())
+            }
+            Self::Accelerate {
+                duration_s,
+                accel_mps2,
+                to_speed_mps,
+                ..
+            } => {
+                if !accel_mps2.is_finite() {
+                    return bad(format!("accel_mps2 = {accel_mps2} must be a number"));
+                }
+                match (duration_s, to_speed_mps) {
+                    (Some(d), None) => positive("duration_s", *d),
+                    (None, Some(v)) if v.is_finite() && *v >= 0.0 => {
+                        if *accel_mps2 == 0.0 {
+                            return bad(
+                                "accelerate to_speed_mps needs a non-zero accel_mps2".into()
+                            );
+                        }
+                        Ok(())
+                    }
+                    (None, Some(v)) => bad(format!("to_speed_mps = {v} must be >= 0")),
+                    _ => bad(
+                        "an accelerate segment needs exactly one of duration_s or to_speed_mps"
+                            .into(),
+                    ),
+                }
+            }
+            Self::Stop {
+                duration_s,
+                decel_mps2,
+                ..
+            } => {
+                if !(duration_s.is_finite() && *duration_s >= 0.0) {
+                    return bad(format!("stop duration_s = {duration_s} must be >= 0"));
+                }
+                positive("decel_mps2", decel_mps2.unwrap_or(DEFAULT_STOP_DECEL_MPS2))
+            }
+        }
+    }
 }
 
 /// Turn direction.
@@ -466,22 +622,28 @@ impl Scenario {
             ReceiverConfig::Motion {
                 segments,
                 transition_s,
+                grade_percent,
+                grade_transition_s,
+                speed_mps,
                 ..
             } => {
-                if *transition_s < 0.0 {
+                if !(transition_s.is_finite() && *transition_s >= 0.0) {
                     return bad("[receiver] transition_s must be >= 0".into());
                 }
-                for s in segments {
-                    if let Segment::Turn {
-                        radius_m, accel_g, ..
-                    } = s
-                    {
-                        if radius_m.is_some() == accel_g.is_some() {
-                            return bad(
-                                "a turn segment needs exactly one of radius_m or accel_g".into()
-                            );
-                        }
-                    }
+                if !(grade_transition_s.is_finite() && *grade_transition_s >= 0.0) {
+                    return bad("[receiver] grade_transition_s must be >= 0".into());
+                }
+                if !(speed_mps.is_finite() && *speed_mps >= 0.0) {
+                    return bad(format!("[receiver] speed_mps = {speed_mps} must be >= 0"));
+                }
+                if !(grade_percent.is_finite() && grade_percent.abs() <= MAX_GRADE_PERCENT) {
+                    return bad(format!(
+                        "[receiver] grade_percent = {grade_percent} must be within +-{MAX_GRADE_PERCENT}"
+                    ));
+                }
+                for (k, s) in segments.iter().enumerate() {
+                    s.validate(k + 1)
+                        .map_err(|m| SimError::Scenario(format!("[receiver] {m}")))?;
                 }
             }
         }
