@@ -115,3 +115,77 @@ pub fn write_accel_csv(path: &Path, samples: &[AccelSample]) -> Result<(), DrErr
     }
     w.flush().map_err(io)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn error_of(text: &str) -> String {
+        let f = tempfile::NamedTempFile::new().unwrap_or_else(|e| panic!("{e}"));
+        std::fs::write(f.path(), text).unwrap_or_else(|e| panic!("{e}"));
+        read_accel_csv(f.path())
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    }
+
+    #[test]
+    fn round_trip() {
+        let samples: Vec<AccelSample> = (0..200)
+            .map(|k| AccelSample {
+                t_s: 0.02 * f64::from(k),
+                a_long_mps2: (0.37 * f64::from(k)).sin() - 0.123456789,
+            })
+            .collect();
+        let f = tempfile::NamedTempFile::new().unwrap_or_else(|e| panic!("{e}"));
+        write_accel_csv(f.path(), &samples).unwrap_or_else(|e| panic!("{e}"));
+        let log = read_accel_csv(f.path()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(log.samples().len(), samples.len());
+        for (a, b) in log.samples().iter().zip(&samples) {
+            assert!((a.t_s - b.t_s).abs() < 1e-9 && (a.a_long_mps2 - b.a_long_mps2).abs() < 1e-9);
+        }
+        assert!(AccelLog::from_samples(samples).is_ok());
+    }
+
+    #[test]
+    fn bad_files_name_the_line() {
+        let cases = [
+            ("t_s,a_mps2\n0,0\n0.1,0\n", "line 1", "a_long_mps2"),
+            (
+                "t_s,a_long_mps2\n0,0\n0.1,NaN\n",
+                "line 3",
+                "a_long_mps2 = `NaN`",
+            ),
+            ("t_s,a_long_mps2\n0,0\n0.1,\n", "line 3", "missing"),
+            (
+                "t_s,a_long_mps2\n0,0\n0.1,0\n0.05,0\n",
+                "line 4",
+                "does not increase",
+            ),
+            (
+                "t_s,a_long_mps2\n0,0\n0.1,0,7\n",
+                "line 3",
+                "3 values but the header has 2",
+            ),
+            ("t_s,a_long_mps2\n0,0\n", "line 2", "at least 2 rows"),
+        ];
+        for (text, line, what) in cases {
+            let e = error_of(text);
+            assert!(
+                e.contains(line) && e.contains(what) && e.contains("accelerometer log file"),
+                "{text:?}: got `{e}`"
+            );
+        }
+        let bad = AccelLog::from_samples(vec![
+            AccelSample {
+                t_s: 0.0,
+                a_long_mps2: 0.0,
+            },
+            AccelSample {
+                t_s: 0.1,
+                a_long_mps2: f64::INFINITY,
+            },
+        ]);
+        assert!(bad.is_err());
+    }
+}

@@ -8,7 +8,13 @@ use std::path::Path;
 pub(crate) struct CsvTable {
     what: &'static str,
     path: String,
-    reader: csv::Reader<std::fs::File>,
+    reader: csv::Reader<std::io::Cursor<Vec<u8>>>,
+    /// Byte offsets of the starts of lines 2, 3, ... (for line numbers: the csv crate does not
+    /// count blank lines).
+    line_starts: Vec<u64>,
+    /// Per line (0-based): blank or a `#` comment (the csv crate may point a record's position at
+    /// the comment or blank lines before it).
+    skippable: Vec<bool>,
     headers: csv::StringRecord,
     header_line: usize,
 }
@@ -25,15 +31,29 @@ impl CsvTable {
     /// Opens `path` (`#` comments, values trimmed) and reads its header.
     pub fn open(path: &Path, what: &'static str) -> Result<CsvTable, DrError> {
         let p = path.display().to_string();
+        // Logs are small (a 10 Hz drive of an hour is about 1 MB): read at once.
+        let bytes = std::fs::read(path).map_err(|e| DrError::Io {
+            what,
+            path: p.clone(),
+            message: e.to_string(),
+        })?;
+        let line_starts = bytes
+            .iter()
+            .enumerate()
+            .filter(|(_, &b)| b == b'\n')
+            .map(|(i, _)| i as u64 + 1)
+            .collect();
+        let skippable = bytes
+            .split(|&b| b == b'\n')
+            .map(|l| {
+                let t = l.trim_ascii();
+                t.is_empty() || t.starts_with(b"#")
+            })
+            .collect();
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .comment(Some(b'#'))
-            .from_path(path)
-            .map_err(|e| DrError::Io {
-                what,
-                path: p.clone(),
-                message: e.to_string(),
-            })?;
+            .from_reader(std::io::Cursor::new(bytes));
         let headers = reader
             .headers()
             .map_err(|e| DrError::Row {
@@ -43,16 +63,28 @@ impl CsvTable {
                 message: e.to_string(),
             })?
             .clone();
-        let header_line = headers
-            .position()
-            .map_or(1, |pos| usize::try_from(pos.line()).unwrap_or(1));
-        Ok(CsvTable {
+        let mut table = CsvTable {
             what,
             path: p,
             reader,
-            headers,
-            header_line,
-        })
+            line_starts,
+            skippable,
+            headers: headers.clone(),
+            header_line: 1,
+        };
+        table.header_line = headers
+            .position()
+            .map_or(1, |pos| table.line_of(pos.byte()));
+        Ok(table)
+    }
+
+    /// The 1-based line holding byte `offset`.
+    fn line_of(&self, offset: u64) -> usize {
+        let mut i = self.line_starts.partition_point(|&s| s <= offset);
+        while self.skippable.get(i).copied().unwrap_or(false) {
+            i += 1;
+        }
+        i + 1
     }
 
     /// The index of column `name`, if the header has it.
@@ -92,9 +124,7 @@ impl CsvTable {
             let more = match self.reader.read_record(&mut record) {
                 Ok(more) => more,
                 Err(e) => {
-                    let line = e
-                        .position()
-                        .map_or(fallback, |p| usize::try_from(p.line()).unwrap_or(fallback));
+                    let line = e.position().map_or(fallback, |p| self.line_of(p.byte()));
                     let message = match e.kind() {
                         csv::ErrorKind::UnequalLengths {
                             expected_len, len, ..
@@ -111,7 +141,7 @@ impl CsvTable {
             }
             let line = record
                 .position()
-                .map_or(fallback, |p| usize::try_from(p.line()).unwrap_or(fallback));
+                .map_or(fallback, |p| self.line_of(p.byte()));
             let row = CsvRow {
                 table: self,
                 record: record.clone(),

@@ -250,3 +250,199 @@ pub fn write_dr_csv(path: &Path, samples: &[DrSample]) -> Result<(), DrError> {
     }
     w.flush().map_err(io)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(text: &str) -> tempfile::NamedTempFile {
+        let f = tempfile::NamedTempFile::new().unwrap_or_else(|e| panic!("{e}"));
+        std::fs::write(f.path(), text).unwrap_or_else(|e| panic!("{e}"));
+        f
+    }
+
+    fn error_of(text: &str) -> String {
+        let f = write(text);
+        read_dr_csv(f.path())
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    }
+
+    #[test]
+    fn raw_and_engineering_logs_round_trip() {
+        let raw: Vec<DrSample> = (0..50)
+            .map(|k| DrSample {
+                t_s: 0.1 * f64::from(k) + 0.123456789,
+                reading: DrReading::Raw {
+                    gyro_v: 2.5 + 0.01 * f64::from(k).sin(),
+                    odo_pulses: f64::from(k % 17),
+                },
+            })
+            .collect();
+        let eng: Vec<DrSample> = raw
+            .iter()
+            .map(|s| DrSample {
+                t_s: s.t_s,
+                reading: DrReading::Engineering {
+                    yaw_rate_dps: -3.25 + s.t_s,
+                    speed_mps: 12.5 + 0.1 * s.t_s,
+                },
+            })
+            .collect();
+        for samples in [raw, eng] {
+            let f = tempfile::NamedTempFile::new().unwrap_or_else(|e| panic!("{e}"));
+            write_dr_csv(f.path(), &samples).unwrap_or_else(|e| panic!("{e}"));
+            let log = read_dr_csv(f.path()).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(log.samples().len(), samples.len());
+            assert_eq!(log.is_raw(), samples[0].reading.is_raw());
+            for (a, b) in log.samples().iter().zip(&samples) {
+                assert!((a.t_s - b.t_s).abs() < 1e-9);
+                let pair = |r: &DrReading| match *r {
+                    DrReading::Raw { gyro_v, odo_pulses } => (gyro_v, odo_pulses),
+                    DrReading::Engineering {
+                        yaw_rate_dps,
+                        speed_mps,
+                    } => (yaw_rate_dps, speed_mps),
+                };
+                let (x, y) = (pair(&a.reading), pair(&b.reading));
+                assert!((x.0 - y.0).abs() < 1e-9 && (x.1 - y.1).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn columns_in_any_order_with_comments_and_extra_columns() {
+        let f = write("# a DR log\nodo_pulses,note,t_s,gyro_v\n0,a,0.0,2.5\n3,b,0.1,2.6\n");
+        let log = read_dr_csv(f.path()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            log.samples()[1],
+            DrSample {
+                t_s: 0.1,
+                reading: DrReading::Raw {
+                    gyro_v: 2.6,
+                    odo_pulses: 3.0
+                }
+            }
+        );
+        assert_eq!(log.time_span_s(), (0.0, 0.1));
+    }
+
+    #[test]
+    fn bad_files_name_the_line_and_the_fix() {
+        let cases = [
+            (
+                "gyro_v,odo_pulses\n2.5,0\n2.5,1\n",
+                "line 1",
+                "no column `t_s`",
+            ),
+            (
+                "t_s,gyro_v\n0,2.5\n0.1,2.5\n",
+                "line 1",
+                "needs gyro_v and odo_pulses",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses,speed_mps\n0,2.5,0,1\n0.1,2.5,1,1\n",
+                "line 1",
+                "keep one pair",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses\n0,2.5,0\n0.1,NaN,1\n",
+                "line 3",
+                "gyro_v = `NaN` is not a finite number",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses\n0,2.5,0\n0.1,2.5,inf\n",
+                "line 3",
+                "odo_pulses = `inf`",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses\n0,2.5,0\n0.1,2.5,x\n",
+                "line 3",
+                "not a finite number",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses\n0,2.5,0\n0.1,,1\n",
+                "line 3",
+                "`gyro_v` is missing",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses\n0,2.5,0\n0.1,2.5,-1\n",
+                "line 3",
+                "negative",
+            ),
+            (
+                "t_s,yaw_rate_dps,speed_mps\n0,0,0\n0.1,1,-2\n",
+                "line 3",
+                "speed_mps = -2 is negative",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses\n0,2.5,0\n0.2,2.5,1\n0.1,2.5,1\n",
+                "line 4",
+                "does not increase",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses\n0,2.5,0\n0,2.5,1\n",
+                "line 3",
+                "remove duplicate rows",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses\n0,2.5,0\n0.1,2.5\n",
+                "line 3",
+                "2 values but the header has 3",
+            ),
+            (
+                "t_s,gyro_v,odo_pulses\n0,2.5,0\n",
+                "line 2",
+                "at least 2 rows",
+            ),
+            (
+                "# c\n\nt_s,gyro_v,odo_pulses\n0,2.5,0\n# c\n0.1,nan,0\n",
+                "line 6",
+                "`nan`",
+            ),
+        ];
+        for (text, line, what) in cases {
+            let e = error_of(text);
+            assert!(
+                e.contains(line) && e.contains(what),
+                "{text:?}: got `{e}`, expected {line} and `{what}`"
+            );
+            assert!(e.contains("DR log file"), "{e}");
+        }
+        let missing = read_dr_csv(Path::new("/nonexistent/dr.csv"))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            missing.contains("cannot read DR log file /nonexistent/dr.csv"),
+            "{missing}"
+        );
+    }
+
+    #[test]
+    fn in_memory_logs_are_checked_like_files() {
+        let s = |t_s: f64, gyro_v: f64| DrSample {
+            t_s,
+            reading: DrReading::Raw {
+                gyro_v,
+                odo_pulses: 1.0,
+            },
+        };
+        assert!(DrLog::from_samples(vec![s(0.0, 2.5), s(0.1, 2.5)]).is_ok());
+        assert!(DrLog::from_samples(vec![s(0.0, 2.5)]).is_err());
+        assert!(DrLog::from_samples(vec![s(0.0, 2.5), s(0.0, 2.5)]).is_err());
+        assert!(DrLog::from_samples(vec![s(0.0, 2.5), s(0.1, f64::NAN)]).is_err());
+        let eng = DrSample {
+            t_s: 0.2,
+            reading: DrReading::Engineering {
+                yaw_rate_dps: 0.0,
+                speed_mps: 1.0,
+            },
+        };
+        let mixed = DrLog::from_samples(vec![s(0.0, 2.5), s(0.1, 2.5), eng]);
+        assert!(mixed.err().is_some_and(|e| e.to_string().contains("mixed")));
+        let f = tempfile::NamedTempFile::new().unwrap_or_else(|e| panic!("{e}"));
+        assert!(write_dr_csv(f.path(), &[s(0.0, 2.5), eng]).is_err());
+    }
+}

@@ -280,3 +280,136 @@ impl DrMechanization {
         &mut self.state
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DT: f64 = 0.1;
+
+    fn raw(t_s: f64, gyro_v: f64, odo_pulses: f64) -> DrSample {
+        DrSample {
+            t_s,
+            reading: DrReading::Raw { gyro_v, odo_pulses },
+        }
+    }
+
+    fn run(mech: &mut DrMechanization, rows: impl Iterator<Item = DrSample>) {
+        for s in rows {
+            mech.propagate(&s).unwrap_or_else(|e| panic!("{e}"));
+        }
+    }
+
+    #[test]
+    fn straight_line_at_constant_speed() {
+        let p = DrParams::default();
+        let psi0 = 30f64.to_radians();
+        let mut m = DrMechanization::new(p, 100.0, -50.0, psi0).unwrap_or_else(|e| panic!("{e}"));
+        // 15 pulses of 0.1 m per 0.1 s: 15 m/s for 10 s.
+        run(
+            &mut m,
+            (0..=100).map(|k| raw(f64::from(k) * DT, p.v_nom_v, 15.0)),
+        );
+        let s = m.state();
+        assert!((s.east_m - (100.0 + 150.0 * psi0.sin())).abs() < 1e-9);
+        assert!((s.north_m - (-50.0 + 150.0 * psi0.cos())).abs() < 1e-9);
+        assert!((s.heading_rad - psi0).abs() < 1e-12);
+        assert!((s.speed_mps - 15.0).abs() < 1e-12);
+        assert!((s.vel_east_mps - 15.0 * psi0.sin()).abs() < 1e-9);
+        assert_eq!(s.t_s, Some(10.0));
+    }
+
+    /// Closed form of a clockwise circle from the origin heading north: centre (R, 0),
+    /// `east = R (1 - cos(w t))`, `north = R sin(w t)`, heading `w t`.
+    #[test]
+    fn constant_rate_circle_matches_the_closed_form() {
+        let p = DrParams {
+            sf_g_dps_per_v: 47.936,
+            v_nom_v: 2.47,
+            sf_n_m_per_pulse: 0.05,
+        };
+        let (v, w): (f64, f64) = (10.0, 0.2);
+        let r = v / w;
+        let gyro_v = p.v_nom_v + w.to_degrees() / p.sf_g_dps_per_v;
+        let pulses = v * DT / p.sf_n_m_per_pulse;
+        let rows = |eng: bool| {
+            (0..=157).map(move |k| {
+                let t = f64::from(k) * DT;
+                if eng {
+                    DrSample {
+                        t_s: t,
+                        reading: DrReading::Engineering {
+                            yaw_rate_dps: w.to_degrees(),
+                            speed_mps: v,
+                        },
+                    }
+                } else {
+                    raw(t, gyro_v, pulses)
+                }
+            })
+        };
+        for eng in [false, true] {
+            let mut m = DrMechanization::new(p, 0.0, 0.0, 0.0).unwrap_or_else(|e| panic!("{e}"));
+            run(&mut m, rows(eng));
+            let t = 15.7;
+            let s = m.state();
+            assert!((s.east_m - r * (1.0 - (w * t).cos())).abs() < 1e-8, "{s:?}");
+            assert!((s.north_m - r * (w * t).sin()).abs() < 1e-8, "{s:?}");
+            assert!((s.heading_rad - wrap_pi(w * t)).abs() < 1e-10);
+            assert!((s.yaw_rate_rad_s - w).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn rows_out_of_order_and_bad_values_are_refused() {
+        let mut m = DrMechanization::new(DrParams::default(), 0.0, 0.0, 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(m.propagate(&raw(1.0, 2.5, 0.0)).is_ok_and(|s| s.is_none()));
+        assert!(m.propagate(&raw(1.0, 2.5, 3.0)).is_err());
+        assert!(m.propagate(&raw(1.1, f64::NAN, 3.0)).is_err());
+        assert!(m.propagate(&raw(f64::NAN, 2.5, 3.0)).is_err());
+        assert!(DrMechanization::new(DrParams::default(), f64::NAN, 0.0, 0.0).is_err());
+        let bad = DrParams {
+            sf_n_m_per_pulse: 0.0,
+            ..DrParams::default()
+        };
+        assert!(DrMechanization::new(bad, 0.0, 0.0, 0.0).is_err());
+    }
+
+    #[test]
+    fn params_save_and_load_round_trip() {
+        let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+        let path = dir.path().join("dr_params.toml");
+        let p = DrParams {
+            sf_g_dps_per_v: 47.93612345678,
+            v_nom_v: 2.5123456789,
+            sf_n_m_per_pulse: 0.0987654321,
+        };
+        p.save(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(DrParams::load(&path).unwrap_or_else(|e| panic!("{e}")), p);
+        let bad = |text: &str| {
+            std::fs::write(&path, text).unwrap_or_else(|e| panic!("{e}"));
+            DrParams::load(&path)
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default()
+        };
+        assert!(bad("sf_g_dps_per_v = 45.0\nv_nom_v = 2.5\n").contains("sf_n_m_per_pulse"));
+        assert!(
+            bad("sf_g_dps_per_v = -45.0\nv_nom_v = 2.5\nsf_n_m_per_pulse = 0.1\n")
+                .contains("must be positive")
+        );
+        assert!(
+            bad("sf_g_dps_per_v = 45.0\nv_nom_v = 2.5\nsf_n_m_per_pulse = 0.1\nx = 1\n")
+                .contains("unknown field")
+        );
+        let missing = DrParams::load(&dir.path().join("none.toml"))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            missing.contains("cannot read DR parameter file"),
+            "{missing}"
+        );
+    }
+}

@@ -309,3 +309,204 @@ pub fn simulate_accel(
         })
         .collect())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dr_mechanization::dr_step;
+
+    /// A clockwise circle at `v` m/s and `w` rad/s from the origin heading north, at 100 Hz, on a
+    /// constant `pitch`.
+    fn circle(v: f64, w: f64, pitch: f64, secs: f64) -> Vec<VehicleTruth> {
+        let n = (secs * 100.0) as usize;
+        (0..=n)
+            .map(|k| {
+                let t = k as f64 / 100.0;
+                let r = v / w;
+                VehicleTruth {
+                    t_s: t,
+                    east_m: r * (1.0 - (w * t).cos()),
+                    north_m: r * (w * t).sin(),
+                    up_m: v * pitch.sin() * t,
+                    speed_mps: v,
+                    heading_rad: crate::vehicle::wrap_pi(w * t),
+                    yaw_rate_rad_s: w,
+                    a_long_mps2: 0.0,
+                    pitch_rad: pitch,
+                }
+            })
+            .collect()
+    }
+
+    fn rows(truth: &[VehicleTruth], cfg: &DrSensorConfig) -> Vec<DrSample> {
+        simulate_dr(truth, cfg).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn tilted_gyro_senses_cos_theta_of_the_yaw_rate() {
+        let truth = circle(12.0, 0.15, 0.0, 30.0);
+        let cfg = DrSensorConfig {
+            gyro_tilt_deg: 20.0,
+            gyro_bias_offset_v: 0.01,
+            ..DrSensorConfig::default()
+        };
+        let nominal = cfg.nominal_params();
+        let exact = cfg.true_params();
+        assert!((exact.sf_g_dps_per_v - 47.936).abs() < 5e-4);
+        for s in &rows(&truth, &cfg)[1..] {
+            let DrReading::Raw { gyro_v, .. } = s.reading else {
+                panic!("raw expected")
+            };
+            let sensed = nominal.sf_g_dps_per_v * (gyro_v - exact.v_nom_v);
+            assert!((sensed - 20f64.to_radians().cos() * 0.15f64.to_degrees()).abs() < 1e-9);
+            let rate = exact.sf_g_dps_per_v * (gyro_v - exact.v_nom_v);
+            assert!((rate - 0.15f64.to_degrees()).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn odometer_pulses_are_whole_and_integrate_to_distance_over_sf_n() {
+        let truth = circle(13.7, 0.05, 0.0, 60.0);
+        let cfg = DrSensorConfig {
+            odo_scale_error: 0.03,
+            sf_n_m_per_pulse: 0.37,
+            ..DrSensorConfig::default()
+        };
+        let mut total = 0.0;
+        for s in rows(&truth, &cfg) {
+            let DrReading::Raw { odo_pulses, .. } = s.reading else {
+                panic!("raw expected")
+            };
+            assert_eq!(odo_pulses, odo_pulses.round());
+            total += odo_pulses;
+        }
+        let exact = 1.03 * 13.7 * 60.0 / 0.37;
+        assert!(
+            total <= exact + 1e-6 && total > exact - 1.0,
+            "{total} vs {exact}"
+        );
+        // With the true Sf_N the distance comes back to within one pulse.
+        assert!((total * cfg.true_params().sf_n_m_per_pulse - 13.7 * 60.0).abs() < 0.37);
+    }
+
+    #[test]
+    fn true_parameters_dead_reckon_the_truth() {
+        let truth = circle(10.0, 0.1, 0.0, 40.0);
+        let cfg = DrSensorConfig {
+            gyro_tilt_deg: 15.0,
+            gyro_bias_offset_v: -0.02,
+            odo_scale_error: -0.04,
+            raw: false,
+            ..DrSensorConfig::default()
+        };
+        let log = rows(&truth, &cfg);
+        let mut m = crate::DrMechanization::new(cfg.nominal_params(), 0.0, 0.0, 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        m.set_params(cfg.true_params())
+            .unwrap_or_else(|e| panic!("{e}"));
+        for s in &log {
+            m.propagate(s).unwrap_or_else(|e| panic!("{e}"));
+        }
+        let end = truth[truth.len() - 1];
+        let s = m.state();
+        assert!(
+            (s.east_m - end.east_m).hypot(s.north_m - end.north_m) < 1e-6,
+            "{s:?}"
+        );
+        // The nominal parameters do not.
+        let mut n = crate::DrMechanization::new(cfg.nominal_params(), 0.0, 0.0, 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        for s in &log {
+            n.propagate(s).unwrap_or_else(|e| panic!("{e}"));
+        }
+        assert!((n.state().east_m - end.east_m).hypot(n.state().north_m - end.north_m) > 10.0);
+        let _ = dr_step;
+    }
+
+    #[test]
+    fn accelerometer_senses_the_slope() {
+        let pitch = 0.06;
+        let truth = circle(10.0, 0.1, pitch, 10.0);
+        let cfg = AccelSensorConfig {
+            bias_mps2: 0.02,
+            ..AccelSensorConfig::default()
+        };
+        let a = simulate_accel(&truth, &cfg).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(a.len(), 501);
+        for s in &a {
+            assert!((s.a_long_mps2 - (GRAVITY_MPS2 * pitch.sin() + 0.02)).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn noise_is_seeded_and_has_the_configured_sigma() {
+        let truth = circle(10.0, 0.1, 0.0, 200.0);
+        let cfg = AccelSensorConfig {
+            vibration_noise_mps2: 0.3,
+            seed: 7,
+            ..AccelSensorConfig::default()
+        };
+        let a = simulate_accel(&truth, &cfg).unwrap_or_else(|e| panic!("{e}"));
+        let b = simulate_accel(&truth, &cfg).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(a, b);
+        let c = simulate_accel(
+            &truth,
+            &AccelSensorConfig {
+                seed: 8,
+                ..cfg.clone()
+            },
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_ne!(a, c);
+        let n = a.len() as f64;
+        let rms = (a.iter().map(|s| s.a_long_mps2.powi(2)).sum::<f64>() / n).sqrt();
+        // 10001 samples: the sample sigma is within 3 % of 0.3 with overwhelming probability.
+        assert!((rms - 0.3).abs() < 0.009, "{rms}");
+    }
+
+    #[test]
+    fn configs_are_validated() {
+        let ok = DrSensorConfig::default();
+        assert!(ok.validate().is_ok());
+        for bad in [
+            DrSensorConfig {
+                rate_hz: 0.0,
+                ..ok.clone()
+            },
+            DrSensorConfig {
+                sf_g_dps_per_v: -1.0,
+                ..ok.clone()
+            },
+            DrSensorConfig {
+                gyro_tilt_deg: 90.0,
+                ..ok.clone()
+            },
+            DrSensorConfig {
+                gyro_noise_v: f64::NAN,
+                ..ok.clone()
+            },
+            DrSensorConfig {
+                sf_n_m_per_pulse: 0.0,
+                ..ok.clone()
+            },
+            DrSensorConfig {
+                odo_scale_error: -1.0,
+                ..ok.clone()
+            },
+        ] {
+            assert!(bad.validate().is_err(), "{bad:?}");
+        }
+        assert!(AccelSensorConfig {
+            vibration_noise_mps2: -0.1,
+            ..AccelSensorConfig::default()
+        }
+        .validate()
+        .is_err());
+        let parsed: DrSensorConfig =
+            toml::from_str("gyro_tilt_deg = 20.0\nseed = 3\n").unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(parsed.rate_hz, 10.0);
+        assert_eq!(parsed.sf_g_dps_per_v, 45.045);
+        assert!(toml::from_str::<DrSensorConfig>("tilt = 20.0\n").is_err());
+        assert!(simulate_dr(&circle(1.0, 0.1, 0.0, 1.0)[..1], &ok).is_err());
+    }
+}

@@ -246,3 +246,54 @@ impl HoldLastSpeed {
         self.last.unwrap_or(0.0)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn smoother_converges_to_the_steady_state_gain() {
+        // Random-walk state, white measurement: steady-state prior variance p solves
+        // p = (p R / (p + R)) + q, i.e. p = (q + sqrt(q^2 + 4 q R)) / 2.
+        let (q_psd, sigma, dt) = (0.5, 0.3, 0.02);
+        let mut s = AccelSmoother::new(q_psd, sigma).unwrap_or_else(|e| panic!("{e}"));
+        for _ in 0..5000 {
+            s.filter(1.0, dt);
+        }
+        let (q, r) = (q_psd * dt, sigma * sigma);
+        let prior = 0.5 * (q + (q * q + 4.0 * q * r).sqrt());
+        assert!((s.variance() - prior * r / (prior + r)).abs() < 1e-12);
+        assert!((s.accel_mps2().unwrap_or(f64::NAN) - 1.0).abs() < 1e-12);
+        assert!(AccelSmoother::new(0.5, 0.0).is_err());
+    }
+
+    #[test]
+    fn speed_filter_learns_the_slope_reference_and_predicts_through_a_gap() {
+        // True speed 10 + 0.5 t; accelerometer reads 0.5 + g sin(0.03) (uphill).
+        let r_true = crate::GRAVITY_MPS2 * 0.03f64.sin();
+        let mut f = SpeedFilter::new(10.0, 1.0, SpeedFilterConfig::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let dt = 0.02;
+        for k in 1..=3000 {
+            let t = f64::from(k) * dt;
+            f.predict(0.5 + r_true, dt);
+            if k % 50 == 0 && t <= 40.0 {
+                f.update_speed(10.0 + 0.5 * t, 0.1)
+                    .unwrap_or_else(|e| panic!("{e}"));
+            }
+        }
+        assert!(
+            (f.reference_mps2() - r_true).abs() < 0.01,
+            "{}",
+            f.reference_mps2()
+        );
+        // 20 s of prediction: error below 0.01 * 20 + the residual at the gap start.
+        assert!((f.speed_mps() - 40.0).abs() < 0.3, "{}", f.speed_mps());
+        assert!(f.update_speed(f64::NAN, 0.1).is_err());
+        let mut hold = HoldLastSpeed::new();
+        assert_eq!(hold.speed_mps(), 0.0);
+        hold.update_speed(12.0);
+        hold.update_speed(f64::NAN);
+        assert_eq!(hold.speed_mps(), 12.0);
+    }
+}
