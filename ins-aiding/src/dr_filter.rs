@@ -27,7 +27,8 @@
 //!
 //! **Process noise** `Q = G diag(q) G^T` per row of `dt` seconds ([`DrFilterConfig`]): heading
 //! noise `q_psi = heading_psd_rad2_per_s dt` enters `dpsi` (so also `dv'` and `dp'` through the
-//! row's turn); odometer quantisation `1/12` pulse^2 and `vel_noise_mps^2` enter `dv'` only (the
+//! row's turn); odometer quantisation `1/6` pulse^2 (the difference of two carried
+//! fractions, each uniform in [0, 1)) and `vel_noise_mps^2` enter `dv'` only (the
 //! pulse remainder is carried, so quantisation does not accumulate in position);
 //! `pos_psd_m2_per_s dt` enters `dp`; the parameters walk with `sf_g_psd`, `v_nom_psd`,
 //! `sf_n_psd` times `dt`.
@@ -341,8 +342,9 @@ impl DrFusion {
     ];
 
     /// A filter starting at (`east_m`, `north_m`) with `heading_rad` (clockwise from north; see
-    /// [`heading_from_velocity`]) and the sensor parameters `params` (nominal, or a saved
-    /// calibration); `params` also convert engineering-unit rows.
+    /// [`heading_from_velocity`]) and the nominal sensor parameters `params` (the configuration's
+    /// `Sf_G`, `V_nom`, `Sf_N`; they also convert engineering-unit rows). To start from a saved
+    /// calibration, add [`DrFusion::with_calibration`].
     pub fn new(
         kind: DrFilterKind,
         params: DrParams,
@@ -377,6 +379,16 @@ impl DrFusion {
         })
     }
 
+    /// Starts from a previous run's calibration (e.g. [`DrParams::load`]) instead of the nominal
+    /// parameters given to [`DrFusion::new`], which remain the reference that converts
+    /// engineering-unit rows (the units the log was made with). Seed 000: this avoids the long
+    /// convergence of the gyro scale factor. The initial parameter sigmas are unchanged (shrink
+    /// them in [`DrFilterConfig`] for a trusted calibration).
+    pub fn with_calibration(mut self, calibrated: DrParams) -> Result<DrFusion, DrError> {
+        self.mech.set_params(calibrated)?;
+        Ok(self)
+    }
+
     /// Processes one DR row: mechanization and covariance prediction `P = F P F^T + Q`.
     pub fn propagate(&mut self, sample: &DrSample) -> Result<(), DrError> {
         let before = *self.mech.state();
@@ -396,8 +408,10 @@ impl DrFusion {
             DrFilterKind::Proposed8 => c.heading_psd_rad2_per_s,
             DrFilterKind::Conventional4 => c.conventional_heading_psd_rad2_per_s,
         } * dt;
+        // The row's count error is the difference of two carried fractions (each uniform in
+        // [0, 1), variance 1/12): variance 1/6 pulse^2.
         let q_pulse = if sample.reading.is_raw() {
-            1.0 / 12.0
+            1.0 / 6.0
         } else {
             0.0
         };
