@@ -23,7 +23,7 @@ use crate::config::{ConfigError, LoopConfig};
 use crate::lock_detector::{CodeLockDetector, PllLockConfig, PllLockDetector};
 use gpsrx_dsp::ca_code::{CaCode, Prn};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, CA_CODE_LENGTH, F_L1_HZ};
-use gpsrx_dsp::correlator::{correlate, ReplicaState};
+use gpsrx_dsp::correlator::{Correlator, PackedCode, ReplicaState, SampleSlice};
 use num_complex::{Complex32, Complex64};
 use serde::{Deserialize, Serialize};
 
@@ -213,7 +213,10 @@ pub struct ChannelEpoch {
 #[derive(Debug, Clone)]
 pub struct Channel {
     prn: Prn,
-    code: CaCode,
+    /// The C/A code, bit-packed for the correlator, built once.
+    packed_code: PackedCode,
+    /// The fastest correlator kernel of this CPU, chosen once.
+    correlator: Correlator,
     fs_hz: f64,
     cfg: ChannelConfig,
     state: ChannelState,
@@ -278,7 +281,8 @@ impl Channel {
         let d = cfg.pull_in.el_spacing_chips;
         Ok(Self {
             prn: start.prn,
-            code: CaCode::new(start.prn),
+            packed_code: PackedCode::new(CaCode::new(start.prn).chips()),
+            correlator: Correlator::best(),
             fs_hz,
             cfg: *cfg,
             state: ChannelState::PullIn,
@@ -409,10 +413,10 @@ impl Channel {
             self.acc_feedforward_hz = self.ff_applied_hz;
         }
         let mut out = [Complex32::new(0.0, 0.0); 3];
-        correlate(
-            samples,
+        self.correlator.correlate_packed(
+            SampleSlice::Cf32(samples),
             self.fs_hz,
-            self.code.chips(),
+            &self.packed_code,
             &state_now,
             &self.taps,
             &mut out,

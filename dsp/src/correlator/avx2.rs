@@ -205,20 +205,16 @@ impl Rotator {
             }
         }
     }
+}
 
-    /// `p *= d`, and `d *= q` when chirping.
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn advance(&mut self, chirp: bool, qr: __m256, qi: __m256) {
-        let pr = _mm256_fmsub_ps(self.pr, self.dr, _mm256_mul_ps(self.pi, self.di));
-        self.pi = _mm256_fmadd_ps(self.pr, self.di, _mm256_mul_ps(self.pi, self.dr));
-        self.pr = pr;
-        if chirp {
-            let dr = _mm256_fmsub_ps(self.dr, qr, _mm256_mul_ps(self.di, qi));
-            self.di = _mm256_fmadd_ps(self.dr, qi, _mm256_mul_ps(self.di, qr));
-            self.dr = dr;
-        }
-    }
+/// The complex product `(ar + j ai)(br + j bi)`.
+#[inline]
+#[target_feature(enable = "avx2,fma")]
+fn cmul(ar: __m256, ai: __m256, br: __m256, bi: __m256) -> (__m256, __m256) {
+    (
+        _mm256_fmsub_ps(ar, br, _mm256_mul_ps(ai, bi)),
+        _mm256_fmadd_ps(ar, bi, _mm256_mul_ps(ai, br)),
+    )
 }
 
 /// Per-lane code constants: `(o_j S) mod 2^32` and the shift base `30 - (o_j S >> 32)`.
@@ -302,13 +298,34 @@ unsafe fn f32_kernel<const F: u8, const NT: usize>(
     job: &Job<'_>,
     out: &mut [Complex32],
 ) {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        if job.carrier.chirps() {
+            f32_run::<F, NT, true>(data, n, job, out)
+        } else {
+            f32_run::<F, NT, false>(data, n, job, out)
+        }
+    }
+}
+
+/// The body of [`f32_kernel`], the rotator's rate (`d *= q`) compiled in or out.
+///
+/// # Safety
+/// As for [`f32_kernel`].
+#[inline]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn f32_run<const F: u8, const NT: usize, const CHIRP: bool>(
+    data: *const u8,
+    n: usize,
+    job: &Job<'_>,
+    out: &mut [Complex32],
+) {
     let bps = bytes_per_sample(F);
     let (full, total) = (n / L, n.div_ceil(L));
     // SAFETY: forwarded from the caller.
     let tail = unsafe { tail_copy(data, n, bps) };
     let (lane_lo, sh_base) = code_lanes(job);
     let sign = _mm256_set1_epi32(i32::MIN);
-    let chirp = job.carrier.chirps();
     let (q_re, q_im) = job.carrier.chirp::<L>();
     let (qr, qi) = (_mm256_set1_ps(q_re), _mm256_set1_ps(q_im));
     let step = job.nco.step * L as u64;
@@ -316,29 +333,39 @@ unsafe fn f32_kernel<const F: u8, const NT: usize>(
     base.copy_from_slice(&job.nco.phases[..NT]);
     let mut acc_re = [_mm256_setzero_ps(); NT];
     let mut acc_im = [_mm256_setzero_ps(); NT];
-    let mut rot = Rotator::seed(&job.carrier, 0, &job.order, 1.0);
-    for s in 0..total {
-        if s % RESEED_STEPS == 0 && s > 0 {
-            rot = Rotator::seed(&job.carrier, s * L, &job.order, 1.0);
-        }
-        // SAFETY: step_ptr yields 8 readable samples (slice or tail buffer).
-        let (xr, xi) = unsafe { load_f32::<F>(step_ptr(data, s, full, bps, &tail)) };
-        let wr = _mm256_fmsub_ps(xr, rot.pr, _mm256_mul_ps(xi, rot.pi));
-        let wi = _mm256_fmadd_ps(xr, rot.pi, _mm256_mul_ps(xi, rot.pr));
-        rot.advance(chirp, qr, qi);
-        for t in 0..NT {
-            let m = _mm256_castsi256_ps(_mm256_and_si256(
-                chip_bits(job.code, base[t], lane_lo, sh_base),
-                sign,
-            ));
-            acc_re[t] = _mm256_add_ps(acc_re[t], _mm256_xor_ps(wr, m));
-            acc_im[t] = _mm256_add_ps(acc_im[t], _mm256_xor_ps(wi, m));
-            let b = base[t] + step;
-            base[t] = if b >= CODE_LEN_FIX {
-                b - CODE_LEN_FIX
-            } else {
-                b
-            };
+    let mut s = 0;
+    while s < total {
+        let end = total.min(s + RESEED_STEPS);
+        let Rotator {
+            mut pr,
+            mut pi,
+            mut dr,
+            mut di,
+        } = Rotator::seed(&job.carrier, s * L, &job.order, 1.0);
+        while s < end {
+            // SAFETY: step_ptr yields 8 readable samples (slice or tail buffer).
+            let (xr, xi) = unsafe { load_f32::<F>(step_ptr(data, s, full, bps, &tail)) };
+            let wr = _mm256_fmsub_ps(xr, pr, _mm256_mul_ps(xi, pi));
+            let wi = _mm256_fmadd_ps(xr, pi, _mm256_mul_ps(xi, pr));
+            (pr, pi) = cmul(pr, pi, dr, di);
+            if CHIRP {
+                (dr, di) = cmul(dr, di, qr, qi);
+            }
+            for t in 0..NT {
+                let m = _mm256_castsi256_ps(_mm256_and_si256(
+                    chip_bits(job.code, base[t], lane_lo, sh_base),
+                    sign,
+                ));
+                acc_re[t] = _mm256_add_ps(acc_re[t], _mm256_xor_ps(wr, m));
+                acc_im[t] = _mm256_add_ps(acc_im[t], _mm256_xor_ps(wi, m));
+                let b = base[t] + step;
+                base[t] = if b >= CODE_LEN_FIX {
+                    b - CODE_LEN_FIX
+                } else {
+                    b
+                };
+            }
+            s += 1;
         }
     }
     for t in 0..NT {
@@ -372,12 +399,33 @@ unsafe fn i16_kernel<const F: u8, const NT: usize>(
     job: &Job<'_>,
     out: &mut [Complex32],
 ) {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        if job.carrier.chirps() {
+            i16_run::<F, NT, true>(data, n, job, out)
+        } else {
+            i16_run::<F, NT, false>(data, n, job, out)
+        }
+    }
+}
+
+/// The body of [`i16_kernel`], the rotator's rate (`d *= q`) compiled in or out.
+///
+/// # Safety
+/// As for [`i16_kernel`].
+#[inline]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn i16_run<const F: u8, const NT: usize, const CHIRP: bool>(
+    data: *const u8,
+    n: usize,
+    job: &Job<'_>,
+    out: &mut [Complex32],
+) {
     let bps = bytes_per_sample(F);
     let (full, total) = (n / L, n.div_ceil(L));
     // SAFETY: forwarded from the caller.
     let tail = unsafe { tail_copy(data, n, bps) };
     let (lane_lo, sh_base) = code_lanes(job);
-    let chirp = job.carrier.chirps();
     let (q_re, q_im) = job.carrier.chirp::<L>();
     let (qr, qi) = (_mm256_set1_ps(q_re), _mm256_set1_ps(q_im));
     // packs_epi32(c, s) holds [c0 c1 c2 c3 s0 s1 s2 s3] per 128-bit half.
@@ -398,10 +446,16 @@ unsafe fn i16_kernel<const F: u8, const NT: usize>(
     let (mut acc_re, mut acc_im, mut cnt) = ([zero; NT], [zero; NT], [zero; NT]);
     let mut sums = [(0i64, 0i64); NT];
     let scale = f64::from(Q14);
-    let mut rot = Rotator::seed(&job.carrier, 0, &job.order, scale);
-    for s in 0..total {
-        if s % RESEED_STEPS == 0 && s > 0 {
-            rot = Rotator::seed(&job.carrier, s * L, &job.order, scale);
+    let mut s = 0;
+    while s < total {
+        let end = total.min(s + RESEED_STEPS);
+        let Rotator {
+            mut pr,
+            mut pi,
+            mut dr,
+            mut di,
+        } = Rotator::seed(&job.carrier, s * L, &job.order, scale);
+        if s > 0 {
             for t in 0..NT {
                 let c = hsum_i(cnt[t]);
                 sums[t].0 += hsum_i(acc_re[t]) - c;
@@ -409,29 +463,35 @@ unsafe fn i16_kernel<const F: u8, const NT: usize>(
                 (acc_re[t], acc_im[t], cnt[t]) = (zero, zero, zero);
             }
         }
-        // SAFETY: step_ptr yields 8 readable samples (slice or tail buffer).
-        let x = unsafe { load_i16::<F>(step_ptr(data, s, full, bps, &tail)) };
-        let cs = _mm256_packs_epi32(_mm256_cvtps_epi32(rot.pr), _mm256_cvtps_epi32(rot.pi));
-        let pair_re = _mm256_sign_epi16(_mm256_shuffle_epi8(cs, to_cs), neg_odd);
-        let pair_im = _mm256_shuffle_epi8(cs, to_sc);
-        let mut wr = _mm256_madd_epi16(x, pair_re);
-        let mut wi = _mm256_madd_epi16(x, pair_im);
-        if F == CI16 {
-            wr = _mm256_srai_epi32::<8>(_mm256_add_epi32(wr, round));
-            wi = _mm256_srai_epi32::<8>(_mm256_add_epi32(wi, round));
-        }
-        rot.advance(chirp, qr, qi);
-        for t in 0..NT {
-            let m = _mm256_srai_epi32::<31>(chip_bits(job.code, base[t], lane_lo, sh_base));
-            acc_re[t] = _mm256_add_epi32(acc_re[t], _mm256_xor_si256(wr, m));
-            acc_im[t] = _mm256_add_epi32(acc_im[t], _mm256_xor_si256(wi, m));
-            cnt[t] = _mm256_add_epi32(cnt[t], m);
-            let b = base[t] + step;
-            base[t] = if b >= CODE_LEN_FIX {
-                b - CODE_LEN_FIX
-            } else {
-                b
-            };
+        while s < end {
+            // SAFETY: step_ptr yields 8 readable samples (slice or tail buffer).
+            let x = unsafe { load_i16::<F>(step_ptr(data, s, full, bps, &tail)) };
+            let cs = _mm256_packs_epi32(_mm256_cvtps_epi32(pr), _mm256_cvtps_epi32(pi));
+            let pair_re = _mm256_sign_epi16(_mm256_shuffle_epi8(cs, to_cs), neg_odd);
+            let pair_im = _mm256_shuffle_epi8(cs, to_sc);
+            let mut wr = _mm256_madd_epi16(x, pair_re);
+            let mut wi = _mm256_madd_epi16(x, pair_im);
+            if F == CI16 {
+                wr = _mm256_srai_epi32::<8>(_mm256_add_epi32(wr, round));
+                wi = _mm256_srai_epi32::<8>(_mm256_add_epi32(wi, round));
+            }
+            (pr, pi) = cmul(pr, pi, dr, di);
+            if CHIRP {
+                (dr, di) = cmul(dr, di, qr, qi);
+            }
+            for t in 0..NT {
+                let m = _mm256_srai_epi32::<31>(chip_bits(job.code, base[t], lane_lo, sh_base));
+                acc_re[t] = _mm256_add_epi32(acc_re[t], _mm256_xor_si256(wr, m));
+                acc_im[t] = _mm256_add_epi32(acc_im[t], _mm256_xor_si256(wi, m));
+                cnt[t] = _mm256_add_epi32(cnt[t], m);
+                let b = base[t] + step;
+                base[t] = if b >= CODE_LEN_FIX {
+                    b - CODE_LEN_FIX
+                } else {
+                    b
+                };
+            }
+            s += 1;
         }
     }
     let unit = if F == CI16 {

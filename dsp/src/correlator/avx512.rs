@@ -4,6 +4,10 @@
 //! subtract; the f32 sign flip and the XOR fuse into one `vpternlogd`; the int16 kernel selects
 //! `w` or `-w` per lane with the chip mask instead of the XOR/count correction.
 
+//!
+//! The AVX-512 intrinsics are stable since Rust 1.89: this module needs 1.89 although the
+//! workspace declares 1.85 (the lead should raise `rust-version`).
+
 use super::kernel::{Arithmetic, SampleSlice};
 use super::packed::PackedCode;
 use super::plan::{code_window, natural, CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
@@ -207,20 +211,16 @@ impl Rotator {
             }
         }
     }
+}
 
-    /// `p *= d`, and `d *= q` when chirping.
-    #[inline]
-    #[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
-    fn advance(&mut self, chirp: bool, qr: __m512, qi: __m512) {
-        let pr = _mm512_fmsub_ps(self.pr, self.dr, _mm512_mul_ps(self.pi, self.di));
-        self.pi = _mm512_fmadd_ps(self.pr, self.di, _mm512_mul_ps(self.pi, self.dr));
-        self.pr = pr;
-        if chirp {
-            let dr = _mm512_fmsub_ps(self.dr, qr, _mm512_mul_ps(self.di, qi));
-            self.di = _mm512_fmadd_ps(self.dr, qi, _mm512_mul_ps(self.di, qr));
-            self.dr = dr;
-        }
-    }
+/// The complex product `(ar + j ai)(br + j bi)`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+fn cmul(ar: __m512, ai: __m512, br: __m512, bi: __m512) -> (__m512, __m512) {
+    (
+        _mm512_fmsub_ps(ar, br, _mm512_mul_ps(ai, bi)),
+        _mm512_fmadd_ps(ar, bi, _mm512_mul_ps(ai, br)),
+    )
 }
 
 /// Per-lane code constants: `(o_j S) mod 2^32` and the shift base `31 - (o_j S >> 32)`.
@@ -293,13 +293,34 @@ unsafe fn f32_kernel<const F: u8, const NT: usize>(
     job: &Job<'_>,
     out: &mut [Complex32],
 ) {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        if job.carrier.chirps() {
+            f32_run::<F, NT, true>(data, n, job, out)
+        } else {
+            f32_run::<F, NT, false>(data, n, job, out)
+        }
+    }
+}
+
+/// The body of [`f32_kernel`], the rotator's rate (`d *= q`) compiled in or out.
+///
+/// # Safety
+/// As for [`f32_kernel`].
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+unsafe fn f32_run<const F: u8, const NT: usize, const CHIRP: bool>(
+    data: *const u8,
+    n: usize,
+    job: &Job<'_>,
+    out: &mut [Complex32],
+) {
     let bps = bytes_per_sample(F);
     let (full, total) = (n / L, n.div_ceil(L));
     // SAFETY: forwarded from the caller.
     let tail = unsafe { tail_copy(data, n, bps) };
     let (lane_lo, sh_base) = code_lanes(job);
     let sign = _mm512_set1_epi32(i32::MIN);
-    let chirp = job.carrier.chirps();
     let (q_re, q_im) = job.carrier.chirp::<L>();
     let (qr, qi) = (_mm512_set1_ps(q_re), _mm512_set1_ps(q_im));
     let step = job.nco.step * L as u64;
@@ -307,29 +328,39 @@ unsafe fn f32_kernel<const F: u8, const NT: usize>(
     base.copy_from_slice(&job.nco.phases[..NT]);
     let mut acc_re = [_mm512_setzero_ps(); NT];
     let mut acc_im = [_mm512_setzero_ps(); NT];
-    let mut rot = Rotator::seed(&job.carrier, 0, &job.order, 1.0);
-    for s in 0..total {
-        if s % RESEED_STEPS == 0 && s > 0 {
-            rot = Rotator::seed(&job.carrier, s * L, &job.order, 1.0);
-        }
-        // SAFETY: step_ptr yields 16 readable samples (slice or tail buffer).
-        let (xr, xi) = unsafe { load_f32::<F>(step_ptr(data, s, full, bps, &tail)) };
-        let wr = _mm512_castps_si512(_mm512_fmsub_ps(xr, rot.pr, _mm512_mul_ps(xi, rot.pi)));
-        let wi = _mm512_castps_si512(_mm512_fmadd_ps(xr, rot.pi, _mm512_mul_ps(xi, rot.pr)));
-        rot.advance(chirp, qr, qi);
-        for t in 0..NT {
-            let bits = chip_bits(job.code, base[t], lane_lo, sh_base);
-            // w ^ (bits & sign): imm 0x78 is a ^ (b & c).
-            let fr = _mm512_ternarylogic_epi32::<0x78>(wr, bits, sign);
-            let fi = _mm512_ternarylogic_epi32::<0x78>(wi, bits, sign);
-            acc_re[t] = _mm512_add_ps(acc_re[t], _mm512_castsi512_ps(fr));
-            acc_im[t] = _mm512_add_ps(acc_im[t], _mm512_castsi512_ps(fi));
-            let b = base[t] + step;
-            base[t] = if b >= CODE_LEN_FIX {
-                b - CODE_LEN_FIX
-            } else {
-                b
-            };
+    let mut s = 0;
+    while s < total {
+        let end = total.min(s + RESEED_STEPS);
+        let Rotator {
+            mut pr,
+            mut pi,
+            mut dr,
+            mut di,
+        } = Rotator::seed(&job.carrier, s * L, &job.order, 1.0);
+        while s < end {
+            // SAFETY: step_ptr yields 16 readable samples (slice or tail buffer).
+            let (xr, xi) = unsafe { load_f32::<F>(step_ptr(data, s, full, bps, &tail)) };
+            let wr = _mm512_castps_si512(_mm512_fmsub_ps(xr, pr, _mm512_mul_ps(xi, pi)));
+            let wi = _mm512_castps_si512(_mm512_fmadd_ps(xr, pi, _mm512_mul_ps(xi, pr)));
+            (pr, pi) = cmul(pr, pi, dr, di);
+            if CHIRP {
+                (dr, di) = cmul(dr, di, qr, qi);
+            }
+            for t in 0..NT {
+                let bits = chip_bits(job.code, base[t], lane_lo, sh_base);
+                // w ^ (bits & sign): imm 0x78 is a ^ (b & c).
+                let fr = _mm512_ternarylogic_epi32::<0x78>(wr, bits, sign);
+                let fi = _mm512_ternarylogic_epi32::<0x78>(wi, bits, sign);
+                acc_re[t] = _mm512_add_ps(acc_re[t], _mm512_castsi512_ps(fr));
+                acc_im[t] = _mm512_add_ps(acc_im[t], _mm512_castsi512_ps(fi));
+                let b = base[t] + step;
+                base[t] = if b >= CODE_LEN_FIX {
+                    b - CODE_LEN_FIX
+                } else {
+                    b
+                };
+            }
+            s += 1;
         }
     }
     for t in 0..NT {
@@ -370,12 +401,33 @@ unsafe fn i16_kernel<const F: u8, const NT: usize>(
     job: &Job<'_>,
     out: &mut [Complex32],
 ) {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        if job.carrier.chirps() {
+            i16_run::<F, NT, true>(data, n, job, out)
+        } else {
+            i16_run::<F, NT, false>(data, n, job, out)
+        }
+    }
+}
+
+/// The body of [`i16_kernel`], the rotator's rate (`d *= q`) compiled in or out.
+///
+/// # Safety
+/// As for [`i16_kernel`].
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+unsafe fn i16_run<const F: u8, const NT: usize, const CHIRP: bool>(
+    data: *const u8,
+    n: usize,
+    job: &Job<'_>,
+    out: &mut [Complex32],
+) {
     let bps = bytes_per_sample(F);
     let (full, total) = (n / L, n.div_ceil(L));
     // SAFETY: forwarded from the caller.
     let tail = unsafe { tail_copy(data, n, bps) };
     let (lane_lo, sh_base) = code_lanes(job);
-    let chirp = job.carrier.chirps();
     let (q_re, q_im) = job.carrier.chirp::<L>();
     let (qr, qi) = (_mm512_set1_ps(q_re), _mm512_set1_ps(q_im));
     // packs_epi32(c, s) holds [c0 c1 c2 c3 s0 s1 s2 s3] per 128-bit quarter.
@@ -393,41 +445,54 @@ unsafe fn i16_kernel<const F: u8, const NT: usize>(
     let (mut acc_re, mut acc_im) = ([zero; NT], [zero; NT]);
     let mut sums = [(0i64, 0i64); NT];
     let scale = f64::from(Q14);
-    let mut rot = Rotator::seed(&job.carrier, 0, &job.order, scale);
-    for s in 0..total {
-        if s % RESEED_STEPS == 0 && s > 0 {
-            rot = Rotator::seed(&job.carrier, s * L, &job.order, scale);
+    let mut s = 0;
+    while s < total {
+        let end = total.min(s + RESEED_STEPS);
+        let Rotator {
+            mut pr,
+            mut pi,
+            mut dr,
+            mut di,
+        } = Rotator::seed(&job.carrier, s * L, &job.order, scale);
+        if s > 0 {
             for t in 0..NT {
                 sums[t].0 += hsum_i(acc_re[t]);
                 sums[t].1 += hsum_i(acc_im[t]);
                 (acc_re[t], acc_im[t]) = (zero, zero);
             }
         }
-        // SAFETY: step_ptr yields 16 readable samples (slice or tail buffer).
-        let x = unsafe { load_i16::<F>(step_ptr(data, s, full, bps, &tail)) };
-        let cs = _mm512_packs_epi32(_mm512_cvtps_epi32(rot.pr), _mm512_cvtps_epi32(rot.pi));
-        let cs_pairs = _mm512_shuffle_epi8(cs, to_cs);
-        // Negate the odd i16 (the sine): [c, -s] pairs.
-        let pair_re = _mm512_mask_sub_epi16(cs_pairs, 0xAAAA_AAAA, zero, cs_pairs);
-        let pair_im = _mm512_shuffle_epi8(cs, to_sc);
-        let mut wr = _mm512_madd_epi16(x, pair_re);
-        let mut wi = _mm512_madd_epi16(x, pair_im);
-        if F == CI16 {
-            wr = _mm512_srai_epi32::<8>(_mm512_add_epi32(wr, round));
-            wi = _mm512_srai_epi32::<8>(_mm512_add_epi32(wi, round));
-        }
-        let (nwr, nwi) = (_mm512_sub_epi32(zero, wr), _mm512_sub_epi32(zero, wi));
-        rot.advance(chirp, qr, qi);
-        for t in 0..NT {
-            let neg = _mm512_cmplt_epi32_mask(chip_bits(job.code, base[t], lane_lo, sh_base), zero);
-            acc_re[t] = _mm512_add_epi32(acc_re[t], _mm512_mask_mov_epi32(wr, neg, nwr));
-            acc_im[t] = _mm512_add_epi32(acc_im[t], _mm512_mask_mov_epi32(wi, neg, nwi));
-            let b = base[t] + step;
-            base[t] = if b >= CODE_LEN_FIX {
-                b - CODE_LEN_FIX
-            } else {
-                b
-            };
+        while s < end {
+            // SAFETY: step_ptr yields 16 readable samples (slice or tail buffer).
+            let x = unsafe { load_i16::<F>(step_ptr(data, s, full, bps, &tail)) };
+            let cs = _mm512_packs_epi32(_mm512_cvtps_epi32(pr), _mm512_cvtps_epi32(pi));
+            let cs_pairs = _mm512_shuffle_epi8(cs, to_cs);
+            // Negate the odd i16 (the sine): [c, -s] pairs.
+            let pair_re = _mm512_mask_sub_epi16(cs_pairs, 0xAAAA_AAAA, zero, cs_pairs);
+            let pair_im = _mm512_shuffle_epi8(cs, to_sc);
+            let mut wr = _mm512_madd_epi16(x, pair_re);
+            let mut wi = _mm512_madd_epi16(x, pair_im);
+            if F == CI16 {
+                wr = _mm512_srai_epi32::<8>(_mm512_add_epi32(wr, round));
+                wi = _mm512_srai_epi32::<8>(_mm512_add_epi32(wi, round));
+            }
+            let (nwr, nwi) = (_mm512_sub_epi32(zero, wr), _mm512_sub_epi32(zero, wi));
+            (pr, pi) = cmul(pr, pi, dr, di);
+            if CHIRP {
+                (dr, di) = cmul(dr, di, qr, qi);
+            }
+            for t in 0..NT {
+                let neg =
+                    _mm512_cmplt_epi32_mask(chip_bits(job.code, base[t], lane_lo, sh_base), zero);
+                acc_re[t] = _mm512_add_epi32(acc_re[t], _mm512_mask_mov_epi32(wr, neg, nwr));
+                acc_im[t] = _mm512_add_epi32(acc_im[t], _mm512_mask_mov_epi32(wi, neg, nwi));
+                let b = base[t] + step;
+                base[t] = if b >= CODE_LEN_FIX {
+                    b - CODE_LEN_FIX
+                } else {
+                    b
+                };
+            }
+            s += 1;
         }
     }
     let unit = if F == CI16 {

@@ -200,17 +200,22 @@ fn every_kernel_matches_the_references_on_random_blocks() {
     let code = CaCode::new(Prn::new(17).unwrap_or_else(|e| panic!("{e}")));
     let kernels = Correlator::available();
     assert!(kernels.iter().any(|c| c.isa() == Isa::Scalar));
+    let mut worst = vec![0.0f64; kernels.len()];
     for &n in &[1usize, 7, 8, 15, 16, 17, 31, 33, 1001, 4093] {
         let block = Block::random(&mut rng, n + 3);
         for _ in 0..2 {
             let case = random_case(&mut rng, n);
             let offset = rng.random_range(0..=3usize);
-            for c in &kernels {
+            for (c, w) in kernels.iter().zip(worst.iter_mut()) {
                 for fmt in [Fmt::Cf32, Fmt::Ci16, Fmt::Ci8] {
-                    check(c, fmt, block.slice(fmt, offset..offset + n), &code, &case);
+                    let e = check(c, fmt, block.slice(fmt, offset..offset + n), &code, &case);
+                    *w = w.max(e);
                 }
             }
         }
+    }
+    for (c, w) in kernels.iter().zip(worst) {
+        println!("{}: worst |err - edge| / sum|x| = {w:.2e}", c.name());
     }
 }
 
@@ -241,6 +246,7 @@ fn long_blocks_do_not_drift() {
                 if c.isa() != Isa::Scalar {
                     assert!(worst < 1e-4, "{} {fmt:?}: {worst}", c.name());
                 }
+                println!("rate {rate}: {} {fmt:?}: {worst:.2e}", c.name());
             }
         }
     }

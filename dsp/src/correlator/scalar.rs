@@ -1,15 +1,15 @@
 //! Portable scalar kernels (and the reference): one sample at a time, fixed-point NCOs.
 //!
-//! Carrier: the 2^-32-cycle phase accumulator with a second-order step (for the rate) and a
+//! Carrier: a 2^-48-cycle phase accumulator with a second-order step (for the rate) and a
 //! 4096-entry table (phase error <= 1/8192 cycle). Code: the 2^-32-chip NCO of
 //! [`super::plan`]. The f32 kernel accumulates `x * exp(-j 2 pi phi) * code` in f32; the int16
 //! kernel multiplies integer samples by the table carrier rounded to Q14 (`round(2^14 cos)`) and
 //! accumulates exactly in i64, scaled by 2^-14 on output.
 
-use super::plan::{code_phase_fix, code_step_fix, CODE_LEN_FIX, FIX};
+use super::plan::{code_phase_fix, code_step_fix, CODE_LEN_FIX};
 use super::{ReplicaState, MAX_TAPS};
 use crate::constants::CA_CODE_LENGTH;
-use crate::nco::{cycles_to_fixed, SinCosTable};
+use crate::nco::SinCosTable;
 use num_complex::Complex32;
 use std::sync::OnceLock;
 
@@ -64,31 +64,38 @@ fn table() -> &'static SinCosTable {
 }
 
 /// The table carrier: `exp(-j 2 pi phi(k))` sample by sample.
+///
+/// Phase, step and step increment in 2^-48 cycle (the table reads the top 12 bits): a rate of
+/// a few kHz/s is only ~1 unit of 2^-32 cycle per sample^2 at 4 MHz, too coarse for 2^-32.
 struct TableCarrier {
-    phase: u32,
+    phase: u64,
     step: i64,
     dstep: i64,
 }
+
+/// One cycle in the table carrier's units.
+const FIX48: f64 = 281_474_976_710_656.0;
 
 impl TableCarrier {
     fn new(state: &ReplicaState, fs_hz: f64) -> Self {
         let step0 = state.carrier_freq_hz / fs_hz;
         let dstep = state.carrier_rate_hz_s / (fs_hz * fs_hz);
+        let phase = -state.carrier_phase_cycles;
         // Wipe-off multiplies by exp(-j 2 pi phi): run the accumulator at the negated
         // frequency. The phase increment between samples k and k+1 is step0 + dstep (k + 1/2).
         Self {
-            phase: cycles_to_fixed(-state.carrier_phase_cycles),
-            step: (-(step0 + 0.5 * dstep) * FIX).round() as i64,
-            dstep: (-dstep * FIX).round() as i64,
+            phase: ((phase - phase.floor()) * FIX48) as u64,
+            step: (-(step0 + 0.5 * dstep) * FIX48).round() as i64,
+            dstep: (-dstep * FIX48).round() as i64,
         }
     }
 
     /// The phase (2^-32 cycle) for the current sample; advances to the next.
     #[inline(always)]
     fn next(&mut self) -> u32 {
-        let p = self.phase;
-        self.phase = self.phase.wrapping_add(self.step as u32);
-        self.step += self.dstep;
+        let p = (self.phase >> 16) as u32;
+        self.phase = self.phase.wrapping_add(self.step as u64) & ((1 << 48) - 1);
+        self.step = self.step.wrapping_add(self.dstep);
         p
     }
 }
