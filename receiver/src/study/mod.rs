@@ -1,10 +1,12 @@
-//! `gpsrx study ...`: loop-bandwidth, steady-state and high-dynamics studies (seed 004).
+//! `gpsrx study ...`: loop-bandwidth, steady-state and high-dynamics studies (seed 004), and
+//! GPS/DR fusion (seeds 000 and 002).
 //!
 //! Each study runs its cases in parallel (rayon) behind a progress bar and writes `study.md`,
 //! `study.csv`, `study.json` and PNG plots to `--out DIR` (see [`report`]). `--quick` runs a
 //! small grid that finishes in well under a minute (used by the tests).
 
 pub mod bandwidth;
+pub mod dr;
 pub mod dynamics;
 pub mod if_sim;
 pub mod report;
@@ -35,6 +37,10 @@ pub enum StudyKind {
     /// Simulated manoeuvres of 1-20 g: satellites kept, loss-of-lock events and errors,
     /// unaided and aided by INS of two qualities.
     Dynamics(dynamics::DynamicsArgs),
+    /// GPS/DR integration with carrier velocity (seed 000: proposed 8-state vs conventional
+    /// 4-state filter, outages, a tilted gyro) and the accelerometer speed filter (seed 002) on a
+    /// simulated urban drive.
+    Dr(dr::DrArgs),
 }
 
 /// Options every study has.
@@ -57,6 +63,7 @@ pub fn run(args: &StudyArgs) -> anyhow::Result<()> {
         StudyKind::SteadyState(a) => (steady_state::run(a, true)?, &a.common.out),
         StudyKind::Bandwidth(a) => (bandwidth::run(a, true)?, &a.common.out),
         StudyKind::Dynamics(a) => (dynamics::run(a, true)?, &a.common.out),
+        StudyKind::Dr(a) => (dr::run(a, true)?, &a.common.out),
     };
     let written = report.write(out)?;
     println!("{}", report.table.to_markdown());

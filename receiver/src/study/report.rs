@@ -163,7 +163,8 @@ impl StudyReport {
 
 static FONT: Once = Once::new();
 
-fn register_font() {
+/// Registers the embedded font as `sans-serif` (once per process).
+pub(crate) fn register_font() {
     FONT.call_once(|| {
         let bytes: &'static [u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
         if plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_err() {
