@@ -25,10 +25,16 @@
 //! - [`dr_filter`]: [`DrFusion`] with [`DrFilterKind::Proposed8`] (seed 000 eqs. 5-14: position,
 //!   velocity, heading, `Sf_G`, `V_nom`, `Sf_N` errors; GNSS position and velocity updates) or
 //!   [`DrFilterKind::Conventional4`] (eq. 7: position, heading, `Sf_N`; position updates only),
-//!   closed loop: `new(kind, params, east_m, north_m, heading_rad, DrFilterConfig)`,
-//!   `propagate(&DrSample)`, `update_position(e, n, cov)`, `update_velocity(ve, vn, cov)`,
-//!   `state()`, `params()`, `covariance()`, `fix_source(max_age_s)` -> [`FixSource`];
-//!   [`heading_from_velocity`] initialises the heading from the GNSS course;
+//!   closed loop: `new(kind, nominal_params, east_m, north_m, heading_rad, DrFilterConfig)`,
+//!   optionally `.with_calibration(DrParams::load(path)?)` (a previous run's parameters; the
+//!   nominal ones still convert engineering-unit rows), then `propagate(&DrSample)` per DR row,
+//!   `update_position(e, n, cov)` -> NIS and `update_velocity(ve, vn, cov)` -> `Some(NIS)` (None
+//!   for the 4-state filter) at the time of the last row, `state()` ([`DrState`]: position,
+//!   heading, speed, yaw rate, velocity), `params()` (the calibration to save),
+//!   `covariance()`, `position_covariance()`, `fix_source(max_age_s)` -> [`FixSource`];
+//!   [`heading_from_velocity`] initialises the heading from the GNSS course. The transition is
+//!   the exact Jacobian of the mechanization ([`row_model`], tested against finite differences);
+//!   process noise and its units are in [`DrFilterConfig`] and the module documentation;
 //! - [`speed_filter`]: seed 002's [`AccelSmoother`] (KF1) and [`SpeedFilter`] (KF2:
 //!   `predict(a_long_mps2, dt)`, `update_speed(v_mps, sigma)`, `speed_mps()`), and the
 //!   [`HoldLastSpeed`] baseline.
