@@ -281,7 +281,7 @@ fn proposed_filter_nees_is_within_chi_square_bounds() {
                 ];
                 let nees = |idx: &[usize]| {
                     let n = idx.len();
-                    let pm = DMatrix::from_fn(n, n, |i, j| f.covariance()[(idx[i], idx[j])]);
+                    let pm = DMatrix::from_fn(n, n, |i, j| f.full_covariance()[(idx[i], idx[j])]);
                     let em = DVector::from_fn(n, |i, _| e[idx[i]]);
                     let pinv = pm
                         .try_inverse()

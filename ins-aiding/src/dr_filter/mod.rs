@@ -54,7 +54,9 @@ use crate::dr_error::DrError;
 use crate::dr_log::DrSample;
 use crate::dr_mechanization::{DrMechanization, DrParams, DrState};
 use crate::vehicle::wrap_pi;
-use nalgebra::{DMatrix, DVector, Matrix2};
+use nalgebra::{DMatrix, Matrix2, SMatrix, SVector};
+
+type Matrix8 = SMatrix<f64, 8, 8>;
 
 /// A GPS/DR fusion filter ([`DrFilterKind`]) around a DR mechanization (module documentation).
 #[derive(Debug, Clone)]
@@ -62,8 +64,9 @@ pub struct DrFusion {
     kind: DrFilterKind,
     config: DrFilterConfig,
     mech: DrMechanization,
-    /// Error covariance in this kind's state order.
-    p: DMatrix<f64>,
+    /// Error covariance over the full 8 states; the rows and columns of states this kind does not
+    /// carry are zero (so they never act), which equals the kind's own filter.
+    p: Matrix8,
     last_update_t_s: Option<f64>,
 }
 
@@ -104,11 +107,10 @@ impl DrFusion {
             config.init_v_nom_sigma_v,
             config.init_sf_n_sigma_rel * params.sf_n_m_per_pulse,
         ];
-        let idx = kind.state_indices();
-        let p = DMatrix::from_diagonal(&DVector::from_iterator(
-            idx.len(),
-            idx.iter().map(|&i| full[i] * full[i]),
-        ));
+        let mut p = Matrix8::zeros();
+        for &i in kind.state_indices() {
+            p[(i, i)] = full[i] * full[i];
+        }
         Ok(DrFusion {
             kind,
             config,
@@ -167,13 +169,19 @@ impl DrFusion {
         ] {
             q[(i, i)] += v;
         }
-        let idx = self.kind.state_indices();
-        let n = idx.len();
-        let f = DMatrix::from_fn(n, n, |r, col| m.f[(idx[r], idx[col])]);
-        let q = DMatrix::from_fn(n, n, |r, col| q[(idx[r], idx[col])]);
-        self.p = &f * &self.p * f.transpose() + q;
-        self.p = (&self.p + self.p.transpose()) * 0.5;
+        self.p = m.f * self.p * m.f.transpose() + q;
+        self.p = (self.p + self.p.transpose()) * 0.5;
+        self.zero_unused_states();
         Ok(())
+    }
+
+    /// Zeroes the rows and columns of the states this kind does not carry.
+    fn zero_unused_states(&mut self) {
+        let idx = self.kind.state_indices();
+        for i in (0..8).filter(|i| !idx.contains(i)) {
+            self.p.row_mut(i).fill(0.0);
+            self.p.column_mut(i).fill(0.0);
+        }
     }
 
     /// GNSS position update (`z = p_DR - p_GNSS`, eq. 14); `cov` is the PVT's 2x2 (east, north)
@@ -227,32 +235,30 @@ impl DrFusion {
             )));
         }
         let idx = self.kind.state_indices();
-        let n = idx.len();
-        let col = |full: usize| idx.iter().position(|&i| i == full);
-        let (Some(c0), Some(c1)) = (col(first_full_state), col(first_full_state + 1)) else {
+        if !(idx.contains(&first_full_state) && idx.contains(&(first_full_state + 1))) {
             return Err(DrError::Input(format!(
                 "the {:?} filter has no {what} states",
                 self.kind
             )));
-        };
-        let mut h = DMatrix::<f64>::zeros(2, n);
-        h[(0, c0)] = 1.0;
-        h[(1, c1)] = 1.0;
-        let r = DMatrix::from_fn(2, 2, |i, j| r[(i, j)]);
-        let s = &h * &self.p * h.transpose() + &r;
-        let s_inv = s.clone().try_inverse().ok_or_else(|| {
+        }
+        let mut h = SMatrix::<f64, 2, 8>::zeros();
+        h[(0, first_full_state)] = 1.0;
+        h[(1, first_full_state + 1)] = 1.0;
+        let s = h * self.p * h.transpose() + r;
+        let s_inv = s.try_inverse().ok_or_else(|| {
             DrError::Input(format!("GNSS {what} innovation covariance is singular"))
         })?;
-        let y = DVector::from_row_slice(&z);
-        let nis = (y.transpose() * &s_inv * &y)[(0, 0)];
-        let k = &self.p * h.transpose() * &s_inv;
-        let dx = &k * &y;
-        let ikh = DMatrix::<f64>::identity(n, n) - &k * &h;
-        self.p = &ikh * &self.p * ikh.transpose() + &k * &r * k.transpose();
-        self.p = (&self.p + self.p.transpose()) * 0.5;
+        let y = SVector::<f64, 2>::from(z);
+        let nis = (y.transpose() * s_inv * y)[(0, 0)];
+        let k = self.p * h.transpose() * s_inv;
+        let dx = k * y;
+        let ikh = Matrix8::identity() - k * h;
+        self.p = ikh * self.p * ikh.transpose() + k * r * k.transpose();
+        self.p = (self.p + self.p.transpose()) * 0.5;
+        self.zero_unused_states();
         let mut full = [0.0; 8];
-        for (j, &i) in idx.iter().enumerate() {
-            full[i] = dx[j];
+        for &i in idx {
+            full[i] = dx[i];
         }
         self.feed_back(&full);
         self.last_update_t_s = self.mech.state().t_s;
@@ -302,7 +308,14 @@ impl DrFusion {
     }
 
     /// The error covariance in this kind's state order ([`DrFilterKind::state_indices`]).
-    pub fn covariance(&self) -> &DMatrix<f64> {
+    pub fn covariance(&self) -> DMatrix<f64> {
+        let idx = self.kind.state_indices();
+        DMatrix::from_fn(idx.len(), idx.len(), |i, j| self.p[(idx[i], idx[j])])
+    }
+
+    /// The error covariance over the full 8 states ([`DrFusion::STATE_NAMES`]), with zero rows
+    /// and columns for the states this kind does not carry.
+    pub fn full_covariance(&self) -> &SMatrix<f64, 8, 8> {
         &self.p
     }
 
@@ -319,12 +332,10 @@ impl DrFusion {
     /// The variance of full state `i` (0-7, [`DrFusion::STATE_NAMES`]), None if this kind does
     /// not carry it.
     pub fn state_variance(&self, full_index: usize) -> Option<f64> {
-        let j = self
-            .kind
+        self.kind
             .state_indices()
-            .iter()
-            .position(|&i| i == full_index)?;
-        Some(self.p[(j, j)])
+            .contains(&full_index)
+            .then(|| self.p[(full_index, full_index)])
     }
 
     /// The filter kind.
