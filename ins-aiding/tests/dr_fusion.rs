@@ -191,7 +191,7 @@ fn chi2_quantile(nu: f64, z: f64) -> f64 {
 /// The 8-state filter on data consistent with its model (white GNSS noise, initial errors drawn
 /// from P0, gyro noise matched by the heading PSD, constant sensor parameters): over M = 80
 /// independent runs, M times the average NEES at an epoch is chi-square with M n degrees of
-/// freedom; it must lie within the two-sided 99 % bounds at 50, 100 and 150 s.
+/// freedom (n = 6, below); checked against its two-sided bounds from 20 to 150 s.
 ///
 /// The NEES is taken over the 6 states `[dp, dpsi, dSf_G, dV_nom, dSf_N]`: the velocity error is,
 /// to first order, the deterministic function `s u'(psi) dpsi + (N/dt) u(psi) dSf_N` of them plus
@@ -294,36 +294,39 @@ fn proposed_filter_nees_is_within_chi_square_bounds() {
         );
     }
     let m = RUNS as f64;
-    let bounds = |n: f64| {
+    let bounds = |z: f64| {
         (
-            chi2_quantile(n * m, -2.575829) / m,
-            chi2_quantile(n * m, 2.575829) / m,
+            chi2_quantile(6.0 * m, -z) / m,
+            chi2_quantile(6.0 * m, z) / m,
         )
     };
-    let (lo, hi) = bounds(6.0);
     let avg = |sum: &[f64], t: usize| sum[t] / m;
-    eprintln!(
-        "8-state NEES every 10 s: {:?}",
-        (10..=epochs)
-            .step_by(10)
-            .map(|t| (avg(&sum8, t) * 10.0).round() / 10.0)
-            .collect::<Vec<_>>()
-    );
-    eprintln!(
-        "6-state NEES every 10 s: {:?}",
-        (10..=epochs)
-            .step_by(10)
-            .map(|t| (avg(&sum6, t) * 10.0).round() / 10.0)
-            .collect::<Vec<_>>()
-    );
-    for t in [50, 100, 150] {
-        let a = avg(&sum6, t);
-        eprintln!("6-state NEES at {t} s over {RUNS} runs: {a:.2}, 99 % bounds [{lo:.2}, {hi:.2}]");
-        assert!(
-            a > lo && a < hi,
-            "average NEES {a:.2} at {t} s outside [{lo:.2}, {hi:.2}]"
+    for (name, sum) in [("8-state", &sum8), ("6-state", &sum6)] {
+        eprintln!(
+            "{name} NEES every 10 s: {:?}",
+            (10..=epochs)
+                .step_by(10)
+                .map(|t| (avg(sum, t) * 100.0).round() / 100.0)
+                .collect::<Vec<_>>()
         );
     }
+    // From 20 s on (after the initial errors of 5 deg of heading and 6 % of Sf_G have settled
+    // into the linear regime): every epoch within the two-sided 99.9 % bounds, and the mean over
+    // the epochs within the 95 % bounds of one epoch (averaging correlated epochs can only
+    // shrink the spread, so these bounds are conservative).
+    let (lo999, hi999) = bounds(3.290527);
+    let (lo95, hi95) = bounds(1.959964);
+    let span = 20..=epochs;
+    let mean = span.clone().map(|t| avg(&sum6, t)).sum::<f64>() / span.clone().count() as f64;
+    let (min, max) = span
+        .clone()
+        .map(|t| avg(&sum6, t))
+        .fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
+    eprintln!(
+        "6-state NEES over {RUNS} runs, 20-{epochs} s: mean {mean:.2} (95 % [{lo95:.2}, {hi95:.2}]), range {min:.2}-{max:.2} (99.9 % [{lo999:.2}, {hi999:.2}])"
+    );
+    assert!(mean > lo95 && mean < hi95, "mean NEES {mean:.2}");
+    assert!(min > lo999 && max < hi999, "NEES range {min:.2}-{max:.2}");
 }
 
 /// Seed 000 case 3: a gyro mounted 20 deg tilted (plus a bias voltage offset and a 2 % odometer
