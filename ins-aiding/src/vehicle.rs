@@ -27,7 +27,8 @@ pub struct VehicleTruth {
     pub pitch_rad: f64,
 }
 
-/// Checks a truth trajectory: at least 2 states, finite values, strictly increasing time.
+/// Checks a truth trajectory: at least 2 states, finite values, speeds `>= 0`, strictly
+/// increasing time.
 pub fn validate_truth(truth: &[VehicleTruth]) -> Result<(), DrError> {
     if truth.len() < 2 {
         return Err(DrError::Config(format!(
@@ -50,6 +51,12 @@ pub fn validate_truth(truth: &[VehicleTruth]) -> Result<(), DrError> {
         if v.iter().any(|x| !x.is_finite()) {
             return Err(DrError::Config(format!(
                 "vehicle truth state {i} has a non-finite value"
+            )));
+        }
+        if s.speed_mps < 0.0 {
+            return Err(DrError::Config(format!(
+                "vehicle truth state {i}: speed_mps = {} is negative (the path speed is a magnitude)",
+                s.speed_mps
             )));
         }
         if i > 0 && s.t_s <= truth[i - 1].t_s {

@@ -641,3 +641,56 @@ fn saved_calibration_starts_the_next_drive_calibrated() {
     );
     assert!(mean[0] < 0.5 * mean[1]);
 }
+
+/// Seed 000 case 1 (normal drive, Table 1): with GNSS all the time, both filters smooth the
+/// GNSS position noise (3 m white per axis), the proposed one more than the conventional one.
+#[test]
+fn both_filters_smooth_gnss_noise_on_a_normal_drive() {
+    let truth = drive(41, 600.0, true, |_| 0.0);
+    let sensors = DrSensorConfig {
+        gyro_bias_offset_v: 0.002,
+        gyro_noise_v: 0.002,
+        odo_scale_error: 0.02,
+        seed: 41,
+        ..DrSensorConfig::default()
+    };
+    let dr = simulate_dr(&truth, &sensors).unwrap_or_else(|e| panic!("{e}"));
+    let gnss = Gnss {
+        pos_sigma_m: 3.0,
+        vel_sigma_mps: 0.05,
+        bias: &|_| [0.0, 0.0],
+        outages: &[],
+    };
+    let mut mean = [0.0; 2];
+    for (i, kind) in [DrFilterKind::Proposed8, DrFilterKind::Conventional4]
+        .into_iter()
+        .enumerate()
+    {
+        let (mut sum, mut n) = (0.0, 0.0);
+        run_filter(
+            kind,
+            &truth,
+            &dr,
+            sensors.nominal_params(),
+            sensors.nominal_params(),
+            [0.0; 3],
+            DrFilterConfig::default(),
+            &gnss,
+            41,
+            |t, f| {
+                if t >= 60.0 {
+                    sum += horizontal_error(f, &truth_at(&truth, t));
+                    n += 1.0;
+                }
+            },
+        );
+        mean[i] = sum / n;
+    }
+    // GNSS alone: the mean of a Rayleigh distance with sigma 3 m is 3 sqrt(pi/2) = 3.76 m.
+    let gnss_alone = 3.0 * (PI / 2.0).sqrt();
+    eprintln!(
+        "normal drive, mean horizontal error: proposed {:.2} m, conventional {:.2} m, GNSS alone {gnss_alone:.2} m",
+        mean[0], mean[1]
+    );
+    assert!(mean[0] < mean[1] && mean[1] < gnss_alone);
+}
