@@ -27,7 +27,7 @@ pub struct VehicleTruth {
     pub pitch_rad: f64,
 }
 
-/// Checks a truth trajectory: at least 2 states, finite values, speeds `>= 0`, strictly
+/// Checks a truth trajectory: at least 2 states, finite values, speeds `>= 0` (to 1e-6 m/s), strictly
 /// increasing time.
 pub fn validate_truth(truth: &[VehicleTruth]) -> Result<(), DrError> {
     if truth.len() < 2 {
@@ -53,7 +53,7 @@ pub fn validate_truth(truth: &[VehicleTruth]) -> Result<(), DrError> {
                 "vehicle truth state {i} has a non-finite value"
             )));
         }
-        if s.speed_mps < 0.0 {
+        if s.speed_mps < -1e-6 {
             return Err(DrError::Config(format!(
                 "vehicle truth state {i}: speed_mps = {} is negative (the path speed is a magnitude)",
                 s.speed_mps
