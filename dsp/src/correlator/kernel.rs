@@ -167,7 +167,9 @@ impl Correlator {
     /// kernels need a code step of at most 2 chips per sample (`fs >= rc / 2`); below that
     /// they fall back to the scalar kernel.
     ///
-    /// Panics only if `out.len() != tap_offsets_chips.len()` (a programming error).
+    /// A meaningless block description (`fs_hz` not finite and positive, a non-finite state
+    /// or tap offset) writes NaN to every output. Panics only if
+    /// `out.len() != tap_offsets_chips.len()` (a programming error).
     pub fn correlate_packed(
         &self,
         samples: SampleSlice<'_>,
@@ -178,6 +180,10 @@ impl Correlator {
         out: &mut [Complex32],
     ) {
         assert_eq!(out.len(), tap_offsets_chips.len(), "one output per tap");
+        if !super::is_meaningful(fs_hz, state, tap_offsets_chips) {
+            out.fill(Complex32::new(f32::NAN, f32::NAN));
+            return;
+        }
         for (taps, out) in tap_offsets_chips
             .chunks(MAX_TAPS)
             .zip(out.chunks_mut(MAX_TAPS))

@@ -358,3 +358,76 @@ fn api_names_and_choice() {
     }
     assert_eq!(out.len(), 2);
 }
+
+#[test]
+fn steps_beyond_the_code_window_fall_back_to_the_scalar_kernel() {
+    // At fs = 0.2 MHz the code advances 5.1 chips per sample: an 8-lane vector would span 36
+    // chips, more than the 32-bit code window, so the SIMD correlators must hand the block to
+    // the scalar kernel of the same arithmetic and return exactly its sums.
+    let mut rng = StdRng::seed_from_u64(11);
+    let code = CaCode::new(Prn::new(9).unwrap_or_else(|e| panic!("{e}")));
+    let block = Block::random(&mut rng, 500);
+    let s = ReplicaState {
+        code_phase_chips: 10.5,
+        code_rate_chips_s: 1.023e6,
+        carrier_phase_cycles: 0.2,
+        carrier_freq_hz: 1000.0,
+        carrier_rate_hz_s: 0.0,
+    };
+    let taps = [-0.5, 0.0, 0.5];
+    for c in Correlator::available() {
+        let scalar = Correlator::new(Isa::Scalar, c.arithmetic())
+            .unwrap_or_else(|| panic!("scalar is always available"));
+        for fmt in [Fmt::Cf32, Fmt::Ci16, Fmt::Ci8] {
+            let x = block.slice(fmt, 0..500);
+            let (mut a, mut b) = ([Complex32::new(0.0, 0.0); 3], [Complex32::new(0.0, 0.0); 3]);
+            c.correlate(x, 0.2e6, code.chips(), &s, &taps, &mut a);
+            scalar.correlate(x, 0.2e6, code.chips(), &s, &taps, &mut b);
+            assert_eq!(a, b, "{} {fmt:?}", c.name());
+        }
+    }
+}
+
+#[test]
+fn meaningless_states_give_nan_not_a_panic() {
+    // fs = 0 or a NaN carrier phase is a caller's bug upstream; no kernel may panic or return
+    // plausible numbers: every output is NaN (the reference too).
+    let code = CaCode::new(Prn::new(2).unwrap_or_else(|e| panic!("{e}")));
+    let x = vec![[3i8, -4]; 100];
+    let good = ReplicaState {
+        code_phase_chips: 5.0,
+        code_rate_chips_s: 1.023e6,
+        carrier_phase_cycles: 0.0,
+        carrier_freq_hz: 100.0,
+        carrier_rate_hz_s: 0.0,
+    };
+    for c in Correlator::available() {
+        for (fs, s) in [
+            (
+                4e6,
+                ReplicaState {
+                    carrier_phase_cycles: f64::NAN,
+                    ..good
+                },
+            ),
+            (0.0, good),
+        ] {
+            let mut out = [Complex32::new(0.0, 0.0); 2];
+            c.correlate(
+                SampleSlice::Ci8(&x),
+                fs,
+                code.chips(),
+                &s,
+                &[0.0, 0.5],
+                &mut out,
+            );
+            if c.isa() != Isa::Scalar {
+                assert!(
+                    out.iter().all(|o| o.re.is_nan()),
+                    "{} fs {fs}: {out:?}",
+                    c.name()
+                );
+            }
+        }
+    }
+}

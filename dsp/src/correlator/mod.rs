@@ -83,6 +83,8 @@ impl ReplicaState {
 ///
 /// The scalar reference kernel: a table carrier (phase error <= 1/8192 cycle) and the 2^-32-chip
 /// code NCO. Allocates nothing; more than [`MAX_TAPS`] taps are processed in chunks.
+/// A meaningless block description (`fs_hz` not finite and positive, a non-finite state or tap
+/// offset) writes NaN to every output.
 /// Panics only if `out.len() != tap_offsets_chips.len()` (a programming error, not user input).
 pub fn correlate(
     samples: &[Complex32],
@@ -93,10 +95,30 @@ pub fn correlate(
     out: &mut [Complex32],
 ) {
     assert_eq!(out.len(), tap_offsets_chips.len(), "one output per tap");
+    if !is_meaningful(fs_hz, state, tap_offsets_chips) {
+        out.fill(Complex32::new(f32::NAN, f32::NAN));
+        return;
+    }
     for (taps, out) in tap_offsets_chips
         .chunks(MAX_TAPS)
         .zip(out.chunks_mut(MAX_TAPS))
     {
         scalar::correlate_f32(samples, fs_hz, code, state, taps, out);
     }
+}
+
+/// Whether `fs_hz` is finite and positive and the state and tap offsets are finite.
+fn is_meaningful(fs_hz: f64, state: &ReplicaState, taps: &[f64]) -> bool {
+    fs_hz.is_finite()
+        && fs_hz > 0.0
+        && [
+            state.code_phase_chips,
+            state.code_rate_chips_s,
+            state.carrier_phase_cycles,
+            state.carrier_freq_hz,
+            state.carrier_rate_hz_s,
+        ]
+        .iter()
+        .chain(taps)
+        .all(|v| v.is_finite())
 }

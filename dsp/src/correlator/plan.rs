@@ -13,6 +13,9 @@
 //! `P *= D`, and with a rate `D *= Q`, `Q = exp(-j 2 pi 2 b L^2)` (`phi(k) = phi0 + a k + b k^2`,
 //! so `phi(k + L) - phi(k) = L a + L^2 b + 2 L b k`). Seeds are computed in f64 and rounded once.
 
+// Only the SIMD kernels use the lane and rotator helpers.
+#![cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+
 use super::{ReplicaState, MAX_TAPS};
 use crate::constants::CA_CODE_LENGTH;
 use num_complex::Complex64;
@@ -24,9 +27,11 @@ pub(crate) const CODE_LEN_FIX: u64 = (CA_CODE_LENGTH as u64) << 32;
 /// Vector steps between exact re-seeds of the rotator (and flushes of integer accumulators).
 pub(crate) const RESEED_STEPS: usize = 256;
 
-/// Code NCO step, 2^-32 chip per sample (negative or NaN rates give 0: the code stands still).
+/// Code NCO step, 2^-32 chip per sample. Meaningless inputs (negative or NaN rate, `fs <= 0`)
+/// give 0 (the code stands still) and steps are capped below one code period, so the phase
+/// arithmetic never overflows.
 pub(crate) fn code_step_fix(code_rate_chips_s: f64, fs_hz: f64) -> u64 {
-    (code_rate_chips_s / fs_hz * FIX).round() as u64
+    ((code_rate_chips_s / fs_hz * FIX).round() as u64).min(CODE_LEN_FIX - 1)
 }
 
 /// A code phase in 2^-32 chip, reduced modulo 1023 chips.
