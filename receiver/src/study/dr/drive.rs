@@ -59,9 +59,14 @@ impl Drive {
         })
     }
 
-    /// The truth at `t_s` (nearest state; the GNSS epochs fall on truth states).
+    /// The truth at `t_s` (nearest state of the evenly spaced truth; the GNSS epochs fall on
+    /// truth states).
     pub fn at(&self, t_s: f64) -> &VehicleTruth {
-        let k = (t_s * TRUTH_RATE_HZ).round().max(0.0) as usize;
+        let dt = match self.truth.get(1) {
+            Some(s) => s.t_s - self.truth[0].t_s,
+            None => 1.0 / TRUTH_RATE_HZ,
+        };
+        let k = ((t_s - self.truth[0].t_s) / dt).round().max(0.0) as usize;
         &self.truth[k.min(self.truth.len() - 1)]
     }
 

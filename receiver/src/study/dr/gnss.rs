@@ -145,3 +145,110 @@ pub fn simulate_gnss(drive: &Drive, seed: u64) -> GnssTrack {
 pub fn in_windows(t_s: f64, windows: &[(f64, f64)]) -> bool {
     windows.iter().any(|&(a, b)| t_s >= a && t_s < b)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gpsrx_ins_aiding::VehicleTruth;
+
+    /// A vehicle standing still for `duration_s` (truth at 1 Hz).
+    fn parked(duration_s: f64) -> Drive {
+        let n = duration_s as usize;
+        let truth = (0..=n)
+            .map(|k| VehicleTruth {
+                t_s: k as f64,
+                east_m: 10.0,
+                north_m: -5.0,
+                up_m: 0.0,
+                speed_mps: 0.0,
+                heading_rad: 0.3,
+                yaw_rate_rad_s: 0.0,
+                a_long_mps2: 0.0,
+                pitch_rad: 0.0,
+            })
+            .collect();
+        Drive {
+            truth,
+            duration_s,
+            description: "parked".into(),
+        }
+    }
+
+    #[test]
+    fn set_changes_and_blockages_follow_the_sections() {
+        let d = 1710.0;
+        let ch = set_change_times(d);
+        let mut prev = 0.0;
+        for &t in &ch {
+            let s = &SECTIONS[section_of(prev, d)];
+            assert!(
+                (t - prev - s.set_change_every_s).abs() < 1e-9,
+                "{prev} -> {t}"
+            );
+            prev = t;
+        }
+        assert!(prev + SECTIONS[section_of(prev, d)].set_change_every_s >= d);
+        for &(a, b) in &blockages(d) {
+            let k = section_of(a, d);
+            let (s0, s1) = section_span(k, d);
+            assert!(a >= s0 && b <= s1 && (b - a - SECTIONS[k].blockage_s).abs() < 1e-9);
+            assert!(SECTIONS[k].blockage_every_s > 0.0);
+        }
+        assert!(in_windows(5.0, &[(4.0, 6.0)]) && !in_windows(6.0, &[(4.0, 6.0)]));
+    }
+
+    #[test]
+    fn errors_have_the_section_variance_and_the_bias_jumps_at_set_changes() {
+        // Parked for 8 x 8000 s: the position error per axis is bias + white noise, variance
+        // sigma_b^2 + sigma_w^2 (the Gauss-Markov bias is stationary at sigma_b and redrawn at
+        // each set change). Pooled by environment (over 200 bias draws per axis), 20 % is about
+        // 3 standard errors of the variance estimate.
+        let d = 64_000.0;
+        let track = simulate_gnss(&parked(d), 11);
+        for env in ["open road", "apartment blocks"] {
+            let (mut sum2, mut n, mut expected) = (0.0, 0.0, 0.0);
+            for e in &track.epochs {
+                let s = &SECTIONS[e.section];
+                if s.environment == env {
+                    sum2 += (e.pos_en_m[0] - 10.0).powi(2) + (e.pos_en_m[1] + 5.0).powi(2);
+                    n += 2.0;
+                    expected = s.white_sigma_m.powi(2) + s.bias_sigma_m.powi(2);
+                }
+            }
+            let var = sum2 / n;
+            assert!(
+                (var / expected - 1.0).abs() < 0.3,
+                "{env}: {var} vs {expected}"
+            );
+        }
+        // Epoch-to-epoch differences: 2 sigma_w^2 inside a bias segment, 2 (sigma_w^2 +
+        // sigma_b^2) across a satellite-set change (a new independent bias).
+        let (mut across, mut na, mut within, mut nw) = (0.0, 0.0, 0.0, 0.0);
+        for w in track.epochs.windows(2) {
+            let s = &SECTIONS[w[1].section];
+            if s.environment != "open road" || w[0].section != w[1].section {
+                continue;
+            }
+            let dx = w[1].pos_en_m[0] - w[0].pos_en_m[0];
+            if track
+                .set_changes_s
+                .iter()
+                .any(|&c| c > w[0].t_s && c <= w[1].t_s)
+            {
+                across += dx * dx;
+                na += 1.0;
+            } else {
+                within += dx * dx;
+                nw += 1.0;
+            }
+        }
+        let (across, within) = (across / na, within / nw);
+        assert!((within / (2.0 * 4.0) - 1.0).abs() < 0.1, "within {within}");
+        assert!(across > 2.0 * within, "across {across} within {within}");
+        // Velocity noise: 0.05 m/s per horizontal axis, no bias.
+        let v: Vec<f64> = track.epochs.iter().map(|e| e.vel_enu_mps[0]).collect();
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / v.len() as f64).sqrt();
+        assert!(mean.abs() < 0.002 && (sd / GNSS_VEL_SIGMA_MPS - 1.0).abs() < 0.03);
+    }
+}

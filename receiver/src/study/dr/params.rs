@@ -151,7 +151,7 @@ pub const OUTAGE_PLACEMENTS: usize = 8;
 /// Case 2 placements with `--quick`.
 pub const OUTAGE_PLACEMENTS_QUICK: usize = 3;
 /// Case 2 noise seeds per placement (full run).
-pub const OUTAGE_SEEDS: u64 = 4;
+pub const OUTAGE_SEEDS: u64 = 8;
 
 /// Speed-filter gaps: lengths cycled over the drive, s (seed 002 removed windows of ~34 s).
 pub const GAP_LENGTHS_S: [f64; 5] = [20.0, 30.0, 40.0, 50.0, 60.0];

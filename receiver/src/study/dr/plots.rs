@@ -268,8 +268,13 @@ fn draw_shaded(
             )
         }))
         .map_err(plot_err(path))?;
+    let mut color_index = 0;
     for (i, s) in plot.series.iter().enumerate() {
-        let color = COLORS[i.min(COLORS.len() - 1)];
+        // An unnamed series continues the previous one's colour (e.g. the two +-1 % lines).
+        if i > 0 && !s.name.is_empty() {
+            color_index += 1;
+        }
+        let color = COLORS[color_index.min(COLORS.len() - 1)];
         let style = ShapeStyle::from(&color).stroke_width(if s.reference { 1 } else { 2 });
         // Break lines at NaN (no GNSS in an outage).
         let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];

@@ -130,3 +130,21 @@ pub fn gap_results(drive: &Drive, run: &SpeedRun, gaps: &[(f64, f64)]) -> Vec<Ga
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gaps_cycle_their_lengths_with_a_minute_of_gnss_between() {
+        let g = gap_windows(900.0, 15.0);
+        assert_eq!(g[0].0, GAP_FIRST_S + 15.0);
+        for (k, w) in g.iter().enumerate() {
+            assert_eq!(w.1 - w.0, GAP_LENGTHS_S[k % GAP_LENGTHS_S.len()]);
+            if k > 0 {
+                assert_eq!(w.0 - g[k - 1].1, GAP_SPACING_S);
+            }
+        }
+        assert!(g.last().is_some_and(|w| w.1 + 10.0 <= 900.0));
+    }
+}
