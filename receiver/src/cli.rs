@@ -199,6 +199,8 @@ struct ConfigFile {
     tracking: Option<gpsrx_tracking::ChannelConfig>,
     #[serde(default)]
     run: Option<crate::commands::run::RunConfig>,
+    #[serde(default)]
+    dr: Option<crate::commands::run::DrRunConfig>,
 }
 
 impl LoopArgs {
@@ -211,6 +213,11 @@ impl LoopArgs {
         let file: ConfigFile =
             toml::from_str(&text).map_err(|e| anyhow::anyhow!("config {}: {e}", path.display()))?;
         Ok(Some(file))
+    }
+
+    /// The `[dr]` table of the configuration file, if any.
+    pub fn dr_config(&self) -> anyhow::Result<Option<crate::commands::run::DrRunConfig>> {
+        Ok(self.config_file()?.and_then(|f| f.dr))
     }
 
     /// The `[run]` table of the configuration file, if any.

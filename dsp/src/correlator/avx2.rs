@@ -9,55 +9,20 @@
 
 use super::kernel::{Arithmetic, SampleSlice};
 use super::packed::PackedCode;
-use super::plan::{code_window, natural, CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
+use super::plan::{code_window, CarrierNco, CODE_LEN_FIX, RESEED_STEPS};
 use super::scalar::Q14;
+use super::simd::{by_taps, bytes_per_sample, dispatch, step_ptr, tail_copy, Job, CF32, CI16, CI8};
 use super::ReplicaState;
 use num_complex::Complex32;
 use std::arch::x86_64::*;
 
 const L: usize = 8;
-const CF32: u8 = 0;
-const CI16: u8 = 1;
-const CI8: u8 = 2;
 /// Lane order of the cf32 deinterleave.
 const CF32_ORDER: [usize; L] = [0, 1, 4, 5, 2, 3, 6, 7];
-
-const fn bytes_per_sample(f: u8) -> usize {
-    match f {
-        CF32 => 8,
-        CI16 => 4,
-        _ => 2,
-    }
-}
 
 /// Proof that the CPU runs AVX2 and FMA: only [`Avx2Kernel::new`] makes one.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Avx2Kernel(());
-
-/// Everything a kernel needs besides the samples.
-struct Job<'a> {
-    code: &'a PackedCode,
-    nco: CodeNco,
-    lane_lo: [u32; L],
-    lane_hi: [u32; L],
-    carrier: CarrierNco,
-    order: [usize; L],
-}
-
-macro_rules! by_taps {
-    ($nt:expr, $f:ident::<$fmt:ident>($($arg:expr),*)) => {
-        match $nt {
-            1 => $f::<$fmt, 1>($($arg),*),
-            2 => $f::<$fmt, 2>($($arg),*),
-            3 => $f::<$fmt, 3>($($arg),*),
-            4 => $f::<$fmt, 4>($($arg),*),
-            5 => $f::<$fmt, 5>($($arg),*),
-            6 => $f::<$fmt, 6>($($arg),*),
-            7 => $f::<$fmt, 7>($($arg),*),
-            _ => $f::<$fmt, 8>($($arg),*),
-        }
-    };
-}
 
 impl Avx2Kernel {
     /// The kernel if this CPU has AVX2 and FMA.
@@ -82,52 +47,12 @@ impl Avx2Kernel {
         if nt == 0 {
             return true;
         }
-        let order = match samples {
-            SampleSlice::Cf32(_) => CF32_ORDER,
-            _ => natural::<L>(),
-        };
-        let nco = CodeNco::new(state, fs_hz, taps);
-        let Some((lane_lo, lane_hi)) = nco.lanes(&order) else {
+        let Some(job) = Job::<L>::new(&samples, fs_hz, code, state, taps, CF32_ORDER) else {
             return false;
         };
-        let job = Job {
-            code,
-            nco,
-            lane_lo,
-            lane_hi,
-            carrier: CarrierNco::new(state, fs_hz),
-            order,
-        };
-        // SAFETY (all calls): `self` exists only if AVX2 and FMA were detected at run time; the
+        // SAFETY (every kernel call): `self` exists only if the CPU check of `new` passed; the
         // pointer and length come from one slice of the named format.
-        unsafe {
-            match (arithmetic, samples) {
-                (Arithmetic::I16, SampleSlice::Ci16(x)) => {
-                    by_taps!(
-                        nt,
-                        i16_kernel::<CI16>(x.as_ptr().cast(), x.len(), &job, out)
-                    )
-                }
-                (Arithmetic::I16, SampleSlice::Ci8(x)) => {
-                    by_taps!(nt, i16_kernel::<CI8>(x.as_ptr().cast(), x.len(), &job, out))
-                }
-                (_, SampleSlice::Cf32(x)) => {
-                    by_taps!(
-                        nt,
-                        f32_kernel::<CF32>(x.as_ptr().cast(), x.len(), &job, out)
-                    )
-                }
-                (Arithmetic::F32, SampleSlice::Ci16(x)) => {
-                    by_taps!(
-                        nt,
-                        f32_kernel::<CI16>(x.as_ptr().cast(), x.len(), &job, out)
-                    )
-                }
-                (Arithmetic::F32, SampleSlice::Ci8(x)) => {
-                    by_taps!(nt, f32_kernel::<CI8>(x.as_ptr().cast(), x.len(), &job, out))
-                }
-            }
-        }
+        unsafe { dispatch!(arithmetic, samples, nt, &job, out) };
         true
     }
 }
@@ -220,7 +145,7 @@ fn cmul(ar: __m256, ai: __m256, br: __m256, bi: __m256) -> (__m256, __m256) {
 /// Per-lane code constants: `(o_j S) mod 2^32` and the shift base `30 - (o_j S >> 32)`.
 #[inline]
 #[target_feature(enable = "avx2,fma")]
-fn code_lanes(job: &Job<'_>) -> (__m256i, __m256i) {
+fn code_lanes(job: &Job<'_, L>) -> (__m256i, __m256i) {
     let mut base = [0i32; L];
     for (b, &h) in base.iter_mut().zip(&job.lane_hi) {
         *b = 30 - h as i32;
@@ -258,35 +183,6 @@ fn hsum(v: __m256) -> f64 {
     a.iter().map(|&x| f64::from(x)).sum()
 }
 
-/// The samples of step `s` (`full` whole steps in `data`, then the zero-padded tail).
-///
-/// # Safety
-/// `data` must hold `full * L` samples of `bps` bytes.
-#[inline(always)]
-unsafe fn step_ptr(data: *const u8, s: usize, full: usize, bps: usize, tail: &[u8]) -> *const u8 {
-    if s < full {
-        // SAFETY: step s < full lies inside the slice.
-        unsafe { data.add(s * L * bps) }
-    } else {
-        tail.as_ptr()
-    }
-}
-
-/// The zero-padded copy of the last `n % L` samples.
-///
-/// # Safety
-/// `data` must hold `n` samples of `bps` bytes.
-#[inline(always)]
-unsafe fn tail_copy(data: *const u8, n: usize, bps: usize) -> [u8; L * 8] {
-    let mut tail = [0u8; L * 8];
-    let full = n / L;
-    // SAFETY: the last n % L samples lie inside the slice; the buffer holds 8 cf32 samples.
-    unsafe {
-        std::ptr::copy_nonoverlapping(data.add(full * L * bps), tail.as_mut_ptr(), (n % L) * bps)
-    };
-    tail
-}
-
 /// The f32 kernel for format `F` and `NT` taps.
 ///
 /// # Safety
@@ -295,7 +191,7 @@ unsafe fn tail_copy(data: *const u8, n: usize, bps: usize) -> [u8; L * 8] {
 unsafe fn f32_kernel<const F: u8, const NT: usize>(
     data: *const u8,
     n: usize,
-    job: &Job<'_>,
+    job: &Job<'_, L>,
     out: &mut [Complex32],
 ) {
     // SAFETY: forwarded from the caller.
@@ -317,13 +213,13 @@ unsafe fn f32_kernel<const F: u8, const NT: usize>(
 unsafe fn f32_run<const F: u8, const NT: usize, const CHIRP: bool>(
     data: *const u8,
     n: usize,
-    job: &Job<'_>,
+    job: &Job<'_, L>,
     out: &mut [Complex32],
 ) {
     let bps = bytes_per_sample(F);
     let (full, total) = (n / L, n.div_ceil(L));
     // SAFETY: forwarded from the caller.
-    let tail = unsafe { tail_copy(data, n, bps) };
+    let tail = unsafe { tail_copy::<L>(data, n, bps) };
     let (lane_lo, sh_base) = code_lanes(job);
     let sign = _mm256_set1_epi32(i32::MIN);
     let (q_re, q_im) = job.carrier.chirp::<L>();
@@ -344,7 +240,7 @@ unsafe fn f32_run<const F: u8, const NT: usize, const CHIRP: bool>(
         } = Rotator::seed(&job.carrier, s * L, &job.order, 1.0);
         while s < end {
             // SAFETY: step_ptr yields 8 readable samples (slice or tail buffer).
-            let (xr, xi) = unsafe { load_f32::<F>(step_ptr(data, s, full, bps, &tail)) };
+            let (xr, xi) = unsafe { load_f32::<F>(step_ptr::<L>(data, s, full, bps, &tail)) };
             let wr = _mm256_fmsub_ps(xr, pr, _mm256_mul_ps(xi, pi));
             let wi = _mm256_fmadd_ps(xr, pi, _mm256_mul_ps(xi, pr));
             (pr, pi) = cmul(pr, pi, dr, di);
@@ -396,7 +292,7 @@ fn hsum_i(v: __m256i) -> i64 {
 unsafe fn i16_kernel<const F: u8, const NT: usize>(
     data: *const u8,
     n: usize,
-    job: &Job<'_>,
+    job: &Job<'_, L>,
     out: &mut [Complex32],
 ) {
     // SAFETY: forwarded from the caller.
@@ -418,13 +314,13 @@ unsafe fn i16_kernel<const F: u8, const NT: usize>(
 unsafe fn i16_run<const F: u8, const NT: usize, const CHIRP: bool>(
     data: *const u8,
     n: usize,
-    job: &Job<'_>,
+    job: &Job<'_, L>,
     out: &mut [Complex32],
 ) {
     let bps = bytes_per_sample(F);
     let (full, total) = (n / L, n.div_ceil(L));
     // SAFETY: forwarded from the caller.
-    let tail = unsafe { tail_copy(data, n, bps) };
+    let tail = unsafe { tail_copy::<L>(data, n, bps) };
     let (lane_lo, sh_base) = code_lanes(job);
     let (q_re, q_im) = job.carrier.chirp::<L>();
     let (qr, qi) = (_mm256_set1_ps(q_re), _mm256_set1_ps(q_im));
@@ -465,7 +361,7 @@ unsafe fn i16_run<const F: u8, const NT: usize, const CHIRP: bool>(
         }
         while s < end {
             // SAFETY: step_ptr yields 8 readable samples (slice or tail buffer).
-            let x = unsafe { load_i16::<F>(step_ptr(data, s, full, bps, &tail)) };
+            let x = unsafe { load_i16::<F>(step_ptr::<L>(data, s, full, bps, &tail)) };
             let cs = _mm256_packs_epi32(_mm256_cvtps_epi32(pr), _mm256_cvtps_epi32(pi));
             let pair_re = _mm256_sign_epi16(_mm256_shuffle_epi8(cs, to_cs), neg_odd);
             let pair_im = _mm256_shuffle_epi8(cs, to_sc);

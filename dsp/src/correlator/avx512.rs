@@ -10,56 +10,21 @@
 
 use super::kernel::{Arithmetic, SampleSlice};
 use super::packed::PackedCode;
-use super::plan::{code_window, natural, CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
+use super::plan::{code_window, CarrierNco, CODE_LEN_FIX, RESEED_STEPS};
 use super::scalar::Q14;
+use super::simd::{by_taps, bytes_per_sample, dispatch, step_ptr, tail_copy, Job, CF32, CI16, CI8};
 use super::ReplicaState;
 use num_complex::Complex32;
 use std::arch::x86_64::*;
 
 const L: usize = 16;
-const CF32: u8 = 0;
-const CI16: u8 = 1;
-const CI8: u8 = 2;
 /// Lane order of the cf32 deinterleave (`vshufps` within each 128-bit quarter).
 const CF32_ORDER: [usize; L] = [0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15];
-
-const fn bytes_per_sample(f: u8) -> usize {
-    match f {
-        CF32 => 8,
-        CI16 => 4,
-        _ => 2,
-    }
-}
 
 /// Proof that the CPU runs AVX-512 F and BW (and AVX2, FMA): only [`Avx512Kernel::new`]
 /// makes one.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Avx512Kernel(());
-
-/// Everything a kernel needs besides the samples.
-struct Job<'a> {
-    code: &'a PackedCode,
-    nco: CodeNco,
-    lane_lo: [u32; L],
-    lane_hi: [u32; L],
-    carrier: CarrierNco,
-    order: [usize; L],
-}
-
-macro_rules! by_taps {
-    ($nt:expr, $f:ident::<$fmt:ident>($($arg:expr),*)) => {
-        match $nt {
-            1 => $f::<$fmt, 1>($($arg),*),
-            2 => $f::<$fmt, 2>($($arg),*),
-            3 => $f::<$fmt, 3>($($arg),*),
-            4 => $f::<$fmt, 4>($($arg),*),
-            5 => $f::<$fmt, 5>($($arg),*),
-            6 => $f::<$fmt, 6>($($arg),*),
-            7 => $f::<$fmt, 7>($($arg),*),
-            _ => $f::<$fmt, 8>($($arg),*),
-        }
-    };
-}
 
 impl Avx512Kernel {
     /// The kernel if this CPU has AVX-512 F and BW, AVX2 and FMA.
@@ -88,52 +53,12 @@ impl Avx512Kernel {
         if nt == 0 {
             return true;
         }
-        let order = match samples {
-            SampleSlice::Cf32(_) => CF32_ORDER,
-            _ => natural::<L>(),
-        };
-        let nco = CodeNco::new(state, fs_hz, taps);
-        let Some((lane_lo, lane_hi)) = nco.lanes(&order) else {
+        let Some(job) = Job::<L>::new(&samples, fs_hz, code, state, taps, CF32_ORDER) else {
             return false;
         };
-        let job = Job {
-            code,
-            nco,
-            lane_lo,
-            lane_hi,
-            carrier: CarrierNco::new(state, fs_hz),
-            order,
-        };
-        // SAFETY (all calls): `self` exists only if AVX-512 F/BW, AVX2 and FMA were detected at
-        // run time; the pointer and length come from one slice of the named format.
-        unsafe {
-            match (arithmetic, samples) {
-                (Arithmetic::I16, SampleSlice::Ci16(x)) => {
-                    by_taps!(
-                        nt,
-                        i16_kernel::<CI16>(x.as_ptr().cast(), x.len(), &job, out)
-                    )
-                }
-                (Arithmetic::I16, SampleSlice::Ci8(x)) => {
-                    by_taps!(nt, i16_kernel::<CI8>(x.as_ptr().cast(), x.len(), &job, out))
-                }
-                (_, SampleSlice::Cf32(x)) => {
-                    by_taps!(
-                        nt,
-                        f32_kernel::<CF32>(x.as_ptr().cast(), x.len(), &job, out)
-                    )
-                }
-                (Arithmetic::F32, SampleSlice::Ci16(x)) => {
-                    by_taps!(
-                        nt,
-                        f32_kernel::<CI16>(x.as_ptr().cast(), x.len(), &job, out)
-                    )
-                }
-                (Arithmetic::F32, SampleSlice::Ci8(x)) => {
-                    by_taps!(nt, f32_kernel::<CI8>(x.as_ptr().cast(), x.len(), &job, out))
-                }
-            }
-        }
+        // SAFETY (every kernel call): `self` exists only if the CPU check of `new` passed; the
+        // pointer and length come from one slice of the named format.
+        unsafe { dispatch!(arithmetic, samples, nt, &job, out) };
         true
     }
 }
@@ -226,7 +151,7 @@ fn cmul(ar: __m512, ai: __m512, br: __m512, bi: __m512) -> (__m512, __m512) {
 /// Per-lane code constants: `(o_j S) mod 2^32` and the shift base `31 - (o_j S >> 32)`.
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
-fn code_lanes(job: &Job<'_>) -> (__m512i, __m512i) {
+fn code_lanes(job: &Job<'_, L>) -> (__m512i, __m512i) {
     let mut base = [0i32; L];
     for (b, &h) in base.iter_mut().zip(&job.lane_hi) {
         *b = 31 - h as i32;
@@ -253,35 +178,6 @@ fn chip_bits(bits: &PackedCode, b: u64, lane_lo: __m512i, sh_base: __m512i) -> _
     _mm512_sllv_epi32(_mm512_set1_epi32(w as i32), shift)
 }
 
-/// The samples of step `s` (`full` whole steps in `data`, then the zero-padded tail).
-///
-/// # Safety
-/// `data` must hold `full * L` samples of `bps` bytes.
-#[inline(always)]
-unsafe fn step_ptr(data: *const u8, s: usize, full: usize, bps: usize, tail: &[u8]) -> *const u8 {
-    if s < full {
-        // SAFETY: step s < full lies inside the slice.
-        unsafe { data.add(s * L * bps) }
-    } else {
-        tail.as_ptr()
-    }
-}
-
-/// The zero-padded copy of the last `n % L` samples.
-///
-/// # Safety
-/// `data` must hold `n` samples of `bps` bytes.
-#[inline(always)]
-unsafe fn tail_copy(data: *const u8, n: usize, bps: usize) -> [u8; L * 8] {
-    let mut tail = [0u8; L * 8];
-    let full = n / L;
-    // SAFETY: the last n % L samples lie inside the slice; the buffer holds 16 cf32 samples.
-    unsafe {
-        std::ptr::copy_nonoverlapping(data.add(full * L * bps), tail.as_mut_ptr(), (n % L) * bps)
-    };
-    tail
-}
-
 /// The f32 kernel for format `F` and `NT` taps.
 ///
 /// # Safety
@@ -290,7 +186,7 @@ unsafe fn tail_copy(data: *const u8, n: usize, bps: usize) -> [u8; L * 8] {
 unsafe fn f32_kernel<const F: u8, const NT: usize>(
     data: *const u8,
     n: usize,
-    job: &Job<'_>,
+    job: &Job<'_, L>,
     out: &mut [Complex32],
 ) {
     // SAFETY: forwarded from the caller.
@@ -312,13 +208,13 @@ unsafe fn f32_kernel<const F: u8, const NT: usize>(
 unsafe fn f32_run<const F: u8, const NT: usize, const CHIRP: bool>(
     data: *const u8,
     n: usize,
-    job: &Job<'_>,
+    job: &Job<'_, L>,
     out: &mut [Complex32],
 ) {
     let bps = bytes_per_sample(F);
     let (full, total) = (n / L, n.div_ceil(L));
     // SAFETY: forwarded from the caller.
-    let tail = unsafe { tail_copy(data, n, bps) };
+    let tail = unsafe { tail_copy::<L>(data, n, bps) };
     let (lane_lo, sh_base) = code_lanes(job);
     let sign = _mm512_set1_epi32(i32::MIN);
     let (q_re, q_im) = job.carrier.chirp::<L>();
@@ -339,7 +235,7 @@ unsafe fn f32_run<const F: u8, const NT: usize, const CHIRP: bool>(
         } = Rotator::seed(&job.carrier, s * L, &job.order, 1.0);
         while s < end {
             // SAFETY: step_ptr yields 16 readable samples (slice or tail buffer).
-            let (xr, xi) = unsafe { load_f32::<F>(step_ptr(data, s, full, bps, &tail)) };
+            let (xr, xi) = unsafe { load_f32::<F>(step_ptr::<L>(data, s, full, bps, &tail)) };
             let wr = _mm512_castps_si512(_mm512_fmsub_ps(xr, pr, _mm512_mul_ps(xi, pi)));
             let wi = _mm512_castps_si512(_mm512_fmadd_ps(xr, pi, _mm512_mul_ps(xi, pr)));
             (pr, pi) = cmul(pr, pi, dr, di);
@@ -398,7 +294,7 @@ fn hsum_i(v: __m512i) -> i64 {
 unsafe fn i16_kernel<const F: u8, const NT: usize>(
     data: *const u8,
     n: usize,
-    job: &Job<'_>,
+    job: &Job<'_, L>,
     out: &mut [Complex32],
 ) {
     // SAFETY: forwarded from the caller.
@@ -420,13 +316,13 @@ unsafe fn i16_kernel<const F: u8, const NT: usize>(
 unsafe fn i16_run<const F: u8, const NT: usize, const CHIRP: bool>(
     data: *const u8,
     n: usize,
-    job: &Job<'_>,
+    job: &Job<'_, L>,
     out: &mut [Complex32],
 ) {
     let bps = bytes_per_sample(F);
     let (full, total) = (n / L, n.div_ceil(L));
     // SAFETY: forwarded from the caller.
-    let tail = unsafe { tail_copy(data, n, bps) };
+    let tail = unsafe { tail_copy::<L>(data, n, bps) };
     let (lane_lo, sh_base) = code_lanes(job);
     let (q_re, q_im) = job.carrier.chirp::<L>();
     let (qr, qi) = (_mm512_set1_ps(q_re), _mm512_set1_ps(q_im));
@@ -463,7 +359,7 @@ unsafe fn i16_run<const F: u8, const NT: usize, const CHIRP: bool>(
         }
         while s < end {
             // SAFETY: step_ptr yields 16 readable samples (slice or tail buffer).
-            let x = unsafe { load_i16::<F>(step_ptr(data, s, full, bps, &tail)) };
+            let x = unsafe { load_i16::<F>(step_ptr::<L>(data, s, full, bps, &tail)) };
             let cs = _mm512_packs_epi32(_mm512_cvtps_epi32(pr), _mm512_cvtps_epi32(pi));
             let cs_pairs = _mm512_shuffle_epi8(cs, to_cs);
             // Negate the odd i16 (the sine): [c, -s] pairs.

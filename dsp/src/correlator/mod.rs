@@ -23,6 +23,8 @@ mod kernel;
 mod packed;
 mod plan;
 mod scalar;
+#[cfg(target_arch = "x86_64")]
+mod simd;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
