@@ -6,6 +6,7 @@
 
 pub mod cli;
 pub mod commands;
+pub mod fusion;
 pub mod landmarks;
 pub mod output;
 pub mod pipeline;

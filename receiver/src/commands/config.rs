@@ -70,7 +70,14 @@ pub fn default_toml() -> anyhow::Result<String> {
          tropo = \"saastamoinen\"    # saastamoinen or none (--tropo)\n\
          raim_pfa = 0.001          # RAIM false-alarm probability (--raim-pfa)\n\
          doppler_max_hz = 5000.0   # acquisition Doppler half-width, Hz (--doppler-max)\n\
-         allow_unhealthy = false   # use satellites flagged unhealthy (--allow-unhealthy)\n",
+         allow_unhealthy = false   # use satellites flagged unhealthy (--allow-unhealthy)\n\
+         \n\
+         [dr]                      # gpsrx run --dr / --accel (seed 000 sensor model)\n\
+         sf_g_dps_per_v = 45.045   # nominal gyro scale factor Sf_G, deg/s/V\n\
+         v_nom_v = 2.5             # nominal gyro zero-rate voltage V_nom, V\n\
+         sf_n_m_per_pulse = 0.1    # nominal odometer scale factor Sf_N, m/pulse\n\
+         filter = \"proposed\"       # proposed (8 states, carrier velocity) or conventional (--dr-filter)\n\
+         update_interval_s = 1.0   # least interval between GNSS updates of the filters, s\n",
         c.min_pull_in_s,
         c.fll_assist_s,
         c.cn0_lost_dbhz,
@@ -100,11 +107,17 @@ mod tests {
         struct File {
             tracking: ChannelConfig,
             run: crate::commands::run::RunConfig,
+            dr: crate::commands::run::DrRunConfig,
         }
         let text = default_toml().unwrap_or_else(|e| panic!("{e}"));
         let f: File = toml::from_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
         assert_eq!(f.tracking, ChannelConfig::default());
         assert_eq!(f.run.rate_hz, Some(10.0));
         assert_eq!(f.run.iono.as_deref(), Some("klobuchar"));
+        let nominal = gpsrx_ins_aiding::DrParams::default();
+        assert_eq!(f.dr.sf_g_dps_per_v, Some(nominal.sf_g_dps_per_v));
+        assert_eq!(f.dr.v_nom_v, Some(nominal.v_nom_v));
+        assert_eq!(f.dr.sf_n_m_per_pulse, Some(nominal.sf_n_m_per_pulse));
+        assert_eq!(f.dr.filter.as_deref(), Some("proposed"));
     }
 }

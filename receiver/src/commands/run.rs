@@ -6,6 +6,10 @@
 //! `channels.csv`.
 
 use crate::cli::{LoopArgs, SourceArgs};
+use crate::fusion::fuse::{fuse_dr, DrFusionSettings};
+use crate::fusion::fused_csv::{fused_as_fixes, write_fused_csv};
+use crate::fusion::gnss::GnssFix;
+use crate::fusion::speed::{attach_speed, speed_track};
 use crate::output::{
     self, create_file, ChannelCsvWriter, ChannelRow, Fix, FixQuality, NavHeader, NavRecord,
     NmeaOptions, NmeaWriter, ObsEpoch, ObsHeader, PvtCsvWriter, RinexObsWriter, SatObs, SatView,
@@ -16,7 +20,9 @@ use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
 use crate::pipeline::tracker::{track_with_reacquisition, AidSource, Reacquisition};
 use anyhow::Context;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
-use gpsrx_ins_aiding::read_ins_csv;
+use gpsrx_ins_aiding::{
+    read_accel_csv, read_dr_csv, read_ins_csv, AccelLog, DrFilterKind, DrLog, DrParams, FixSource,
+};
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::frames::azimuth_elevation;
 use gpsrx_nav::pvt::{solve, PvtOptions, PvtSolution, RaimStatus, SatMeasurement};
@@ -107,6 +113,51 @@ pub struct RunArgs {
     /// Longest gap allowed between INS rows, s.
     #[arg(long, value_name = "S", default_value_t = 0.5)]
     pub ins_max_gap: f64,
+    /// Dead-reckoning log, CSV `t_s,gyro_v,odo_pulses` (raw, seed 000) or
+    /// `t_s,yaw_rate_dps,speed_mps` (`t_s` from the first IF sample): fused with the fixes into
+    /// `fused.csv`, `fused.nmea`, `fused.geojson`, `fused.kml`; the calibrated sensor parameters
+    /// go to `dr_params.toml`. Nominal parameters from the config file's `[dr]` table.
+    #[arg(long, value_name = "FILE")]
+    pub dr: Option<PathBuf>,
+    /// Longitudinal accelerometer log, CSV `t_s,a_long_mps2`: seed 002's speed filter, column
+    /// `speed_filter_mps` of `fused.csv`.
+    #[arg(long, value_name = "FILE")]
+    pub accel: Option<PathBuf>,
+    /// DR filter: seed 000's proposed 8-state filter (position and carrier velocity) or the
+    /// conventional 4-state one (position only) [default: proposed].
+    #[arg(long, value_enum, requires = "dr")]
+    pub dr_filter: Option<DrFilterChoice>,
+    /// Initial DR sensor parameters: a `dr_params.toml` written by a previous run (seed 000:
+    /// saves the ~900 s calibration); overrides the config file's `[dr]` values.
+    #[arg(long, value_name = "FILE", requires = "dr")]
+    pub dr_params: Option<PathBuf>,
+}
+
+/// `--dr-filter`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DrFilterChoice {
+    /// Seed 000's 8-state filter: position and carrier-velocity updates, gyro and odometer
+    /// calibration.
+    Proposed,
+    /// The conventional 4-state filter (seed 000 eq. 7): position updates only.
+    Conventional,
+}
+
+/// The `[dr]` table of a configuration file: the nominal DR sensor parameters (seed 000) and
+/// the fusion settings of `gpsrx run --dr`.
+#[derive(Debug, Clone, Default, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DrRunConfig {
+    /// Gyro scale factor Sf_G, deg/s/V.
+    pub sf_g_dps_per_v: Option<f64>,
+    /// Gyro zero-rate voltage V_nom, V.
+    pub v_nom_v: Option<f64>,
+    /// Odometer scale factor Sf_N, m/pulse.
+    pub sf_n_m_per_pulse: Option<f64>,
+    /// `proposed` or `conventional`.
+    pub filter: Option<String>,
+    /// Least interval between GNSS updates of the filters, s.
+    pub update_interval_s: Option<f64>,
 }
 
 /// The `[run]` table of a configuration file; command-line options override it.
@@ -211,6 +262,63 @@ pub struct RunSummary {
     pub mean_llh: Option<(f64, f64, f64)>,
     /// Mean PDOP.
     pub mean_pdop: Option<f64>,
+    /// With `--dr`/`--accel`: rows of `fused.csv` by source (gnss, fused, dr).
+    pub fused_rows: Option<[usize; 3]>,
+    /// With `--dr`: the calibrated sensor parameters at the end.
+    pub dr_params: Option<DrParams>,
+}
+
+/// The DR inputs of a run, read and checked before tracking starts.
+struct DrInputs {
+    dr: Option<DrLog>,
+    accel: Option<AccelLog>,
+    settings: DrFusionSettings,
+}
+
+impl DrInputs {
+    fn load(args: &RunArgs, rate_hz: f64) -> anyhow::Result<Option<DrInputs>> {
+        if args.dr.is_none() && args.accel.is_none() {
+            return Ok(None);
+        }
+        let file = args.loops.dr_config()?.unwrap_or_default();
+        let nominal = DrParams::default();
+        let params = DrParams {
+            sf_g_dps_per_v: file.sf_g_dps_per_v.unwrap_or(nominal.sf_g_dps_per_v),
+            v_nom_v: file.v_nom_v.unwrap_or(nominal.v_nom_v),
+            sf_n_m_per_pulse: file.sf_n_m_per_pulse.unwrap_or(nominal.sf_n_m_per_pulse),
+        };
+        params.validate().context("config [dr]")?;
+        let kind = match (args.dr_filter, file.filter.as_deref()) {
+            (Some(DrFilterChoice::Proposed), _) | (None, None | Some("proposed")) => {
+                DrFilterKind::Proposed8
+            }
+            (Some(DrFilterChoice::Conventional), _) | (None, Some("conventional")) => {
+                DrFilterKind::Conventional4
+            }
+            (None, Some(other)) => {
+                anyhow::bail!("[dr] filter = \"{other}\": use \"proposed\" or \"conventional\"")
+            }
+        };
+        let mut settings = DrFusionSettings::new(kind, params, 1.0 / rate_hz);
+        settings.calibration = args.dr_params.as_deref().map(DrParams::load).transpose()?;
+        if let Some(u) = file.update_interval_s {
+            if !(u.is_finite() && u > 0.0 && u <= 60.0) {
+                anyhow::bail!("[dr] update_interval_s = {u}: use (0, 60] s");
+            }
+            settings.update_interval_s = u;
+        }
+        let dr = args.dr.as_deref().map(read_dr_csv).transpose()?;
+        let accel = args.accel.as_deref().map(read_accel_csv).transpose()?;
+        if let Some(d) = &dr {
+            let (a, b) = d.time_span_s();
+            tracing::info!("DR log: {} rows from {a:.2} to {b:.2} s", d.samples().len());
+        }
+        Ok(Some(DrInputs {
+            dr,
+            accel,
+            settings,
+        }))
+    }
 }
 
 /// Runs the receiver on a file.
@@ -247,6 +355,8 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
                 .map(|e| e.toe.week)
         })
         .unwrap_or_else(current_gps_week);
+    let dr_inputs = DrInputs::load(args, set.rate)?;
+    let mut gnss_fixes: Vec<GnssFix> = Vec::new();
     let feedforward = match &args.ins {
         Some(path) => {
             if let Some(a) = args.ins_band_limit {
@@ -540,6 +650,9 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         if let Some(ff) = feedforward {
             ff.set_fix(t_file, sol.pos_ecef_m, sol.clock_drift_mps);
         }
+        if dr_inputs.is_some() {
+            gnss_fixes.push(GnssFix::from_solution(t_file, &sol));
+        }
         pvt_csv.write_fix(&fix)?;
         nmea.write_fix(&fix)?;
         fixes.push(fix);
@@ -669,6 +782,12 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
     let mut f = create_file(&out("track.kml"))?;
     output::write_kml(&mut f, "track.kml", "gpsrx track", &fixes)?;
 
+    if let Some(inputs) = &dr_inputs {
+        let (rows, params) = write_fused_outputs(inputs, &gnss_fixes, &out)?;
+        summary.fused_rows = Some(rows);
+        summary.dr_params = params;
+    }
+
     summary.duration_s = total
         .map(|t| t as f64 / fs)
         .unwrap_or(processed as f64 / fs);
@@ -692,6 +811,49 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         summary.mean_pdop = Some(fixes.iter().map(|f| f.pdop).sum::<f64>() / n);
     }
     Ok((summary, fixes))
+}
+
+/// Fuses the fixes with the DR and accelerometer logs and writes `fused.csv`, `fused.nmea`,
+/// `fused.geojson`, `fused.kml` and (with `--dr`) `dr_params.toml`; returns the row counts by
+/// source (gnss, fused, dr) and the calibrated parameters.
+fn write_fused_outputs(
+    inputs: &DrInputs,
+    gnss: &[GnssFix],
+    out: &dyn Fn(&str) -> PathBuf,
+) -> anyhow::Result<([usize; 3], Option<DrParams>)> {
+    let mut result = fuse_dr(gnss, inputs.dr.as_ref(), &inputs.settings)?;
+    if let Some(accel) = &inputs.accel {
+        let track = speed_track(gnss, accel, inputs.settings.update_interval_s)?;
+        attach_speed(&mut result.fixes, &track);
+    }
+    write_fused_csv(&out("fused.csv"), &result.fixes)?;
+    let fixes = fused_as_fixes(&result.fixes);
+    let mut nmea = NmeaWriter::create(&out("fused.nmea"), NmeaOptions::default())?;
+    for f in &fixes {
+        nmea.write_fix(f)?;
+    }
+    nmea.finish()?;
+    let mut f = create_file(&out("fused.geojson"))?;
+    output::write_geojson(&mut f, "fused.geojson", &fixes)?;
+    let mut f = create_file(&out("fused.kml"))?;
+    output::write_kml(&mut f, "fused.kml", "gpsrx GNSS/DR", &fixes)?;
+    if let (Some(p), Some(_)) = (&result.final_params, &inputs.dr) {
+        p.save(&out("dr_params.toml"))?;
+    }
+    let count = |s: FixSource| result.fixes.iter().filter(|f| f.source == s).count();
+    let rows = [
+        count(FixSource::Gnss),
+        count(FixSource::Fused),
+        count(FixSource::DrOnly),
+    ];
+    tracing::info!(
+        "fused.csv: {} GNSS rows, {} fused, {} DR only; {} GNSS updates",
+        rows[0],
+        rows[1],
+        rows[2],
+        result.updates
+    );
+    Ok((rows, result.final_params.filter(|_| inputs.dr.is_some())))
 }
 
 fn raim_text(r: &RaimStatus) -> String {
@@ -720,6 +882,15 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         _ => println!(
             "no fix: the recording ended before 4 satellites had their ephemeris (subframes 1-3 take 18-30 s; give --nav FILE to start sooner)"
         ),
+    }
+    if let Some([g, f, d]) = s.fused_rows {
+        println!("fused.csv: {f} fused rows, {d} dead-reckoning only, {g} GNSS only");
+    }
+    if let Some(p) = s.dr_params {
+        println!(
+            "DR calibration: Sf_G {:.3} deg/s/V, V_nom {:.4} V, Sf_N {:.5} m/pulse (dr_params.toml)",
+            p.sf_g_dps_per_v, p.v_nom_v, p.sf_n_m_per_pulse
+        );
     }
     println!("outputs in {}", args.out.display());
     Ok(())

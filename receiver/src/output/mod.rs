@@ -139,6 +139,8 @@ pub struct SatObs {
 pub enum FixQuality {
     /// Autonomous GNSS fix.
     Gnss,
+    /// GNSS fused with dead reckoning (a GNSS update within the last moments).
+    Fused,
     /// Dead-reckoning (propagated or INS-aided) solution.
     DeadReckoning,
     /// No valid position.
@@ -151,6 +153,7 @@ impl FixQuality {
     pub fn name(self) -> &'static str {
         match self {
             FixQuality::Gnss => "gnss",
+            FixQuality::Fused => "fused",
             FixQuality::DeadReckoning => "dead_reckoning",
             FixQuality::None => "none",
         }

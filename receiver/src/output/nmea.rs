@@ -107,12 +107,12 @@ fn opt_num(v: f64, decimals: usize) -> String {
     }
 }
 
-/// GGA: time, position, quality (1 GNSS fix, 6 dead reckoning, 0 invalid), satellites used,
+/// GGA: time, position, quality (1 GNSS or GNSS/DR fix, 6 dead reckoning only, 0 invalid), satellites used,
 /// HDOP, altitude (see the module note), geoid separation.
 pub fn gga(fix: &Fix, opts: &NmeaOptions) -> String {
     let (time, _) = utc_fields(fix.time, opts.leap_seconds);
     let quality = match fix.quality {
-        FixQuality::Gnss => 1,
+        FixQuality::Gnss | FixQuality::Fused => 1,
         FixQuality::DeadReckoning => 6,
         FixQuality::None => 0,
     };
@@ -160,7 +160,7 @@ pub fn rmc(fix: &Fix, opts: &NmeaOptions) -> String {
     let valid = position_valid(fix);
     let (status, mode) = match fix.quality {
         _ if !valid => ('V', 'N'),
-        FixQuality::Gnss => ('A', 'A'),
+        FixQuality::Gnss | FixQuality::Fused => ('A', 'A'),
         FixQuality::DeadReckoning => ('A', 'E'),
         FixQuality::None => ('V', 'N'),
     };
