@@ -56,9 +56,14 @@ pub enum Isa {
 pub enum Arithmetic {
     /// f32 wipe-off and accumulation.
     F32,
-    /// Integer samples times a Q14 (2^14-scaled) int16 carrier replica, i32 products and
-    /// accumulation, scaled back by 2^-14 on output. Cf32 input has no integer scale to
-    /// quantise to: with it, an I16 correlator runs the F32 kernel of the same ISA.
+    /// Integer samples times a Q14 int16 carrier replica `round(2^14 exp(-j 2 pi phi))`
+    /// (`vpmaddwd`: exact i32 products), exact integer accumulation, scaled back by 2^-14 on
+    /// output. Carrier quantisation: 2^-15 per component (< 4.5e-5 relative). ci8 products
+    /// (|w| <= 2^22) are summed as they are; ci16 products are first rounded to multiples of
+    /// 2^8 (`(w + 128) >> 8`, at most 2^-7 sample units per sample) to stay within 2^22; the
+    /// i32 lane sums are flushed to i64 every 256 vector steps, so nothing overflows. The
+    /// scalar I16 kernel uses the table carrier in Q14 and i64 sums. Cf32 input has no integer
+    /// scale to quantise to: with it, an I16 correlator runs the F32 kernel of the same ISA.
     I16,
 }
 
