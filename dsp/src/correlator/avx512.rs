@@ -5,8 +5,7 @@
 //! `w` or `-w` per lane with the chip mask instead of the XOR/count correction.
 
 //!
-//! The AVX-512 intrinsics are stable since Rust 1.89: this module needs 1.89 although the
-//! workspace declares 1.85 (the lead should raise `rust-version`).
+//! The AVX-512 intrinsics are stable since Rust 1.89 (the workspace's `rust-version`).
 
 use super::kernel::{Arithmetic, SampleSlice};
 use super::packed::PackedCode;

@@ -28,9 +28,7 @@ mod simd;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
-// AVX-512 intrinsics are stable since Rust 1.89 (the workspace declares 1.85).
 #[cfg(target_arch = "x86_64")]
-#[clippy::msrv = "1.89"]
 mod avx512;
 
 #[cfg(test)]
