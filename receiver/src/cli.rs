@@ -35,6 +35,8 @@ pub enum Command {
     Config(ConfigArgs),
     /// Loop studies: steady-state errors, bandwidth vs noise, high dynamics (seed 004).
     Study(crate::study::StudyArgs),
+    /// Measure this machine: correlator kernels, acquisition, end-to-end real-time factor.
+    Bench(crate::commands::bench::BenchArgs),
 }
 
 /// `gpsrx config`.

@@ -23,6 +23,7 @@ fn main() {
         Command::Run(args) => commands::run::run(&args),
         Command::Config(args) => commands::config::run(&args),
         Command::Study(args) => gpsrx_receiver::study::run(&args),
+        Command::Bench(args) => commands::bench::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -1,6 +1,7 @@
 //! One module per `gpsrx` subcommand.
 
 pub mod acquire;
+pub mod bench;
 pub mod config;
 pub mod demo;
 pub mod info;
