@@ -87,7 +87,7 @@ impl ChannelConfig {
         for l in std::iter::once(&self.track).chain(self.aided_track.as_ref()) {
             l.validate()?;
             let ms = (l.t_coh_s * 1e3).round() as usize;
-            if ms == 0 || MS_PER_BIT % ms != 0 {
+            if ms == 0 || !MS_PER_BIT.is_multiple_of(ms) {
                 return Err(ConfigError::OutOfRange {
                     field: "t_coh_s",
                     value: l.t_coh_s,
@@ -470,7 +470,7 @@ impl Channel {
         if let Some(c) = estimate {
             self.cn0_dbhz = c;
             // Lock decisions once per estimation window.
-            if self.cn0.blocks() % self.cn0_window_blocks == 0 {
+            if self.cn0.blocks().is_multiple_of(self.cn0_window_blocks) {
                 let ok = self.code_lock.update(c);
                 self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz {
                     self.low_cn0_count + 1
@@ -496,7 +496,7 @@ impl Channel {
             || edge_phase.is_some_and(|edge| {
                 let k = (ms_index + 1 + MS_PER_BIT as u64 - edge as u64 % MS_PER_BIT as u64)
                     % MS_PER_BIT as u64;
-                k % t_coh_ms as u64 == 0
+                k.is_multiple_of(t_coh_ms as u64)
             });
         if self.acc_ms < t_coh_ms || !aligned {
             if self.acc_ms >= t_coh_ms {
