@@ -151,7 +151,8 @@ pub fn fuse_dr(
     let mut next_fix = i_start + 1;
     let mut last_update = Some(first.t_s);
     let mut last_fix = first;
-    let mut next_out = rows[k0].t_s;
+    // Rows start with the first propagated DR row (the initial state has no velocity yet).
+    let mut next_out = rows[k0].t_s + 1e-6;
     for (k, row) in rows.iter().enumerate().skip(k0) {
         if k > k0 {
             // Fixes up to this row's time update the filter at the previous row's time.
