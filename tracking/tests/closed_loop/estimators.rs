@@ -32,7 +32,7 @@ fn prompts(
     let mut ps = Vec::with_capacity(n);
     let mut bits = Vec::with_capacity(n);
     for k in 0..n {
-        if (k + 20 - edge) % 20 == 0 {
+        if (k + 20 - edge).is_multiple_of(20) {
             bit = if r.random::<bool>() { 1.0 } else { -1.0 };
         }
         let phase = 0.7 + 2.0 * PI * resid_hz * k as f64 * T;
