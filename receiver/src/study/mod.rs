@@ -75,7 +75,13 @@ pub fn run(args: &StudyArgs) -> anyhow::Result<()> {
         file_name(&written.markdown),
         file_name(&written.csv),
         file_name(&written.json),
-        written.plots.len(),
+        // Some studies draw their own plots (shaded outages): count what is there.
+        std::fs::read_dir(out)
+            .map(|d| d
+                .filter_map(Result::ok)
+                .filter(|e| e.path().extension().is_some_and(|x| x == "png"))
+                .count())
+            .unwrap_or(written.plots.len()),
         out.display()
     );
     Ok(())
