@@ -149,7 +149,7 @@ fn round_trip(format: &SampleFormat, raw: &[(f32, f32)]) -> Result<(), TestCaseE
     }
     prop_assert_eq!(stats.clipped, expected_clipped);
     let per_byte = (8 / format.bits_per_sample().min(8)) as usize;
-    while expected.len() % per_byte != 0 {
+    while !expected.len().is_multiple_of(per_byte) {
         let p = pad_value(format);
         expected.push(c(p, if format.is_complex() { p } else { 0.0 }));
     }
