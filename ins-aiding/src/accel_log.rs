@@ -5,9 +5,8 @@
 //! forward positive; on a slope it includes `g sin(pitch)`). Every value must be a finite number;
 //! errors name the file, the line and what to do.
 
-use crate::csv_table::CsvTable;
+use crate::csv_table::{write_lines, CsvTable};
 use crate::dr_error::DrError;
-use std::io::Write;
 use std::path::Path;
 
 const WHAT: &str = "accelerometer log";
@@ -68,52 +67,25 @@ pub fn read_accel_csv(path: &Path) -> Result<AccelLog, DrError> {
             "the header must name t_s and a_long_mps2 (longitudinal acceleration, m/s^2)".into(),
         ));
     };
-    let mut samples: Vec<AccelSample> = Vec::new();
-    let mut last_line = table.header_line();
-    table.for_each_row(|row| {
-        last_line = row.line;
-        let t_s = row.number(t_col, "t_s")?;
-        let a_long_mps2 = row.number(a_col, "a_long_mps2")?;
-        if let Some(last) = samples.last() {
-            if t_s <= last.t_s {
-                return Err(row.error(format!(
-                    "t_s = {t_s} does not increase (previous {}): sort the file by t_s and remove duplicate rows",
-                    last.t_s
-                )));
-            }
-        }
-        samples.push(AccelSample { t_s, a_long_mps2 });
-        Ok(())
-    })?;
-    if samples.len() < 2 {
-        return Err(table.error(
-            last_line,
-            format!(
-                "an accelerometer log needs at least 2 rows (found {})",
-                samples.len()
-            ),
-        ));
-    }
+    let rows = table.read_series(
+        t_col,
+        |row| row.number(a_col, "a_long_mps2"),
+        |n| format!("an accelerometer log needs at least 2 rows (found {n})"),
+    )?;
+    let samples = rows
+        .into_iter()
+        .map(|(t_s, a_long_mps2)| AccelSample { t_s, a_long_mps2 })
+        .collect();
     Ok(AccelLog { samples })
 }
 
 /// Writes samples as an accelerometer log [`read_accel_csv`] reads back (`t_s,a_long_mps2`, to
 /// 1e-9).
 pub fn write_accel_csv(path: &Path, samples: &[AccelSample]) -> Result<(), DrError> {
-    let p = path.display().to_string();
-    let werr = |message: String| DrError::Write {
-        what: WHAT,
-        path: p.clone(),
-        message,
-    };
-    let f = std::fs::File::create(path).map_err(|e| werr(e.to_string()))?;
-    let mut w = std::io::BufWriter::new(f);
-    let io = |e: std::io::Error| werr(e.to_string());
-    writeln!(w, "t_s,a_long_mps2").map_err(io)?;
-    for s in samples {
-        writeln!(w, "{:.9},{:.9}", s.t_s, s.a_long_mps2).map_err(io)?;
-    }
-    w.flush().map_err(io)
+    let rows = samples
+        .iter()
+        .map(|s| format!("{:.9},{:.9}", s.t_s, s.a_long_mps2));
+    write_lines(path, WHAT, "t_s,a_long_mps2", rows)
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! line-numbered, finite-number parsing of each row.
 
 use crate::dr_error::DrError;
+use std::io::Write;
 use std::path::Path;
 
 /// An open CSV log with its header.
@@ -107,11 +108,6 @@ impl CsvTable {
         self.error(self.header_line, message)
     }
 
-    /// The header line number.
-    pub fn header_line(&self) -> usize {
-        self.header_line
-    }
-
     /// Calls `f` on every data row, in order, stopping at the first error.
     pub fn for_each_row(
         &mut self,
@@ -151,6 +147,58 @@ impl CsvTable {
             i += 1;
         }
     }
+
+    /// Reads every row as `(t_s, value)`: `t_s` from column `t_col` must increase strictly, and
+    /// `parse` makes the value. At least 2 rows: `too_few(n)` words the error otherwise.
+    pub fn read_series<T>(
+        &mut self,
+        t_col: usize,
+        mut parse: impl FnMut(&CsvRow<'_>) -> Result<T, DrError>,
+        too_few: impl Fn(usize) -> String,
+    ) -> Result<Vec<(f64, T)>, DrError> {
+        let mut rows: Vec<(f64, T)> = Vec::new();
+        let mut last_line = self.header_line;
+        self.for_each_row(|row| {
+            last_line = row.line;
+            let t_s = row.number(t_col, "t_s")?;
+            let value = parse(row)?;
+            if let Some(&(last, _)) = rows.last() {
+                if t_s <= last {
+                    return Err(row.error(format!(
+                        "t_s = {t_s} does not increase (previous {last}): sort the file by t_s and remove duplicate rows"
+                    )));
+                }
+            }
+            rows.push((t_s, value));
+            Ok(())
+        })?;
+        if rows.len() < 2 {
+            return Err(self.error(last_line, too_few(rows.len())));
+        }
+        Ok(rows)
+    }
+}
+
+/// Writes a log: the `header` line, then one line per item of `rows` (each without its newline).
+/// Errors name `what` and the path.
+pub(crate) fn write_lines(
+    path: &Path,
+    what: &'static str,
+    header: &str,
+    rows: impl IntoIterator<Item = String>,
+) -> Result<(), DrError> {
+    let werr = |e: std::io::Error| DrError::Write {
+        what,
+        path: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let f = std::fs::File::create(path).map_err(werr)?;
+    let mut w = std::io::BufWriter::new(f);
+    writeln!(w, "{header}").map_err(werr)?;
+    for row in rows {
+        writeln!(w, "{row}").map_err(werr)?;
+    }
+    w.flush().map_err(werr)
 }
 
 impl CsvRow<'_> {

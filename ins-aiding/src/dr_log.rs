@@ -14,9 +14,8 @@
 //! The nominal sensor parameters (`Sf_G` deg/s/V, `V_nom` V, `Sf_N` m/pulse) are not in the file:
 //! they come from the configuration ([`crate::DrParams`]).
 
-use crate::csv_table::CsvTable;
+use crate::csv_table::{write_lines, CsvTable};
 use crate::dr_error::DrError;
-use std::io::Write;
 use std::path::Path;
 
 const WHAT: &str = "DR log";
@@ -172,45 +171,35 @@ pub fn read_dr_csv(path: &Path) -> Result<DrLog, DrError> {
     } else {
         ("yaw_rate_dps", "speed_mps")
     };
-    let mut samples: Vec<DrSample> = Vec::new();
-    let mut last_line = table.header_line();
-    table.for_each_row(|row| {
-        last_line = row.line;
-        let t_s = row.number(t_col, "t_s")?;
-        let x = row.number(a, na)?;
-        let y = row.number(b, nb)?;
-        let reading = if raw {
-            DrReading::Raw {
-                gyro_v: x,
-                odo_pulses: y,
-            }
-        } else {
-            DrReading::Engineering {
-                yaw_rate_dps: x,
-                speed_mps: y,
-            }
-        };
-        reading.check().map_err(|m| row.error(m))?;
-        if let Some(last) = samples.last() {
-            if t_s <= last.t_s {
-                return Err(row.error(format!(
-                    "t_s = {t_s} does not increase (previous {}): sort the file by t_s and remove duplicate rows",
-                    last.t_s
-                )));
-            }
-        }
-        samples.push(DrSample { t_s, reading });
-        Ok(())
-    })?;
-    if samples.len() < 2 {
-        return Err(table.error(
-            last_line,
+    let rows = table.read_series(
+        t_col,
+        |row| {
+            let x = row.number(a, na)?;
+            let y = row.number(b, nb)?;
+            let reading = if raw {
+                DrReading::Raw {
+                    gyro_v: x,
+                    odo_pulses: y,
+                }
+            } else {
+                DrReading::Engineering {
+                    yaw_rate_dps: x,
+                    speed_mps: y,
+                }
+            };
+            reading.check().map_err(|m| row.error(m))?;
+            Ok(reading)
+        },
+        |n| {
             format!(
-                "a DR log needs at least 2 rows (found {}): log the sensors over the whole drive",
-                samples.len()
-            ),
-        ));
-    }
+                "a DR log needs at least 2 rows (found {n}): log the sensors over the whole drive"
+            )
+        },
+    )?;
+    let samples = rows
+        .into_iter()
+        .map(|(t_s, reading)| DrSample { t_s, reading })
+        .collect();
     Ok(DrLog { samples })
 }
 
@@ -218,27 +207,22 @@ pub fn read_dr_csv(path: &Path) -> Result<DrLog, DrError> {
 /// `t_s,yaw_rate_dps,speed_mps` after the kind of the first sample (all must be of that kind);
 /// times to 1e-9 s, voltages to 1e-9 V, pulses and rates to 1e-9.
 pub fn write_dr_csv(path: &Path, samples: &[DrSample]) -> Result<(), DrError> {
-    let p = path.display().to_string();
-    let werr = |message: String| DrError::Write {
-        what: WHAT,
-        path: p.clone(),
-        message,
-    };
     let raw = samples.first().is_none_or(|s| s.reading.is_raw());
     if let Some(i) = samples.iter().position(|s| s.reading.is_raw() != raw) {
-        return Err(werr(format!(
-            "sample {i} is of another kind (raw/engineering) than the first: a log holds one kind"
-        )));
+        return Err(DrError::Write {
+            what: WHAT,
+            path: path.display().to_string(),
+            message: format!(
+                "sample {i} is of another kind (raw/engineering) than the first: a log holds one kind"
+            ),
+        });
     }
-    let f = std::fs::File::create(path).map_err(|e| werr(e.to_string()))?;
-    let mut w = std::io::BufWriter::new(f);
-    let io = |e: std::io::Error| werr(e.to_string());
-    if raw {
-        writeln!(w, "t_s,gyro_v,odo_pulses").map_err(io)?;
+    let header = if raw {
+        "t_s,gyro_v,odo_pulses"
     } else {
-        writeln!(w, "t_s,yaw_rate_dps,speed_mps").map_err(io)?;
-    }
-    for s in samples {
+        "t_s,yaw_rate_dps,speed_mps"
+    };
+    let rows = samples.iter().map(|s| {
         let (a, b) = match s.reading {
             DrReading::Raw { gyro_v, odo_pulses } => (gyro_v, odo_pulses),
             DrReading::Engineering {
@@ -246,9 +230,9 @@ pub fn write_dr_csv(path: &Path, samples: &[DrSample]) -> Result<(), DrError> {
                 speed_mps,
             } => (yaw_rate_dps, speed_mps),
         };
-        writeln!(w, "{:.9},{a:.9},{b:.9}", s.t_s).map_err(io)?;
-    }
-    w.flush().map_err(io)
+        format!("{:.9},{a:.9},{b:.9}", s.t_s)
+    });
+    write_lines(path, WHAT, header, rows)
 }
 
 #[cfg(test)]

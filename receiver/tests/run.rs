@@ -201,6 +201,39 @@ fn a_recording_too_short_for_a_fix_ends_with_a_message_not_an_error() {
 }
 
 #[test]
+fn observables_before_the_first_fix_carry_the_decoded_week() {
+    // 16 s: subframe 1 (TOW 538200-538206) is decoded, subframe 3 is not, so no fix. Without
+    // --week the reference week is today's; the epochs before subframe 1 were labelled with it
+    // and must be written with the decoded week 2190, in increasing time.
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let data = simulate(
+        "[receiver]\nkind = \"static\"\nllh_deg = [35.1796, 129.0756, 20.0]",
+        16.0,
+        dir.path(),
+    );
+    let out = dir.path().join("out");
+    let fixes = run(&data, &out, &[]);
+    assert!(fixes.is_empty(), "{} fixes from 16 s", fixes.len());
+    let text =
+        std::fs::read_to_string(out.join("observables.rnx")).unwrap_or_else(|e| panic!("{e}"));
+    // RINEX 3 epoch lines: "> yyyy mm dd hh mm ss.sssssss  flag nsat"; 2190/538200 s is
+    // 2022-01-01 05:30:00 GPS time.
+    let epochs: Vec<&str> = text.lines().filter(|l| l.starts_with("> ")).collect();
+    assert!(epochs.len() > 5, "{} epochs", epochs.len());
+    for w in epochs.windows(2) {
+        assert!(
+            w[0][2..29] < w[1][2..29],
+            "not increasing: `{}` then `{}`",
+            w[0],
+            w[1]
+        );
+    }
+    for e in &epochs {
+        assert!(e.starts_with("> 2022 01 01 05 "), "wrong week: `{e}`");
+    }
+}
+
+#[test]
 fn three_satellites_and_one_landmark_give_fixes() {
     // Seed 001: a landmark range without a clock term completes a 3-satellite geometry.
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));

@@ -70,6 +70,10 @@ pub fn default_toml() -> anyhow::Result<String> {
          tropo = \"saastamoinen\"    # saastamoinen or none (--tropo)\n\
          raim_pfa = 0.001          # RAIM false-alarm probability (--raim-pfa)\n\
          doppler_max_hz = 5000.0   # acquisition Doppler half-width, Hz (--doppler-max)\n\
+         doppler_center_hz = 0.0   # acquisition Doppler centre: front-end LO offset, Hz (--doppler-center)\n\
+         acq_coherent_ms = 1       # acquisition coherent integration, 1 .. 10 ms (--acq-coherent-ms)\n\
+         acq_noncoherent = 10      # acquisition non-coherent blocks (--acq-noncoherent)\n\
+         # (weak signals, below about 35 dB-Hz: acq_coherent_ms = 10, acq_noncoherent = 10 or more)\n\
          allow_unhealthy = false   # use satellites flagged unhealthy (--allow-unhealthy)\n\
          \n\
          [dr]                      # gpsrx run --dr / --accel (seed 000 sensor model)\n\
@@ -114,6 +118,10 @@ mod tests {
         assert_eq!(f.tracking, ChannelConfig::default());
         assert_eq!(f.run.rate_hz, Some(10.0));
         assert_eq!(f.run.iono.as_deref(), Some("klobuchar"));
+        assert_eq!(
+            (f.run.acq_coherent_ms, f.run.acq_noncoherent),
+            (Some(1), Some(10))
+        );
         let nominal = gpsrx_ins_aiding::DrParams::default();
         assert_eq!(f.dr.sf_g_dps_per_v, Some(nominal.sf_g_dps_per_v));
         assert_eq!(f.dr.v_nom_v, Some(nominal.v_nom_v));

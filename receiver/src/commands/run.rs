@@ -84,9 +84,21 @@ pub struct RunArgs {
     /// SigMF metadata, else the current week).
     #[arg(long, value_name = "WEEK")]
     pub week: Option<u32>,
-    /// Doppler search half-width of the acquisition, Hz [default: 5000].
+    /// Doppler search half-width of the acquisition, Hz [default: 5000; 15000 or more for a
+    /// front end with a large LO offset, or --doppler-center].
     #[arg(long, value_name = "HZ")]
     pub doppler_max: Option<f64>,
+    /// Centre of the acquisition's Doppler search, Hz: a known front-end frequency offset
+    /// [default: 0].
+    #[arg(long, value_name = "HZ", allow_hyphen_values = true)]
+    pub doppler_center: Option<f64>,
+    /// Acquisition coherent integration, ms, 1 to 10 [default: 1]. Weak signals (below about
+    /// 35 dB-Hz): 10, with --acq-noncoherent 10 or more.
+    #[arg(long, value_name = "MS")]
+    pub acq_coherent_ms: Option<u32>,
+    /// Acquisition non-coherent sum of this many coherent blocks [default: 10].
+    #[arg(long, value_name = "N")]
+    pub acq_noncoherent: Option<u32>,
     /// RAIM false-alarm probability [default: 0.001].
     #[arg(long, value_name = "P")]
     pub raim_pfa: Option<f64>,
@@ -176,6 +188,12 @@ pub struct RunConfig {
     pub raim_pfa: Option<f64>,
     /// Acquisition Doppler half-width, Hz.
     pub doppler_max_hz: Option<f64>,
+    /// Acquisition Doppler search centre, Hz.
+    pub doppler_center_hz: Option<f64>,
+    /// Acquisition coherent integration, ms.
+    pub acq_coherent_ms: Option<u32>,
+    /// Acquisition non-coherent blocks.
+    pub acq_noncoherent: Option<u32>,
     /// Use unhealthy satellites.
     pub allow_unhealthy: Option<bool>,
 }
@@ -189,6 +207,9 @@ struct Settings {
     tropo: TropoModel,
     raim_pfa: f64,
     doppler_max: f64,
+    doppler_center: f64,
+    acq_coherent_ms: u32,
+    acq_noncoherent: u32,
     allow_unhealthy: bool,
 }
 
@@ -221,6 +242,12 @@ impl Settings {
             tropo,
             raim_pfa: args.raim_pfa.or(file.raim_pfa).unwrap_or(1e-3),
             doppler_max: args.doppler_max.or(file.doppler_max_hz).unwrap_or(5000.0),
+            doppler_center: args
+                .doppler_center
+                .or(file.doppler_center_hz)
+                .unwrap_or(0.0),
+            acq_coherent_ms: args.acq_coherent_ms.or(file.acq_coherent_ms).unwrap_or(1),
+            acq_noncoherent: args.acq_noncoherent.or(file.acq_noncoherent).unwrap_or(10),
             allow_unhealthy: args.allow_unhealthy || file.allow_unhealthy.unwrap_or(false),
         };
         if !(1.0..=50.0).contains(&s.rate) {
@@ -239,6 +266,24 @@ impl Settings {
             anyhow::bail!(
                 "Doppler search half-width {} Hz: use (0, 100000]",
                 s.doppler_max
+            );
+        }
+        if !(s.doppler_center.is_finite() && s.doppler_center.abs() <= 100e3) {
+            anyhow::bail!(
+                "Doppler search centre {} Hz: use a value within +-100000",
+                s.doppler_center
+            );
+        }
+        if !(1..=10).contains(&s.acq_coherent_ms) {
+            anyhow::bail!(
+                "acquisition coherent integration {} ms: use 1 to 10 ms",
+                s.acq_coherent_ms
+            );
+        }
+        if !(1..=1000).contains(&s.acq_noncoherent) {
+            anyhow::bail!(
+                "acquisition non-coherent blocks {}: use 1 to 1000",
+                s.acq_noncoherent
             );
         }
         Ok(s)
@@ -321,6 +366,10 @@ impl DrInputs {
     }
 }
 
+/// Seconds of observables held back waiting for the first fix (whose position goes into the
+/// RINEX header) before they are written without one.
+const OBS_BACKLOG_MAX_S: f64 = 300.0;
+
 /// Runs the receiver on a file.
 pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSummary, Vec<Fix>)> {
     let t_wall = std::time::Instant::now();
@@ -394,6 +443,9 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
 
     // Cold acquisition on the first samples.
     let acq_cfg = AcqConfig {
+        coherent_ms: set.acq_coherent_ms,
+        noncoherent: set.acq_noncoherent,
+        doppler_center_hz: set.doppler_center,
         doppler_max_hz: set.doppler_max,
         ..AcqConfig::default()
     };
@@ -588,7 +640,28 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
                 w.write_epoch(&obs)?;
                 obs_writer = Some(w);
             }
-            (None, None) => obs_backlog.push(obs),
+            (None, None) => {
+                obs_backlog.push(obs);
+                // Bounded memory: without a fix for this long (but with the week decoded, so
+                // the labels will not change), the observables go out with an unknown position.
+                let week_known = decoders.values().any(|d| d.decoded_week().is_some());
+                if week_known && obs_backlog.len() as f64 > OBS_BACKLOG_MAX_S * set.rate {
+                    let week = epoch.rx_time.week;
+                    let header = ObsHeader {
+                        interval_s: Some(1.0 / set.rate),
+                        ..ObsHeader::default()
+                    };
+                    let mut w = RinexObsWriter::create(&out("observables.rnx"), header)?;
+                    for mut o in obs_backlog.drain(..) {
+                        o.time.week = week;
+                        w.write_epoch(&o)?;
+                    }
+                    tracing::warn!(
+                        "no fix after {OBS_BACKLOG_MAX_S} s of observables: observables.rnx has no approximate position"
+                    );
+                    obs_writer = Some(w);
+                }
+            }
         }
         let Some(sol) = solution else {
             return Ok(());
@@ -757,8 +830,14 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
                 interval_s: Some(1.0 / set.rate),
                 ..ObsHeader::default()
             };
+            // Epochs before the first subframe 1 carried the reference week; the last epoch has
+            // the best week known (decoded, or still the reference week): label them all with it.
+            let week = obs_backlog.last().map(|o| o.time.week);
             let mut w = RinexObsWriter::create(&out("observables.rnx"), header)?;
-            for o in obs_backlog.drain(..) {
+            for mut o in obs_backlog.drain(..) {
+                if let Some(week) = week {
+                    o.time.week = week;
+                }
                 w.write_epoch(&o)?;
             }
             w.finish()?;
