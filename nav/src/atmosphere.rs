@@ -16,6 +16,17 @@ pub struct KlobucharParams {
     pub beta: [f64; 4],
 }
 
+impl KlobucharParams {
+    /// Coefficients to use until the broadcast ones are decoded (subframe 4 page 18 comes only
+    /// once every 12.5 min): a typical broadcast set (2004-01-01; the fallback RTKLIB uses too).
+    /// It removes a good part of the delay on most days, where no correction would leave all
+    /// of it (about 2-10 m at the zenith by day).
+    pub const FALLBACK: KlobucharParams = KlobucharParams {
+        alpha: [0.1118e-07, -0.7451e-08, -0.5961e-07, 0.1192e-06],
+        beta: [0.1167e+06, -0.2294e+06, -0.1311e+06, 0.1049e+07],
+    };
+}
+
 /// Night-time constant delay DC of the Klobuchar model, s (Figure 20-4).
 pub const KLOBUCHAR_NIGHT_DELAY_S: f64 = 5.0e-9;
 

@@ -199,7 +199,15 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
     let nav = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data/brdc0010.22n");
     let nav = nav.to_str().unwrap_or_default();
     let ins = ins_path.to_str().unwrap_or_default();
-    let common = ["--nav", nav, "--pll-bw", "3", "--allow-unhealthy"];
+    let common = [
+        "--nav",
+        nav,
+        "--pll-order",
+        "2",
+        "--pll-bw",
+        "3",
+        "--allow-unhealthy",
+    ];
     let aided_out = dir.path().join("aided");
     let unaided_out = dir.path().join("unaided");
     let mut aided_args = common.to_vec();
@@ -270,6 +278,7 @@ fn aided_loops_are_used_while_the_aid_is_on() {
         Some((b.carrier_cycles - a.carrier_cycles) / 1e-3)
     };
     let mut cfg = ChannelConfig::default();
+    cfg.track.pll_order = 2;
     cfg.track.pll_bw_hz = 15.0;
     let mut aided = cfg.track;
     aided.pll_bw_hz = 2.0;

@@ -20,6 +20,7 @@ use crate::carrier_loop::CarrierLoop;
 use crate::cn0::SmoothedNwpr;
 use crate::code_loop::CodeLoop;
 use crate::config::{ConfigError, LoopConfig};
+use crate::fade_detector::FadeDetector;
 use crate::lock_detector::{CodeLockDetector, PllLockConfig, PllLockDetector};
 use gpsrx_dsp::ca_code::{CaCode, Prn};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, CA_CODE_LENGTH, F_L1_HZ};
@@ -40,6 +41,16 @@ pub struct ChannelConfig {
     /// loop can be much narrower than an unaided one and let through less noise; the channel
     /// switches between `track` and these at a data-bit edge whenever the aid comes or goes.
     pub aided_track: Option<LoopConfig>,
+    /// Loops after pull-in for weak signals (`None`: never switch): taken while the C/N0 is
+    /// below `weak_enter_dbhz`, left when it climbs above `weak_leave_dbhz` (switches at a
+    /// data-bit edge). Longer integration and narrower loops hold weaker signals (phase jitter
+    /// `sqrt(Bn/(C/N0) (1 + 1/(2 T C/N0)))`) but follow less dynamics, so the default `track`
+    /// loops can stay wide enough for 10 g. An aided channel runs `aided_track` instead.
+    pub weak_track: Option<LoopConfig>,
+    /// C/N0 below which the channel takes the `weak_track` loops, dB-Hz.
+    pub weak_enter_dbhz: f64,
+    /// C/N0 above which it goes back to `track`, dB-Hz (> `weak_enter_dbhz`: hysteresis).
+    pub weak_leave_dbhz: f64,
     /// Minimum time in pull-in before the hand-over to tracking, s.
     pub min_pull_in_s: f64,
     /// Time after which the FLL assist of the pull-in loop is switched off, s: the
@@ -59,9 +70,12 @@ impl Default for ChannelConfig {
     fn default() -> Self {
         Self {
             pull_in: LoopConfig::default(),
+            // 3rd order at 18 Hz: no steady-state error under constant acceleration, and a
+            // 10 g manoeuvre with a 0.5 s jerk ramp (~200 m/s^3) costs ~0.085 cycle of
+            // phase (j / (lambda wn^3), wn = Bn / 0.7845).
             track: LoopConfig {
-                pll_order: 2,
-                pll_bw_hz: 10.0,
+                pll_order: 3,
+                pll_bw_hz: 18.0,
                 fll_order: 0,
                 fll_bw_hz: 0.0,
                 dll_order: 1,
@@ -71,6 +85,20 @@ impl Default for ChannelConfig {
                 ..LoopConfig::default()
             },
             aided_track: None,
+            // Below 32 dB-Hz: 20 ms coherent (bit-aligned), 2nd-order PLL at 5 Hz, DLL 0.5 Hz.
+            weak_track: Some(LoopConfig {
+                pll_order: 2,
+                pll_bw_hz: 5.0,
+                fll_order: 0,
+                fll_bw_hz: 0.0,
+                dll_order: 1,
+                dll_bw_hz: 0.5,
+                t_coh_s: 20.0e-3,
+                el_spacing_chips: 1.0,
+                ..LoopConfig::default()
+            }),
+            weak_enter_dbhz: 32.0,
+            weak_leave_dbhz: 35.0,
             min_pull_in_s: 0.5,
             fll_assist_s: 0.3,
             cn0_lost_dbhz: 25.0,
@@ -84,7 +112,8 @@ impl ChannelConfig {
     /// Checks both loop configurations and the thresholds.
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.pull_in.validate()?;
-        for l in std::iter::once(&self.track).chain(self.aided_track.as_ref()) {
+        let others = self.aided_track.iter().chain(self.weak_track.iter());
+        for l in std::iter::once(&self.track).chain(others) {
             l.validate()?;
             let ms = (l.t_coh_s * 1e3).round() as usize;
             if ms == 0 || !MS_PER_BIT.is_multiple_of(ms) {
@@ -117,6 +146,19 @@ impl ChannelConfig {
                 field: "fll_assist_s",
                 value: self.fll_assist_s,
                 valid: ">= 0 s".into(),
+            });
+        }
+        if !(self.weak_enter_dbhz.is_finite()
+            && self.weak_leave_dbhz.is_finite()
+            && self.weak_leave_dbhz > self.weak_enter_dbhz)
+        {
+            return Err(ConfigError::OutOfRange {
+                field: "weak_leave_dbhz",
+                value: self.weak_leave_dbhz,
+                valid: format!(
+                    "a C/N0 above weak_enter_dbhz = {} dB-Hz",
+                    self.weak_enter_dbhz
+                ),
             });
         }
         if !self.cn0_lost_dbhz.is_finite() {
@@ -177,7 +219,9 @@ pub struct ChannelEpoch {
     pub doppler_hz: f64,
     /// Latest C/N0 estimate, dB-Hz (NaN before the first).
     pub cn0_dbhz: f64,
-    /// Phase-lock indicator state.
+    /// Phase lock: the `cos 2 phi` indicator says locked and the prompt power has not just
+    /// collapsed ([`crate::fade_detector`]: a wide PLL on noise keeps `cos 2 phi` high for a
+    /// second after a blockage). Measurements are usable only with it.
     pub pll_lock: bool,
     /// `cos 2 phi` of the phase-lock indicator.
     pub pll_lock_metric: f64,
@@ -223,6 +267,7 @@ pub struct Channel {
     carrier: CarrierLoop,
     code_loop: CodeLoop,
     pll_lock: PllLockDetector,
+    fade: FadeDetector,
     code_lock: CodeLockDetector,
     cn0: SmoothedNwpr,
     cn0_started: bool,
@@ -240,8 +285,11 @@ pub struct Channel {
     aid: Option<(DopplerAid, f64)>,
     /// The feed-forward contained in the current NCO frequency, Hz (None: unaided).
     ff_applied_hz: Option<f64>,
-    /// Whether the tracking loops are the aided ones ([`ChannelConfig::aided_track`]).
-    aided_loops: bool,
+    /// Which tracking loops run (after pull-in).
+    loops: TrackLoops,
+    /// The C/N0 has fallen below [`ChannelConfig::weak_enter_dbhz`] (and not yet climbed back
+    /// above `weak_leave_dbhz`).
+    weak: bool,
     /// The feed-forward held over the interval being accumulated.
     acc_feedforward_hz: Option<f64>,
     ms_count: u64,
@@ -289,6 +337,7 @@ impl Channel {
             carrier,
             code_loop,
             pll_lock: PllLockDetector::new(PllLockConfig::default()),
+            fade: FadeDetector::new(),
             code_lock: CodeLockDetector::new(cfg.cn0_lost_dbhz, cfg.lost_estimates),
             cn0_started: false,
             cn0_window_blocks: ((cfg.cn0_window_s / 0.02).round() as u32).max(1),
@@ -306,7 +355,8 @@ impl Channel {
             carrier_freq_hz: start.doppler_hz,
             aid: None,
             ff_applied_hz: None,
-            aided_loops: false,
+            loops: TrackLoops::Normal,
+            weak: start.cn0_dbhz < cfg.weak_enter_dbhz,
             acc_feedforward_hz: None,
             ms_count: 0,
             bit_sync_origin_ms: 0,
@@ -469,6 +519,11 @@ impl Channel {
         }
         if let Some(c) = estimate {
             self.cn0_dbhz = c;
+            if c < self.cfg.weak_enter_dbhz {
+                self.weak = true;
+            } else if c > self.cfg.weak_leave_dbhz {
+                self.weak = false;
+            }
             // Lock decisions once per estimation window.
             if self.cn0.blocks().is_multiple_of(self.cn0_window_blocks) {
                 let ok = self.code_lock.update(c);
@@ -483,6 +538,7 @@ impl Channel {
             }
         }
         self.pll_lock.update(p);
+        self.fade.push(p);
         if matches!(self.bit_sync.state(), BitSyncState::Failed) {
             // No bit edges within the synchroniser's patience: no usable signal. Release the
             // channel so the satellite goes back to acquisition.
@@ -542,7 +598,7 @@ impl Channel {
             carrier_phase_cycles: ph0,
             doppler_hz: f0,
             cn0_dbhz: self.cn0_dbhz,
-            pll_lock: self.pll_lock.locked(),
+            pll_lock: self.pll_lock.locked() && !self.fade.faded(),
             pll_lock_metric: self.pll_lock.cos_2phi(),
             code_lock: self.code_lock.locked(),
             prompt: pa,
@@ -564,7 +620,7 @@ impl Channel {
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
         self.maybe_hand_over(next_is_edge);
-        self.maybe_switch_aiding(next_is_edge);
+        self.maybe_switch_loops(next_is_edge);
         Some(epoch)
     }
 
@@ -579,7 +635,8 @@ impl Channel {
         if self.pull_in_ms < min_ms || !self.pll_lock.locked() {
             return;
         }
-        let loops = self.tracking_loops();
+        let which = self.wanted_loops();
+        let loops = self.loop_config(which);
         let (Ok(carrier), Ok(code_loop)) = (
             CarrierLoop::new(&loops, self.carrier.frequency_memory_hz()),
             CodeLoop::new(&loops),
@@ -596,31 +653,46 @@ impl Channel {
         let d = loops.el_spacing_chips;
         self.taps = [d / 2.0, 0.0, -d / 2.0];
         self.state = ChannelState::Track;
-        self.aided_loops = self.ff_applied_hz.is_some() && self.cfg.aided_track.is_some();
+        self.loops = which;
     }
 
     /// The loops the tracking state should run now: the aided ones while a feed-forward is
-    /// applied (if configured), else the unaided ones.
-    fn tracking_loops(&self) -> LoopConfig {
-        match (self.ff_applied_hz, self.cfg.aided_track) {
-            (Some(_), Some(a)) => a,
-            _ => self.cfg.track,
+    /// applied (if configured), else the weak-signal ones while the C/N0 is low (if
+    /// configured), else the normal ones.
+    fn wanted_loops(&self) -> TrackLoops {
+        if self.ff_applied_hz.is_some() && self.cfg.aided_track.is_some() {
+            TrackLoops::Aided
+        } else if self.weak && self.cfg.weak_track.is_some() {
+            TrackLoops::Weak
+        } else {
+            TrackLoops::Normal
         }
     }
 
-    /// In tracking, switches between the unaided and aided loops when the aid has come or gone
-    /// (at a data-bit edge, so that the integrations stay aligned). The carrier NCO frequency
-    /// is kept: the new loop starts from the current base frequency; the code loop restarts
-    /// from the current code rate (carrier-aided, so only the DLL's small correction resets).
-    fn maybe_switch_aiding(&mut self, at_edge: bool) {
-        if self.state != ChannelState::Track || !at_edge || self.cfg.aided_track.is_none() {
+    /// The configuration of `which` loops.
+    fn loop_config(&self, which: TrackLoops) -> LoopConfig {
+        match which {
+            TrackLoops::Aided => self.cfg.aided_track,
+            TrackLoops::Weak => self.cfg.weak_track,
+            TrackLoops::Normal => None,
+        }
+        .unwrap_or(self.cfg.track)
+    }
+
+    /// In tracking, switches loops when the aid has come or gone or the C/N0 has crossed a
+    /// weak-signal threshold (at a data-bit edge, so that the integrations stay aligned). The
+    /// carrier NCO frequency is kept: the new loop starts from the current base frequency; the
+    /// code loop restarts from the current code rate (carrier-aided, so only the DLL's small
+    /// correction resets).
+    fn maybe_switch_loops(&mut self, at_edge: bool) {
+        if self.state != ChannelState::Track || !at_edge {
             return;
         }
-        let want_aided = self.ff_applied_hz.is_some();
-        if want_aided == self.aided_loops {
+        let which = self.wanted_loops();
+        if which == self.loops {
             return;
         }
-        let loops = self.tracking_loops();
+        let loops = self.loop_config(which);
         let (Ok(carrier), Ok(code_loop)) = (
             CarrierLoop::new(&loops, self.carrier.frequency_memory_hz()),
             CodeLoop::new(&loops),
@@ -631,11 +703,27 @@ impl Channel {
         self.code_loop = code_loop;
         let d = loops.el_spacing_chips;
         self.taps = [d / 2.0, 0.0, -d / 2.0];
-        self.aided_loops = want_aided;
+        self.loops = which;
     }
 
     /// Whether the channel is running its aided tracking loops.
     pub fn aided_loops(&self) -> bool {
-        self.aided_loops
+        self.loops == TrackLoops::Aided
     }
+
+    /// Whether the channel is running its weak-signal tracking loops.
+    pub fn weak_loops(&self) -> bool {
+        self.loops == TrackLoops::Weak
+    }
+}
+
+/// Which of the configured tracking loops a channel runs after pull-in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TrackLoops {
+    /// [`ChannelConfig::track`].
+    Normal,
+    /// [`ChannelConfig::aided_track`].
+    Aided,
+    /// [`ChannelConfig::weak_track`].
+    Weak,
 }

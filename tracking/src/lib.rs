@@ -13,6 +13,7 @@
 //! - [`carrier_loop`], [`code_loop`]: what a channel drives once per integration interval.
 //! - [`lock_detector`]: phase lock (`cos 2 phi`) and code lock (C/N0) with hysteresis.
 //! - [`cn0`]: NWPR and M2M4 C/N0 estimators.
+//! - [`fade_detector`]: a sudden collapse of the prompt power (blockage, sample gap).
 //! - [`bit_sync`]: histogram bit synchronisation and bit decisions.
 //! - [`phase_sim`]: a phase-domain closed-loop simulator (correlator-level prompts) for studies.
 //!
@@ -27,6 +28,7 @@ pub mod cn0;
 pub mod code_loop;
 pub mod config;
 pub mod discriminator;
+pub mod fade_detector;
 pub mod lock_detector;
 pub mod loop_analysis;
 pub mod loop_filter;

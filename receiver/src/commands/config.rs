@@ -53,9 +53,13 @@ pub fn default_toml() -> anyhow::Result<String> {
          cn0_lost_dbhz = {:?}      # C/N0 below which a channel counts as lost, dB-Hz\n\
          cn0_window_s = {:?}       # length of one C/N0 estimate (bit-aligned NWPR), s\n\
          lost_estimates = {}       # consecutive low estimates that release the channel\n\
+         weak_enter_dbhz = {:?}    # below this C/N0 a channel takes [tracking.weak_track], dB-Hz (0: never)\n\
+         weak_leave_dbhz = {:?}    # above this it goes back to [tracking.track], dB-Hz\n\
          \n\
          # Pull-in loops: 1 ms, wide, FLL-assisted.\n{}\n\
-         # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n{}\n\
+         # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n\
+         # 3rd order at 18 Hz follows 10 g manoeuvres.\n{}\n\
+         # Tracking loops for weak signals (C/N0 below weak_enter_dbhz): 20 ms, narrow.\n{}\n\
          # Tracking loops while an INS feed-forward aids the channel (gpsrx run --ins; optional,\n\
          # default: the same as [tracking.track]; --aided-pll-bw, --aided-pll-order):\n\
          # [tracking.aided_track]\n\
@@ -87,8 +91,11 @@ pub fn default_toml() -> anyhow::Result<String> {
         c.cn0_lost_dbhz,
         c.cn0_window_s,
         c.lost_estimates,
+        c.weak_enter_dbhz,
+        c.weak_leave_dbhz,
         loops("pull_in", &c.pull_in)?,
         loops("track", &c.track)?,
+        loops("weak_track", &c.weak_track.unwrap_or(c.track))?,
     );
     Ok(text)
 }

@@ -19,10 +19,11 @@ use crate::pipeline::navdata::{current_gps_week, NavDecoder, NavEvent};
 use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
 use crate::pipeline::tracker::{track_with_reacquisition, AidSource, Reacquisition};
 use anyhow::Context;
-use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
+use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine, SearchTarget};
 use gpsrx_ins_aiding::{
     read_accel_csv, read_dr_csv, read_ins_csv, AccelLog, DrFilterKind, DrLog, DrParams, FixSource,
 };
+use gpsrx_nav::atmosphere::KlobucharParams;
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::frames::azimuth_elevation;
 use gpsrx_nav::pvt::{solve, PvtOptions, PvtSolution, RaimStatus, SatMeasurement};
@@ -210,6 +211,9 @@ struct Settings {
     doppler_center: f64,
     acq_coherent_ms: u32,
     acq_noncoherent: u32,
+    /// The acquisition integration was chosen (command line or file): no automatic
+    /// weak-signal search.
+    acq_explicit: bool,
     allow_unhealthy: bool,
 }
 
@@ -248,6 +252,10 @@ impl Settings {
                 .unwrap_or(0.0),
             acq_coherent_ms: args.acq_coherent_ms.or(file.acq_coherent_ms).unwrap_or(1),
             acq_noncoherent: args.acq_noncoherent.or(file.acq_noncoherent).unwrap_or(10),
+            acq_explicit: args.acq_coherent_ms.is_some()
+                || args.acq_noncoherent.is_some()
+                || file.acq_coherent_ms.is_some()
+                || file.acq_noncoherent.is_some(),
             allow_unhealthy: args.allow_unhealthy || file.allow_unhealthy.unwrap_or(false),
         };
         if !(1.0..=50.0).contains(&s.rate) {
@@ -366,6 +374,10 @@ impl DrInputs {
     }
 }
 
+/// The weak-signal acquisition: coherent ms and non-coherent blocks.
+const WEAK_ACQ_COHERENT_MS: u32 = 10;
+const WEAK_ACQ_NONCOHERENT: u32 = 10;
+
 /// Seconds of observables held back waiting for the first fix (whose position goes into the
 /// RINEX header) before they are written without one.
 const OBS_BACKLOG_MAX_S: f64 = 300.0;
@@ -449,8 +461,27 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         doppler_max_hz: set.doppler_max,
         ..AcqConfig::default()
     };
-    let engine = AcquisitionEngine::new(fs, acq_cfg)?;
-    let mut first = vec![Complex32::new(0.0, 0.0); engine.samples_wanted()];
+    let engine = AcquisitionEngine::new(fs, acq_cfg.clone())?;
+    // Weak signals: when the usual search finds fewer than 4 satellites (and the user did not
+    // choose the integration), search the rest again with 10 ms x 10, about 8 dB more
+    // sensitive, and keep that engine for re-acquisition.
+    let weak_engine = if set.acq_explicit {
+        None
+    } else {
+        Some(AcquisitionEngine::new(
+            fs,
+            AcqConfig {
+                coherent_ms: WEAK_ACQ_COHERENT_MS,
+                noncoherent: WEAK_ACQ_NONCOHERENT,
+                ..acq_cfg.clone()
+            },
+        )?)
+    };
+    let wanted = weak_engine
+        .as_ref()
+        .map_or(0, AcquisitionEngine::samples_wanted)
+        .max(engine.samples_wanted());
+    let mut first = vec![Complex32::new(0.0, 0.0); wanted];
     let (first_index, n) = {
         let mut acq_src = open_source(&src_cfg)?;
         let mut filled = 0usize;
@@ -471,7 +502,30 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
             engine.samples_needed()
         );
     }
-    let found = engine.search_all(&first[..n])?;
+    let mut found = engine.search_all(&first[..n.min(engine.samples_wanted())])?;
+    let detected = found.iter().filter(|d| d.detected).count();
+    let engine = match weak_engine {
+        Some(weak) if detected < 4 && n >= weak.samples_needed() => {
+            tracing::warn!(
+                "{detected} satellite(s) found with {} ms x {}: searching again with {WEAK_ACQ_COHERENT_MS} ms x {WEAK_ACQ_NONCOHERENT} for weak signals (--acq-coherent-ms chooses)",
+                acq_cfg.coherent_ms,
+                acq_cfg.noncoherent
+            );
+            let missing: Vec<SearchTarget> = found
+                .iter()
+                .filter(|d| !d.detected)
+                .map(|d| SearchTarget::full(d.prn))
+                .collect();
+            let again = weak.search(&first[..n.min(weak.samples_wanted())], &missing)?;
+            for r in again {
+                if let Some(slot) = found.iter_mut().find(|d| d.prn == r.prn) {
+                    *slot = r;
+                }
+            }
+            weak
+        }
+        _ => engine,
+    };
     let mut channels = Vec::new();
     for d in found.iter().filter(|d| d.detected) {
         let start = ChannelStart {
@@ -508,7 +562,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
     );
 
     let mut decoders: BTreeMap<u8, NavDecoder> = BTreeMap::new();
-    let mut builder = ObservableBuilder::new(fs, set.rate);
+    let mut builder = ObservableBuilder::new(fs, set.rate).with_min_cn0_dbhz(cfg.cn0_lost_dbhz);
     let opts = PvtOptions {
         tropo: set.tropo == TropoModel::Saastamoinen,
         elevation_mask_deg: set.elevation_mask,
@@ -526,16 +580,24 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
     let mut summary = RunSummary::default();
     let mut err: Option<anyhow::Error> = None;
     let mut last_row_t: BTreeMap<usize, f64> = BTreeMap::new();
+    let mut iono_fallback_said = false;
 
     let mut handle_epoch = |epoch: ObservableEpoch,
                             decoders: &BTreeMap<u8, NavDecoder>,
                             builder: &mut ObservableBuilder|
      -> anyhow::Result<()> {
         let iono = if set.iono == IonoModel::Klobuchar {
-            decoders
+            let known = decoders
                 .values()
                 .find_map(|d| d.iono)
-                .or_else(|| nav_assist.as_ref().and_then(|n| n.iono))
+                .or_else(|| nav_assist.as_ref().and_then(|n| n.iono));
+            if known.is_none() && !iono_fallback_said {
+                tracing::info!(
+                    "ionosphere: typical Klobuchar coefficients until subframe 4 page 18 is decoded (or give --nav)"
+                );
+                iono_fallback_said = true;
+            }
+            Some(known.unwrap_or(KlobucharParams::FALLBACK))
         } else {
             None
         };

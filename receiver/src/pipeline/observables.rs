@@ -84,6 +84,9 @@ pub struct ObservableBuilder {
     phase_rate: BTreeMap<(i64, u8), f64>,
     /// Hatch filter length, epochs.
     hatch_epochs: u32,
+    /// Reports with a lower C/N0 estimate give no observables (see
+    /// [`ObservableBuilder::with_min_cn0_dbhz`]).
+    min_cn0_dbhz: f64,
 }
 
 impl ObservableBuilder {
@@ -101,7 +104,18 @@ impl ObservableBuilder {
             smoothing: BTreeMap::new(),
             phase_rate: BTreeMap::new(),
             hatch_epochs: (rate_hz * 10.0).round().max(1.0) as u32,
+            min_cn0_dbhz: f64::NEG_INFINITY,
         }
+    }
+
+    /// Takes observables only from reports whose C/N0 estimate is at least `dbhz` (and
+    /// flags a loss of lock when it falls below). A blocked signal's C/N0 estimate falls within
+    /// a few hundred ms, while a wide PLL running on noise keeps the PLL lock indicator high for
+    /// about a second (it steers the noise into the in-phase arm): without this gate a tunnel
+    /// entry gives a second of fixes from noise.
+    pub fn with_min_cn0_dbhz(mut self, dbhz: f64) -> Self {
+        self.min_cn0_dbhz = dbhz;
+        self
     }
 
     /// Receiver time of sample 0, once known.
@@ -124,11 +138,12 @@ impl ObservableBuilder {
     /// Takes one channel report (with the decoder of its satellite); returns the epochs that
     /// are complete (no channel can add to them any more).
     pub fn push(&mut self, e: &ChannelEpoch, dec: &NavDecoder) -> Vec<ObservableEpoch> {
+        // Only phase-locked channels with signal give observables (a channel that has just
+        // lost its signal still reports until its C/N0 test releases it).
+        let usable = e.pll_lock && e.state != ChannelState::Lost && e.cn0_dbhz >= self.min_cn0_dbhz;
         let lost = self.lli.entry(e.prn).or_insert(true);
-        *lost |= !e.pll_lock || e.state == ChannelState::Lost;
-        // Only phase-locked channels give observables (a channel that has just lost its signal
-        // still reports until its C/N0 test releases it).
-        if !e.pll_lock || e.state == ChannelState::Lost {
+        *lost |= !usable;
+        if !usable {
             return Vec::new();
         }
         let Some(sv_tow0) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) else {

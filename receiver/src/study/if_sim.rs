@@ -322,8 +322,8 @@ pub fn start_from_truth(
 
 /// A channel configuration with the default pull-in (wide, FLL-assisted, T = 1 ms) and this
 /// tracking loop: PLL of `order` (1-3) and noise bandwidth `bn_hz` without FLL, 1st-order
-/// carrier-aided DLL of `dll_bn_hz`, integration `t_coh_s`, E-L spacing 1 chip; the rest as
-/// [`ChannelConfig::default`].
+/// carrier-aided DLL of `dll_bn_hz`, integration `t_coh_s`, E-L spacing 1 chip, no weak-signal
+/// loops; the rest as [`ChannelConfig::default`].
 pub fn track_config(order: u8, bn_hz: f64, t_coh_s: f64, dll_bn_hz: f64) -> ChannelConfig {
     let base = ChannelConfig::default();
     ChannelConfig {
@@ -334,6 +334,8 @@ pub fn track_config(order: u8, bn_hz: f64, t_coh_s: f64, dll_bn_hz: f64) -> Chan
             t_coh_s,
             ..base.track
         },
+        // A loop study measures the loops it names: no switch to the weak-signal loops.
+        weak_track: None,
         ..base
     }
 }

@@ -34,6 +34,7 @@ pub fn cell_channel_config(order: u8, bn_hz: f64, t_s: f64) -> ChannelConfig {
         min_pull_in_s: 0.5,
         fll_assist_s: 0.0,
         cn0_lost_dbhz: 20.0,
+        weak_track: None,
         ..ChannelConfig::default()
     }
 }
