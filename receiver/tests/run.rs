@@ -73,6 +73,28 @@ fn errors(fixes: &[Fix], truth: &[(f64, [f64; 3], [f64; 3])]) -> (f64, f64, f64)
     )
 }
 
+/// What [`simulate_and_run`] measured.
+struct Scored {
+    fixes: Vec<Fix>,
+    h: f64,
+    v: f64,
+    vel: f64,
+}
+
+/// Simulates `receiver` for `duration_s`, runs `gpsrx run` on it with `extra` options, prints
+/// and returns the fixes with their errors against the truth (see [`errors`]).
+fn simulate_and_run(label: &str, receiver: &str, duration_s: f64, extra: &[&str]) -> Scored {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let data = simulate(receiver, duration_s, dir.path());
+    let fixes = run(&data, &dir.path().join("out"), extra);
+    let (h, v, vel) = errors(&fixes, &truth(dir.path()));
+    eprintln!(
+        "{label}: {} fixes, H RMS {h:.2} m, V RMS {v:.2} m, velocity RMS {vel:.3} m/s",
+        fixes.len()
+    );
+    Scored { fixes, h, v, vel }
+}
+
 #[test]
 fn static_receiver_fixes_within_a_metre() {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
@@ -119,26 +141,20 @@ fn static_receiver_fixes_within_a_metre() {
 
 #[test]
 fn moving_receiver_at_constant_speed() {
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let data = simulate(
+    let nav = nav_file();
+    let r = simulate_and_run(
+        "moving 25 m/s",
         "[receiver]\nkind = \"motion\"\nstart_llh_deg = [35.1796, 129.0756, 20.0]\nheading_deg = 60.0\nspeed_mps = 25.0\nsegments = []",
         16.0,
-        dir.path(),
+        &["--nav", nav.to_str().unwrap_or_default()],
     );
-    let fixes = run(
-        &data,
-        &dir.path().join("out"),
-        &["--nav", nav_file().to_str().unwrap_or_default()],
-    );
-    let (h, v, vel) = errors(&fixes, &truth(dir.path()));
-    eprintln!(
-        "moving 25 m/s: {} fixes, H RMS {h:.2} m, V RMS {v:.2} m, velocity RMS {vel:.3} m/s",
-        fixes.len()
-    );
-    assert!(fixes.len() > 60, "{} fixes", fixes.len());
+    assert!(r.fixes.len() > 60, "{} fixes", r.fixes.len());
     assert!(
-        h < 2.0 && v < 4.0 && vel < 0.15,
-        "H {h:.2} V {v:.2} vel {vel:.3}"
+        r.h < 2.0 && r.v < 4.0 && r.vel < 0.15,
+        "H {:.2} V {:.2} vel {:.3}",
+        r.h,
+        r.v,
+        r.vel
     );
 }
 
@@ -146,26 +162,17 @@ fn moving_receiver_at_constant_speed() {
 fn weak_signals_are_found_by_the_second_search_and_give_fixes() {
     // Every satellite at 31 dB-Hz: the 1 ms x 10 cold search finds none of them, the automatic
     // 10 ms x 10 search finds them, and the channels run the 20 ms weak-signal loops.
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let data = simulate(
+    let nav = nav_file();
+    let r = simulate_and_run(
+        "31 dB-Hz",
         "[receiver]\nkind = \"static\"\nllh_deg = [48.8566, 2.3522, 60.0]\n[satellites]\ncn0_all_dbhz = 31.0",
         20.0,
-        dir.path(),
-    );
-    let fixes = run(
-        &data,
-        &dir.path().join("out"),
-        &["--nav", nav_file().to_str().unwrap_or_default()],
-    );
-    let (h, v, _) = errors(&fixes, &truth(dir.path()));
-    eprintln!(
-        "31 dB-Hz: {} fixes, H RMS {h:.2} m, V RMS {v:.2} m",
-        fixes.len()
+        &["--nav", nav.to_str().unwrap_or_default()],
     );
     // Code jitter at 31 dB-Hz is several metres per satellite before the 10 s carrier
     // smoothing has converged (measured: H 4.5 m, V 8.3 m over these first 11 s of fixes).
-    assert!(fixes.len() > 30, "{} fixes", fixes.len());
-    assert!(h < 8.0 && v < 15.0, "H {h:.2} V {v:.2}");
+    assert!(r.fixes.len() > 30, "{} fixes", r.fixes.len());
+    assert!(r.h < 8.0 && r.v < 15.0, "H {:.2} V {:.2}", r.h, r.v);
 }
 
 #[test]
@@ -173,28 +180,26 @@ fn the_default_loops_keep_fixing_through_a_10_g_turn_without_assistance() {
     // 100 m/s, a 10 g turn from 30 to 38 s (0.5 s jerk ramps). No --nav: the ephemerides and the
     // ionosphere are decoded from the signal, and the fixes before subframe 4 page 18 use the
     // typical Klobuchar coefficients (without them the first fixes were 7 m high).
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let data = simulate(
+    let r = simulate_and_run(
+        "10 g",
         "[receiver]\nkind = \"motion\"\nstart_llh_deg = [37.5665, 126.9780, 40.0]\nheading_deg = 30.0\nspeed_mps = 100.0\ntransition_s = 0.5\nsegments = [{ type = \"cruise\", duration_s = 30.0 }, { type = \"turn\", duration_s = 8.0, accel_g = 10.0, direction = \"left\" }, { type = \"cruise\", duration_s = 10.0 }]",
         46.0,
-        dir.path(),
+        &["--week", "2190"],
     );
-    let fixes = run(&data, &dir.path().join("out"), &["--week", "2190"]);
-    let (h, v, vel) = errors(&fixes, &truth(dir.path()));
-    let longest_gap = fixes
+    let longest_gap = r
+        .fixes
         .windows(2)
         .map(|w| w[1].time.tow_s - w[0].time.tow_s)
         .fold(0.0, f64::max);
-    eprintln!(
-        "10 g: {} fixes, longest gap {longest_gap:.1} s, H RMS {h:.2} m, V RMS {v:.2} m, velocity RMS {vel:.2} m/s",
-        fixes.len()
-    );
     // Fixes from about 20 s (subframes 1-3) to the end at 10 Hz, without a break in the turn.
-    assert!(fixes.len() > 200, "{} fixes", fixes.len());
+    assert!(r.fixes.len() > 200, "{} fixes", r.fixes.len());
     assert!(longest_gap < 0.5, "a {longest_gap:.1} s gap in the fixes");
     assert!(
-        h < 1.5 && v < 3.0 && vel < 0.5,
-        "H {h:.2} V {v:.2} vel {vel:.2}"
+        r.h < 1.5 && r.v < 3.0 && r.vel < 0.5,
+        "H {:.2} V {:.2} vel {:.2}",
+        r.h,
+        r.v,
+        r.vel
     );
 }
 

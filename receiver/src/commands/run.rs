@@ -631,17 +631,6 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
             })
             .collect();
         let opts = PvtOptions { iono, ..opts };
-        if std::env::var("GPSRX_DUMP_OBS").is_ok() && meas.len() >= 4 {
-            for s in &epoch.sats {
-                eprintln!(
-                    "OBS {:.6} {} {:.3} {:.3}",
-                    epoch.sample / fs,
-                    s.prn,
-                    s.pseudorange_m,
-                    s.doppler_hz
-                );
-            }
-        }
         // Landmark observations of this epoch (receiver time within half an interval; the clock
         // bias is kept below 0.5 ms, far less than that).
         let landmarks: Vec<gpsrx_nav::pvt::Landmark> = landmark_obs

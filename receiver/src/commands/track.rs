@@ -122,10 +122,17 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
         }
         None => None,
     };
-    // Lost satellites (and ones not found at the start) are searched for again every second.
+    // Lost satellites (and ones not found at the start) are searched for again every second,
+    // with the integration and Doppler range of the first search.
     let engine = gpsrx_dsp::acquisition::AcquisitionEngine::new(
         fs,
-        gpsrx_dsp::acquisition::AcqConfig::default(),
+        gpsrx_dsp::acquisition::AcqConfig {
+            coherent_ms: acq.coherent_ms,
+            noncoherent: acq.noncoherent,
+            doppler_center_hz: args.acquisition.doppler_center,
+            doppler_max_hz: args.acquisition.doppler_max,
+            ..gpsrx_dsp::acquisition::AcqConfig::default()
+        },
     )?;
     let prns = args
         .acquisition
