@@ -211,9 +211,6 @@ struct Settings {
     doppler_center: f64,
     acq_coherent_ms: u32,
     acq_noncoherent: u32,
-    /// The acquisition integration was chosen (command line or file): no automatic
-    /// weak-signal search.
-    acq_explicit: bool,
     allow_unhealthy: bool,
 }
 
@@ -252,10 +249,6 @@ impl Settings {
                 .unwrap_or(0.0),
             acq_coherent_ms: args.acq_coherent_ms.or(file.acq_coherent_ms).unwrap_or(1),
             acq_noncoherent: args.acq_noncoherent.or(file.acq_noncoherent).unwrap_or(10),
-            acq_explicit: args.acq_coherent_ms.is_some()
-                || args.acq_noncoherent.is_some()
-                || file.acq_coherent_ms.is_some()
-                || file.acq_noncoherent.is_some(),
             allow_unhealthy: args.allow_unhealthy || file.allow_unhealthy.unwrap_or(false),
         };
         if !(1.0..=50.0).contains(&s.rate) {
@@ -462,10 +455,12 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         ..AcqConfig::default()
     };
     let engine = AcquisitionEngine::new(fs, acq_cfg.clone())?;
-    // Weak signals: when the usual search finds fewer than 4 satellites (and the user did not
-    // choose the integration), search the rest again with 10 ms x 10, about 8 dB more
-    // sensitive, and keep that engine for re-acquisition.
-    let weak_engine = if set.acq_explicit {
+    // Weak signals: when the search finds fewer than 4 satellites (and is less sensitive than
+    // 10 ms x 10), search the rest again with 10 ms x 10, about 8 dB more sensitive than
+    // 1 ms x 10, and keep that engine for re-acquisition.
+    let less_sensitive = set.acq_coherent_ms < WEAK_ACQ_COHERENT_MS
+        || set.acq_coherent_ms * set.acq_noncoherent < WEAK_ACQ_COHERENT_MS * WEAK_ACQ_NONCOHERENT;
+    let weak_engine = if !less_sensitive {
         None
     } else {
         Some(AcquisitionEngine::new(
@@ -1009,6 +1004,9 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             println!("first fix {t:.2} s after the start; {} fixes", s.fixes);
             println!("mean position {lat:.7} deg, {lon:.7} deg, {h:.2} m; mean PDOP {:.2}", s.mean_pdop.unwrap_or(f64::NAN));
         }
+        _ if s.tracked_prns.is_empty() => println!(
+            "no fix: no satellite was tracked. Check the format, rate, IF and Q sign (gpsrx info FILE), widen the search (--doppler-max, --doppler-center for a front-end LO offset) or integrate longer (--acq-coherent-ms 10 --acq-noncoherent 20)"
+        ),
         _ => println!(
             "no fix: the recording ended before 4 satellites had their ephemeris (subframes 1-3 take 18-30 s; give --nav FILE to start sooner)"
         ),
