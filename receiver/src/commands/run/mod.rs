@@ -4,12 +4,12 @@
 //! -> observables at common receiver epochs -> WLS PVT with RAIM -> outputs in `--out DIR`:
 //! `pvt.csv`, `pvt.nmea`, `observables.rnx`, `ephemeris.rnx`, `track.geojson`, `track.kml`,
 //! `channels.csv`.
+//!
+//! `args` is the command line, `settings` its merge with the configuration file,
+//! `cold_start` the first acquisition, `dr_inputs` the `--dr`/`--accel` fusion; this module
+//! runs the pipeline and writes the outputs.
 
-use crate::cli::{LoopArgs, SourceArgs};
-use crate::fusion::fuse::{fuse_dr, DrFusionSettings};
-use crate::fusion::fused_csv::{fused_as_fixes, write_fused_csv};
 use crate::fusion::gnss::GnssFix;
-use crate::fusion::speed::{attach_speed, speed_track};
 use crate::output::{
     self, create_file, ChannelCsvWriter, ChannelRow, Fix, FixQuality, NavHeader, NavRecord,
     NmeaOptions, NmeaWriter, ObsEpoch, ObsHeader, PvtCsvWriter, RinexObsWriter, SatObs, SatView,
@@ -19,277 +19,27 @@ use crate::pipeline::navdata::{current_gps_week, NavDecoder, NavEvent};
 use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
 use crate::pipeline::tracker::{track_with_reacquisition, AidSource, Reacquisition};
 use anyhow::Context;
-use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine, SearchTarget};
-use gpsrx_ins_aiding::{
-    read_accel_csv, read_dr_csv, read_ins_csv, AccelLog, DrFilterKind, DrLog, DrParams, FixSource,
-};
+use gpsrx_ins_aiding::{read_ins_csv, DrParams};
 use gpsrx_nav::atmosphere::KlobucharParams;
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::frames::azimuth_elevation;
 use gpsrx_nav::pvt::{solve, PvtOptions, PvtSolution, RaimStatus, SatMeasurement};
 use gpsrx_nav::rinex_nav::{read_rinex_nav, NavData};
 use gpsrx_samples::open_source;
-use gpsrx_tracking::{Channel, ChannelStart, ChannelState};
+use gpsrx_tracking::ChannelState;
 use indicatif::{ProgressBar, ProgressStyle};
-use num_complex::Complex32;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 
-/// Ionosphere model switch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum IonoModel {
-    /// Broadcast Klobuchar (decoded from subframe 4 page 18, or from --nav).
-    Klobuchar,
-    /// No correction.
-    None,
-}
+mod args;
+mod cold_start;
+mod dr_inputs;
+mod settings;
 
-/// Troposphere model switch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum TropoModel {
-    /// Saastamoinen, standard atmosphere.
-    Saastamoinen,
-    /// No correction.
-    None,
-}
-
-/// `gpsrx run`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct RunArgs {
-    /// The recording and how to read it.
-    #[command(flatten)]
-    pub source: SourceArgs,
-    /// Loop settings.
-    #[command(flatten)]
-    pub loops: LoopArgs,
-    /// Output directory (created if needed).
-    #[arg(long, value_name = "DIR")]
-    pub out: PathBuf,
-    /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
-    #[arg(long, value_name = "FILE")]
-    pub nav: Option<PathBuf>,
-    /// Ionosphere correction [default: klobuchar].
-    #[arg(long, value_enum)]
-    pub iono: Option<IonoModel>,
-    /// Troposphere correction (`none` for simulated files without troposphere)
-    /// [default: saastamoinen].
-    #[arg(long, value_enum)]
-    pub tropo: Option<TropoModel>,
-    /// Elevation mask, degrees [default: 5].
-    #[arg(long, value_name = "DEG")]
-    pub elevation_mask: Option<f64>,
-    /// Observable and fix rate, Hz, 1 to 50 [default: 10].
-    #[arg(long, value_name = "HZ")]
-    pub rate: Option<f64>,
-    /// Full GPS week near the recording, to resolve the broadcast 10-bit week (default: from
-    /// SigMF metadata, else the current week).
-    #[arg(long, value_name = "WEEK")]
-    pub week: Option<u32>,
-    /// Doppler search half-width of the acquisition, Hz [default: 5000; 15000 or more for a
-    /// front end with a large LO offset, or --doppler-center].
-    #[arg(long, value_name = "HZ")]
-    pub doppler_max: Option<f64>,
-    /// Centre of the acquisition's Doppler search, Hz: a known front-end frequency offset
-    /// [default: 0].
-    #[arg(long, value_name = "HZ", allow_hyphen_values = true)]
-    pub doppler_center: Option<f64>,
-    /// Acquisition coherent integration, ms, 1 to 10 [default: 1]. Weak signals (below about
-    /// 35 dB-Hz): 10, with --acq-noncoherent 10 or more.
-    #[arg(long, value_name = "MS")]
-    pub acq_coherent_ms: Option<u32>,
-    /// Acquisition non-coherent sum of this many coherent blocks [default: 10].
-    #[arg(long, value_name = "N")]
-    pub acq_noncoherent: Option<u32>,
-    /// RAIM false-alarm probability [default: 0.001].
-    #[arg(long, value_name = "P")]
-    pub raim_pfa: Option<f64>,
-    /// Landmark range observations, CSV `tow_s,x_m,y_m,z_m,range_m,sigma_m` (seed 001): added to
-    /// the fixes without a clock term, so 3 satellites and 1 landmark give a fix.
-    #[arg(long, value_name = "FILE")]
-    pub landmarks: Option<PathBuf>,
-    /// Use satellites whose ephemeris says they are unhealthy (some simulators copy a health
-    /// flag that the real satellite had at the time).
-    #[arg(long)]
-    pub allow_unhealthy: bool,
-    /// INS output, CSV `t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps[,gps_tow_s]` (ECEF; `t_s` from
-    /// the first IF sample; >= 10 Hz): its velocity is fed forward into every carrier and code
-    /// loop (seed 004). Give `--nav` too for aiding before the ephemerides are decoded.
-    #[arg(long, value_name = "FILE")]
-    pub ins: Option<PathBuf>,
-    /// Read `--ins` but do not aid the loops (to compare aided and unaided runs).
-    #[arg(long, requires = "ins")]
-    pub no_aiding: bool,
-    /// First-order band limiter alpha/(s+alpha) on the feed-forward, rad/s (seed 004 eq. 8):
-    /// reproduces an INS of limited dynamic range.
-    #[arg(long, value_name = "RAD_S", requires = "ins")]
-    pub ins_band_limit: Option<f64>,
-    /// Longest gap allowed between INS rows, s.
-    #[arg(long, value_name = "S", default_value_t = 0.5)]
-    pub ins_max_gap: f64,
-    /// Dead-reckoning log, CSV `t_s,gyro_v,odo_pulses` (raw, seed 000) or
-    /// `t_s,yaw_rate_dps,speed_mps` (`t_s` from the first IF sample): fused with the fixes into
-    /// `fused.csv`, `fused.nmea`, `fused.geojson`, `fused.kml`; the calibrated sensor parameters
-    /// go to `dr_params.toml`. Nominal parameters from the config file's `[dr]` table.
-    #[arg(long, value_name = "FILE")]
-    pub dr: Option<PathBuf>,
-    /// Longitudinal accelerometer log, CSV `t_s,a_long_mps2`: seed 002's speed filter, column
-    /// `speed_filter_mps` of `fused.csv`.
-    #[arg(long, value_name = "FILE")]
-    pub accel: Option<PathBuf>,
-    /// DR filter: seed 000's proposed 8-state filter (position and carrier velocity) or the
-    /// conventional 4-state one (position only) [default: proposed].
-    #[arg(long, value_enum, requires = "dr")]
-    pub dr_filter: Option<DrFilterChoice>,
-    /// Initial DR sensor parameters: a `dr_params.toml` written by a previous run (seed 000:
-    /// saves the ~900 s calibration); overrides the config file's `[dr]` values.
-    #[arg(long, value_name = "FILE", requires = "dr")]
-    pub dr_params: Option<PathBuf>,
-}
-
-/// `--dr-filter`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum DrFilterChoice {
-    /// Seed 000's 8-state filter: position and carrier-velocity updates, gyro and odometer
-    /// calibration.
-    Proposed,
-    /// The conventional 4-state filter (seed 000 eq. 7): position updates only.
-    Conventional,
-}
-
-/// The `[dr]` table of a configuration file: the nominal DR sensor parameters (seed 000) and
-/// the fusion settings of `gpsrx run --dr`.
-#[derive(Debug, Clone, Default, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct DrRunConfig {
-    /// Gyro scale factor Sf_G, deg/s/V.
-    pub sf_g_dps_per_v: Option<f64>,
-    /// Gyro zero-rate voltage V_nom, V.
-    pub v_nom_v: Option<f64>,
-    /// Odometer scale factor Sf_N, m/pulse.
-    pub sf_n_m_per_pulse: Option<f64>,
-    /// `proposed` or `conventional`.
-    pub filter: Option<String>,
-    /// Least interval between GNSS updates of the filters, s.
-    pub update_interval_s: Option<f64>,
-}
-
-/// The `[run]` table of a configuration file; command-line options override it.
-#[derive(Debug, Clone, Default, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct RunConfig {
-    /// Observable and fix rate, Hz.
-    pub rate_hz: Option<f64>,
-    /// Elevation mask, degrees.
-    pub elevation_mask_deg: Option<f64>,
-    /// `klobuchar` or `none`.
-    pub iono: Option<String>,
-    /// `saastamoinen` or `none`.
-    pub tropo: Option<String>,
-    /// RAIM false-alarm probability.
-    pub raim_pfa: Option<f64>,
-    /// Acquisition Doppler half-width, Hz.
-    pub doppler_max_hz: Option<f64>,
-    /// Acquisition Doppler search centre, Hz.
-    pub doppler_center_hz: Option<f64>,
-    /// Acquisition coherent integration, ms.
-    pub acq_coherent_ms: Option<u32>,
-    /// Acquisition non-coherent blocks.
-    pub acq_noncoherent: Option<u32>,
-    /// Use unhealthy satellites.
-    pub allow_unhealthy: Option<bool>,
-}
-
-/// Run settings after defaults, the config file and the command line.
-#[derive(Debug, Clone, Copy)]
-struct Settings {
-    rate: f64,
-    elevation_mask: f64,
-    iono: IonoModel,
-    tropo: TropoModel,
-    raim_pfa: f64,
-    doppler_max: f64,
-    doppler_center: f64,
-    acq_coherent_ms: u32,
-    acq_noncoherent: u32,
-    allow_unhealthy: bool,
-}
-
-impl Settings {
-    fn resolve(args: &RunArgs) -> anyhow::Result<Settings> {
-        let file = args.loops.run_config()?.unwrap_or_default();
-        let iono = match (args.iono, file.iono.as_deref()) {
-            (Some(i), _) => i,
-            (None, None | Some("klobuchar")) => IonoModel::Klobuchar,
-            (None, Some("none")) => IonoModel::None,
-            (None, Some(other)) => {
-                anyhow::bail!("[run] iono = \"{other}\": use \"klobuchar\" or \"none\"")
-            }
-        };
-        let tropo = match (args.tropo, file.tropo.as_deref()) {
-            (Some(t), _) => t,
-            (None, None | Some("saastamoinen")) => TropoModel::Saastamoinen,
-            (None, Some("none")) => TropoModel::None,
-            (None, Some(other)) => {
-                anyhow::bail!("[run] tropo = \"{other}\": use \"saastamoinen\" or \"none\"")
-            }
-        };
-        let s = Settings {
-            rate: args.rate.or(file.rate_hz).unwrap_or(10.0),
-            elevation_mask: args
-                .elevation_mask
-                .or(file.elevation_mask_deg)
-                .unwrap_or(5.0),
-            iono,
-            tropo,
-            raim_pfa: args.raim_pfa.or(file.raim_pfa).unwrap_or(1e-3),
-            doppler_max: args.doppler_max.or(file.doppler_max_hz).unwrap_or(5000.0),
-            doppler_center: args
-                .doppler_center
-                .or(file.doppler_center_hz)
-                .unwrap_or(0.0),
-            acq_coherent_ms: args.acq_coherent_ms.or(file.acq_coherent_ms).unwrap_or(1),
-            acq_noncoherent: args.acq_noncoherent.or(file.acq_noncoherent).unwrap_or(10),
-            allow_unhealthy: args.allow_unhealthy || file.allow_unhealthy.unwrap_or(false),
-        };
-        if !(1.0..=50.0).contains(&s.rate) {
-            anyhow::bail!("rate {} Hz: use 1 to 50 Hz", s.rate);
-        }
-        if !(-10.0..=90.0).contains(&s.elevation_mask) {
-            anyhow::bail!("elevation mask {} deg: use -10 to 90", s.elevation_mask);
-        }
-        if !(s.raim_pfa > 0.0 && s.raim_pfa < 1.0) {
-            anyhow::bail!(
-                "RAIM false-alarm probability {}: use a value in (0, 1)",
-                s.raim_pfa
-            );
-        }
-        if !(s.doppler_max > 0.0 && s.doppler_max <= 100e3) {
-            anyhow::bail!(
-                "Doppler search half-width {} Hz: use (0, 100000]",
-                s.doppler_max
-            );
-        }
-        if !(s.doppler_center.is_finite() && s.doppler_center.abs() <= 100e3) {
-            anyhow::bail!(
-                "Doppler search centre {} Hz: use a value within +-100000",
-                s.doppler_center
-            );
-        }
-        if !(1..=10).contains(&s.acq_coherent_ms) {
-            anyhow::bail!(
-                "acquisition coherent integration {} ms: use 1 to 10 ms",
-                s.acq_coherent_ms
-            );
-        }
-        if !(1..=1000).contains(&s.acq_noncoherent) {
-            anyhow::bail!(
-                "acquisition non-coherent blocks {}: use 1 to 1000",
-                s.acq_noncoherent
-            );
-        }
-        Ok(s)
-    }
-}
+pub use args::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
+use cold_start::cold_start;
+use dr_inputs::{write_fused_outputs, DrInputs};
+use settings::Settings;
+pub use settings::{DrRunConfig, RunConfig};
 
 /// What a run produced.
 #[derive(Debug, Clone, Default, serde::Serialize)]
@@ -313,63 +63,6 @@ pub struct RunSummary {
     /// With `--dr`: the calibrated sensor parameters at the end.
     pub dr_params: Option<DrParams>,
 }
-
-/// The DR inputs of a run, read and checked before tracking starts.
-struct DrInputs {
-    dr: Option<DrLog>,
-    accel: Option<AccelLog>,
-    settings: DrFusionSettings,
-}
-
-impl DrInputs {
-    fn load(args: &RunArgs, rate_hz: f64) -> anyhow::Result<Option<DrInputs>> {
-        if args.dr.is_none() && args.accel.is_none() {
-            return Ok(None);
-        }
-        let file = args.loops.dr_config()?.unwrap_or_default();
-        let nominal = DrParams::default();
-        let params = DrParams {
-            sf_g_dps_per_v: file.sf_g_dps_per_v.unwrap_or(nominal.sf_g_dps_per_v),
-            v_nom_v: file.v_nom_v.unwrap_or(nominal.v_nom_v),
-            sf_n_m_per_pulse: file.sf_n_m_per_pulse.unwrap_or(nominal.sf_n_m_per_pulse),
-        };
-        params.validate().context("config [dr]")?;
-        let kind = match (args.dr_filter, file.filter.as_deref()) {
-            (Some(DrFilterChoice::Proposed), _) | (None, None | Some("proposed")) => {
-                DrFilterKind::Proposed8
-            }
-            (Some(DrFilterChoice::Conventional), _) | (None, Some("conventional")) => {
-                DrFilterKind::Conventional4
-            }
-            (None, Some(other)) => {
-                anyhow::bail!("[dr] filter = \"{other}\": use \"proposed\" or \"conventional\"")
-            }
-        };
-        let mut settings = DrFusionSettings::new(kind, params, 1.0 / rate_hz);
-        settings.calibration = args.dr_params.as_deref().map(DrParams::load).transpose()?;
-        if let Some(u) = file.update_interval_s {
-            if !(u.is_finite() && u > 0.0 && u <= 60.0) {
-                anyhow::bail!("[dr] update_interval_s = {u}: use (0, 60] s");
-            }
-            settings.update_interval_s = u;
-        }
-        let dr = args.dr.as_deref().map(read_dr_csv).transpose()?;
-        let accel = args.accel.as_deref().map(read_accel_csv).transpose()?;
-        if let Some(d) = &dr {
-            let (a, b) = d.time_span_s();
-            tracing::info!("DR log: {} rows from {a:.2} to {b:.2} s", d.samples().len());
-        }
-        Ok(Some(DrInputs {
-            dr,
-            accel,
-            settings,
-        }))
-    }
-}
-
-/// The weak-signal acquisition: coherent ms and non-coherent blocks.
-const WEAK_ACQ_COHERENT_MS: u32 = 10;
-const WEAK_ACQ_NONCOHERENT: u32 = 10;
 
 /// Seconds of observables held back waiting for the first fix (whose position goes into the
 /// RINEX header) before they are written without one.
@@ -446,97 +139,8 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
     let aid_fn = |prn: u8, t_s: f64| feedforward.and_then(|f| f.aid(prn, t_s));
     let aid_source: Option<AidSource<'_>> = feedforward.map(|_| &aid_fn as AidSource<'_>);
 
-    // Cold acquisition on the first samples.
-    let acq_cfg = AcqConfig {
-        coherent_ms: set.acq_coherent_ms,
-        noncoherent: set.acq_noncoherent,
-        doppler_center_hz: set.doppler_center,
-        doppler_max_hz: set.doppler_max,
-        ..AcqConfig::default()
-    };
-    let engine = AcquisitionEngine::new(fs, acq_cfg.clone())?;
-    // Weak signals: when the search finds fewer than 4 satellites (and is less sensitive than
-    // 10 ms x 10), search the rest again with 10 ms x 10, about 8 dB more sensitive than
-    // 1 ms x 10, and keep that engine for re-acquisition.
-    let less_sensitive = set.acq_coherent_ms < WEAK_ACQ_COHERENT_MS
-        || set.acq_coherent_ms * set.acq_noncoherent < WEAK_ACQ_COHERENT_MS * WEAK_ACQ_NONCOHERENT;
-    let weak_engine = if !less_sensitive {
-        None
-    } else {
-        Some(AcquisitionEngine::new(
-            fs,
-            AcqConfig {
-                coherent_ms: WEAK_ACQ_COHERENT_MS,
-                noncoherent: WEAK_ACQ_NONCOHERENT,
-                ..acq_cfg.clone()
-            },
-        )?)
-    };
-    let wanted = weak_engine
-        .as_ref()
-        .map_or(0, AcquisitionEngine::samples_wanted)
-        .max(engine.samples_wanted());
-    let mut first = vec![Complex32::new(0.0, 0.0); wanted];
-    let (first_index, n) = {
-        let mut acq_src = open_source(&src_cfg)?;
-        let mut filled = 0usize;
-        let mut first_index = None;
-        while filled < first.len() {
-            let (idx, got) = acq_src.read(&mut first[filled..])?;
-            if got == 0 {
-                break;
-            }
-            first_index.get_or_insert(idx);
-            filled += got;
-        }
-        (first_index.unwrap_or(0), filled)
-    };
-    if n < engine.samples_needed() {
-        anyhow::bail!(
-            "the recording is too short for acquisition ({n} samples; at least {} needed)",
-            engine.samples_needed()
-        );
-    }
-    let mut found = engine.search_all(&first[..n.min(engine.samples_wanted())])?;
-    let detected = found.iter().filter(|d| d.detected).count();
-    let engine = match weak_engine {
-        Some(weak) if detected < 4 && n >= weak.samples_needed() => {
-            tracing::warn!(
-                "{detected} satellite(s) found with {} ms x {}: searching again with {WEAK_ACQ_COHERENT_MS} ms x {WEAK_ACQ_NONCOHERENT} for weak signals (--acq-coherent-ms chooses)",
-                acq_cfg.coherent_ms,
-                acq_cfg.noncoherent
-            );
-            let missing: Vec<SearchTarget> = found
-                .iter()
-                .filter(|d| !d.detected)
-                .map(|d| SearchTarget::full(d.prn))
-                .collect();
-            let again = weak.search(&first[..n.min(weak.samples_wanted())], &missing)?;
-            for r in again {
-                if let Some(slot) = found.iter_mut().find(|d| d.prn == r.prn) {
-                    *slot = r;
-                }
-            }
-            weak
-        }
-        _ => engine,
-    };
-    let mut channels = Vec::new();
-    for d in found.iter().filter(|d| d.detected) {
-        let start = ChannelStart {
-            prn: d.prn,
-            code_start_sample: first_index + d.code_phase_samples.round().max(0.0) as u64,
-            doppler_hz: d.doppler_hz,
-            cn0_dbhz: d.cn0_dbhz.unwrap_or(f64::NAN),
-        };
-        channels.push(Channel::new(&start, fs, &cfg)?);
-        tracing::info!(
-            "{}: acquired, Doppler {:.0} Hz, C/N0 {:.1} dB-Hz",
-            d.prn,
-            d.doppler_hz,
-            d.cn0_dbhz.unwrap_or(f64::NAN)
-        );
-    }
+    // Cold acquisition on the first samples (with the weak-signal search if needed).
+    let (engine, channels) = cold_start(fs, &set, &src_cfg, &cfg)?;
     let reacq = Reacquisition {
         engine: &engine,
         interval_s: 1.0,
@@ -936,49 +540,6 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         summary.mean_pdop = Some(fixes.iter().map(|f| f.pdop).sum::<f64>() / n);
     }
     Ok((summary, fixes))
-}
-
-/// Fuses the fixes with the DR and accelerometer logs and writes `fused.csv`, `fused.nmea`,
-/// `fused.geojson`, `fused.kml` and (with `--dr`) `dr_params.toml`; returns the row counts by
-/// source (gnss, fused, dr) and the calibrated parameters.
-fn write_fused_outputs(
-    inputs: &DrInputs,
-    gnss: &[GnssFix],
-    out: &dyn Fn(&str) -> PathBuf,
-) -> anyhow::Result<([usize; 3], Option<DrParams>)> {
-    let mut result = fuse_dr(gnss, inputs.dr.as_ref(), &inputs.settings)?;
-    if let Some(accel) = &inputs.accel {
-        let track = speed_track(gnss, accel, inputs.settings.update_interval_s)?;
-        attach_speed(&mut result.fixes, &track);
-    }
-    write_fused_csv(&out("fused.csv"), &result.fixes)?;
-    let fixes = fused_as_fixes(&result.fixes);
-    let mut nmea = NmeaWriter::create(&out("fused.nmea"), NmeaOptions::default())?;
-    for f in &fixes {
-        nmea.write_fix(f)?;
-    }
-    nmea.finish()?;
-    let mut f = create_file(&out("fused.geojson"))?;
-    output::write_geojson(&mut f, "fused.geojson", &fixes)?;
-    let mut f = create_file(&out("fused.kml"))?;
-    output::write_kml(&mut f, "fused.kml", "gpsrx GNSS/DR", &fixes)?;
-    if let (Some(p), Some(_)) = (&result.final_params, &inputs.dr) {
-        p.save(&out("dr_params.toml"))?;
-    }
-    let count = |s: FixSource| result.fixes.iter().filter(|f| f.source == s).count();
-    let rows = [
-        count(FixSource::Gnss),
-        count(FixSource::Fused),
-        count(FixSource::DrOnly),
-    ];
-    tracing::info!(
-        "fused.csv: {} GNSS rows, {} fused, {} DR only; {} GNSS updates",
-        rows[0],
-        rows[1],
-        rows[2],
-        result.updates
-    );
-    Ok((rows, result.final_params.filter(|_| inputs.dr.is_some())))
 }
 
 fn raim_text(r: &RaimStatus) -> String {
