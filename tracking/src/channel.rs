@@ -22,6 +22,7 @@ use crate::code_loop::CodeLoop;
 use crate::config::{ConfigError, LoopConfig};
 use crate::fade_detector::FadeDetector;
 use crate::lock_detector::{CodeLockDetector, PllLockConfig, PllLockDetector};
+use gpsrx_dsp::acquisition::AcqResult;
 use gpsrx_dsp::ca_code::{CaCode, Prn};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, CA_CODE_LENGTH, F_L1_HZ};
 use gpsrx_dsp::correlator::{Correlator, PackedCode, ReplicaState, SampleSlice};
@@ -196,6 +197,19 @@ pub struct ChannelStart {
     /// C/N0 estimate from acquisition, dB-Hz (NaN if unknown): reported until the channel's
     /// own estimate is available.
     pub cn0_dbhz: f64,
+}
+
+impl ChannelStart {
+    /// The start of a channel for a detection of a search whose first sample was
+    /// `first_sample` (code phases count from it).
+    pub fn from_acquisition(d: &AcqResult, first_sample: u64) -> Self {
+        Self {
+            prn: d.prn,
+            code_start_sample: first_sample + d.code_phase_samples.round().max(0.0) as u64,
+            doppler_hz: d.doppler_hz,
+            cn0_dbhz: d.cn0_dbhz.unwrap_or(f64::NAN),
+        }
+    }
 }
 
 /// What a channel reports at the end of each integration interval.

@@ -256,12 +256,7 @@ fn start_channels(
     channels: &mut Vec<Channel>,
 ) {
     for d in results.iter().filter(|d| d.detected) {
-        let start = ChannelStart {
-            prn: d.prn,
-            code_start_sample: first + d.code_phase_samples.round().max(0.0) as u64,
-            doppler_hz: d.doppler_hz,
-            cn0_dbhz: d.cn0_dbhz.unwrap_or(f64::NAN),
-        };
+        let start = ChannelStart::from_acquisition(d, first);
         match Channel::new(&start, r.engine.fs_hz(), &r.channel_config) {
             Ok(ch) => {
                 tracing::info!(

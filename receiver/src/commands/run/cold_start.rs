@@ -94,12 +94,7 @@ pub(super) fn cold_start(
     };
     let mut channels = Vec::new();
     for d in found.iter().filter(|d| d.detected) {
-        let start = ChannelStart {
-            prn: d.prn,
-            code_start_sample: first_index + d.code_phase_samples.round().max(0.0) as u64,
-            doppler_hz: d.doppler_hz,
-            cn0_dbhz: d.cn0_dbhz.unwrap_or(f64::NAN),
-        };
+        let start = ChannelStart::from_acquisition(d, first_index);
         channels.push(Channel::new(&start, fs, cfg)?);
         tracing::info!(
             "{}: acquired, Doppler {:.0} Hz, C/N0 {:.1} dB-Hz",
