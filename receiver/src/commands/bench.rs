@@ -188,14 +188,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
     let correlators = bench_correlators(timed_s);
     let reference_msps_per_core = bench_reference(timed_s);
 
-    let tmp;
-    let dir: PathBuf = match &args.keep {
-        Some(d) => d.clone(),
-        None => {
-            tmp = tempfile::tempdir().context("cannot create a temporary directory")?;
-            tmp.path().to_path_buf()
-        }
-    };
+    let (dir, _tmp) = super::work_dir(args.keep.as_deref())?;
     let mut scenario = Scenario::from_toml(SEOUL_SCENARIO_TOML)?;
     scenario.nav = "builtin:brdc0010.22n".into();
     // Without the end-to-end run the recording only feeds the acquisition.

@@ -14,14 +14,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     if let Some(d) = args.duration {
         scenario.duration_s = d;
     }
-    let tmp;
-    let dir: PathBuf = match &args.keep {
-        Some(d) => d.clone(),
-        None => {
-            tmp = tempfile::tempdir().context("cannot create a temporary directory")?;
-            tmp.path().to_path_buf()
-        }
-    };
+    let (dir, _tmp) = super::work_dir(args.keep.as_deref())?;
     println!("gpsrx demo: {}", scenario.description);
     println!(
         "simulating {:.0} s of {} at {:.3} MHz into {}",

@@ -274,19 +274,14 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         match (&mut obs_writer, &solution) {
             (Some(w), _) => w.write_epoch(&obs)?,
             (None, Some(sol)) => {
-                let header = ObsHeader {
-                    approx_position_m: [sol.pos_ecef_m.x, sol.pos_ecef_m.y, sol.pos_ecef_m.z],
-                    interval_s: Some(1.0 / set.rate),
-                    ..ObsHeader::default()
-                };
-                let mut w = RinexObsWriter::create(&out("observables.rnx"), header)?;
-                for mut o in obs_backlog.drain(..) {
-                    // Epochs before subframe 1 carried the reference week: relabel them.
-                    o.time.week = epoch.rx_time.week;
-                    if o.time.tow_s < epoch.rx_time.tow_s {
-                        w.write_epoch(&o)?;
-                    }
-                }
+                let position = [sol.pos_ecef_m.x, sol.pos_ecef_m.y, sol.pos_ecef_m.z];
+                let mut w = open_observables(
+                    &out("observables.rnx"),
+                    Some(position),
+                    set.rate,
+                    &mut obs_backlog,
+                    epoch.rx_time.week,
+                )?;
                 w.write_epoch(&obs)?;
                 obs_writer = Some(w);
             }
@@ -296,16 +291,13 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
                 // the labels will not change), the observables go out with an unknown position.
                 let week_known = decoders.values().any(|d| d.decoded_week().is_some());
                 if week_known && obs_backlog.len() as f64 > OBS_BACKLOG_MAX_S * set.rate {
-                    let week = epoch.rx_time.week;
-                    let header = ObsHeader {
-                        interval_s: Some(1.0 / set.rate),
-                        ..ObsHeader::default()
-                    };
-                    let mut w = RinexObsWriter::create(&out("observables.rnx"), header)?;
-                    for mut o in obs_backlog.drain(..) {
-                        o.time.week = week;
-                        w.write_epoch(&o)?;
-                    }
+                    let w = open_observables(
+                        &out("observables.rnx"),
+                        None,
+                        set.rate,
+                        &mut obs_backlog,
+                        epoch.rx_time.week,
+                    )?;
                     tracing::warn!(
                         "no fix after {OBS_BACKLOG_MAX_S} s of observables: observables.rnx has no approximate position"
                     );
@@ -475,22 +467,17 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
             w.finish()?;
         }
         None if !obs_backlog.is_empty() => {
-            // No fix: the observables still go out, with an unknown approximate position.
-            let header = ObsHeader {
-                interval_s: Some(1.0 / set.rate),
-                ..ObsHeader::default()
-            };
-            // Epochs before the first subframe 1 carried the reference week; the last epoch has
-            // the best week known (decoded, or still the reference week): label them all with it.
-            let week = obs_backlog.last().map(|o| o.time.week);
-            let mut w = RinexObsWriter::create(&out("observables.rnx"), header)?;
-            for mut o in obs_backlog.drain(..) {
-                if let Some(week) = week {
-                    o.time.week = week;
-                }
-                w.write_epoch(&o)?;
-            }
-            w.finish()?;
+            // No fix: the observables still go out, with an unknown approximate position, all
+            // labelled with the best week known (the last epoch's: decoded, or the reference).
+            let week = obs_backlog.last().map_or(0, |o| o.time.week);
+            open_observables(
+                &out("observables.rnx"),
+                None,
+                set.rate,
+                &mut obs_backlog,
+                week,
+            )?
+            .finish()?;
         }
         None => {}
     }
@@ -540,6 +527,33 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunSumma
         summary.mean_pdop = Some(fixes.iter().map(|f| f.pdop).sum::<f64>() / n);
     }
     Ok((summary, fixes))
+}
+
+/// Creates `observables.rnx` (header position `approx_position_m`, if known) and writes the
+/// epochs held back for it, in increasing time. They all get `week`: epochs before the first
+/// subframe 1 carried the reference week, which can be 1024 weeks (or more) off.
+fn open_observables(
+    path: &std::path::Path,
+    approx_position_m: Option<[f64; 3]>,
+    rate_hz: f64,
+    backlog: &mut Vec<ObsEpoch>,
+    week: u32,
+) -> anyhow::Result<RinexObsWriter<std::io::BufWriter<std::fs::File>>> {
+    let header = ObsHeader {
+        approx_position_m: approx_position_m.unwrap_or_default(),
+        interval_s: Some(1.0 / rate_hz),
+        ..ObsHeader::default()
+    };
+    let mut w = RinexObsWriter::create(path, header)?;
+    let mut last_tow_s = f64::NEG_INFINITY;
+    for mut o in backlog.drain(..) {
+        o.time.week = week;
+        if o.time.tow_s > last_tow_s {
+            last_tow_s = o.time.tow_s;
+            w.write_epoch(&o)?;
+        }
+    }
+    Ok(w)
 }
 
 fn raim_text(r: &RaimStatus) -> String {
