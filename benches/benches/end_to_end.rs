@@ -7,9 +7,9 @@
 
 use clap::Parser;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use gpsrx_receiver::cli::{Cli, Command};
-use gpsrx_receiver::commands::run::run_file;
-use gpsrx_receiver::commands::simulate::simulate;
+use gpsrx_cli::cli::{Cli, Command};
+use gpsrx_cli::commands::run::run_file;
+use gpsrx_cli::commands::simulate::simulate;
 use gpsrx_samples::sim::Scenario;
 use std::path::Path;
 

@@ -1,13 +1,11 @@
-//! The gpsrx receiver: the pipeline from IF samples to fixes, its outputs, studies, and the
-//! `gpsrx` command-line tool built on them.
+//! The gpsrx receiver as a library: the pipeline from IF samples to fixes, and its outputs.
 //!
-//! - [`cli`]: command-line arguments (clap derive);
-//! - [`commands`]: one module per subcommand.
+//! - [`pipeline`]: tracking channels, navigation data, observables, aiding;
+//! - [`output`]: RINEX, NMEA, GeoJSON, KML and CSV writers;
+//! - [`fusion`]: GNSS/dead-reckoning fusion after tracking (seeds 000 and 002);
+//! - [`landmarks`]: landmark range observations for the solver (seed 001).
 
-pub mod cli;
-pub mod commands;
 pub mod fusion;
 pub mod landmarks;
 pub mod output;
 pub mod pipeline;
-pub mod study;

@@ -1,0 +1,209 @@
+//! `gpsrx track`: acquire, then track satellites through a recording, and write every
+//! integration interval of every channel to CSV for loop studies.
+
+use crate::cli::LoopArgs;
+use crate::commands::acquire::{acquire, AcquireArgs};
+use gpsrx_receiver::pipeline::tracker::{track_with_reacquisition, Reacquisition};
+use anyhow::Context;
+use gpsrx_samples::open_source;
+use gpsrx_tracking::{Channel, ChannelEpoch, ChannelStart, ChannelState};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// `gpsrx track`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct TrackArgs {
+    /// The recording, how to read it, and the acquisition settings (`--prn` limits the PRNs).
+    #[command(flatten)]
+    pub acquisition: AcquireArgs,
+    /// Loop settings.
+    #[command(flatten)]
+    pub loops: LoopArgs,
+    /// Write every integration interval of every channel to this CSV file.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+}
+
+/// Per-channel summary of a tracking run.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct ChannelSummary {
+    /// PRN.
+    pub prn: u8,
+    /// Final state.
+    pub state: String,
+    /// Last C/N0 estimate, dB-Hz.
+    pub cn0_dbhz: f64,
+    /// Last Doppler, Hz.
+    pub doppler_hz: f64,
+    /// Time of the first phase lock, s.
+    pub first_lock_s: Option<f64>,
+    /// Data-bit edge position: ms after the file start, modulo 20.
+    pub bit_edge_ms_mod_20: Option<f64>,
+    /// Bits decoded.
+    pub bits: usize,
+}
+
+const CSV_HEADER: &str = "prn,state,t_rx_s,sample_index,code_phase_chips,code_rate_chips_s,carrier_phase_cycles,doppler_hz,cn0_dbhz,pll_lock,pll_lock_metric,code_lock,prompt_i,prompt_q,early_abs,late_abs,phase_error_cycles,freq_error_hz,code_error_chips,t_coh_s,bit_edge,bit,bit_t_s";
+
+fn csv_row(e: &ChannelEpoch) -> String {
+    let state = match e.state {
+        ChannelState::PullIn => "pull_in",
+        ChannelState::Track => "track",
+        ChannelState::Lost => "lost",
+    };
+    let (bit, bit_t) = match e.bit {
+        Some(b) => (b.value.to_string(), format!("{:.6}", b.t_s)),
+        None => (String::new(), String::new()),
+    };
+    format!(
+        "{},{state},{:.7},{},{:.5},{:.4},{:.5},{:.3},{:.2},{},{:.3},{},{:.1},{:.1},{:.1},{:.1},{:.5},{:.3},{:.5},{},{},{bit},{bit_t}",
+        e.prn,
+        e.t_rx_s,
+        e.sample_index,
+        e.code_phase_chips,
+        e.code_rate_chips_s,
+        e.carrier_phase_cycles,
+        e.doppler_hz,
+        e.cn0_dbhz,
+        u8::from(e.pll_lock),
+        e.pll_lock_metric,
+        u8::from(e.code_lock),
+        e.prompt.re,
+        e.prompt.im,
+        e.early.norm(),
+        e.late.norm(),
+        e.phase_error_cycles,
+        e.freq_error_hz,
+        e.code_error_chips,
+        e.t_coh_s,
+        u8::from(e.bit_edge),
+    )
+}
+
+/// Acquires and tracks; returns the per-channel summaries.
+pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
+    let cfg = args.loops.channel_config()?;
+    let acq = acquire(&args.acquisition)?;
+    let found: Vec<_> = acq.rows.iter().filter(|r| r.detected).collect();
+    if found.is_empty() {
+        anyhow::bail!(
+            "no satellite found in the first {} ms: check --format, --fs, --if, --invert-q, or search wider (--doppler-max) or longer (--coherent-ms 10)",
+            acq.coherent_ms * acq.noncoherent
+        );
+    }
+    let fs = acq.fs_hz;
+    let mut channels = Vec::new();
+    for r in &found {
+        let start = ChannelStart {
+            prn: r.prn,
+            code_start_sample: acq.first_sample + r.code_phase_samples.round().max(0.0) as u64,
+            doppler_hz: r.doppler_hz,
+            cn0_dbhz: r.cn0_dbhz.unwrap_or(f64::NAN),
+        };
+        channels.push(Channel::new(&start, fs, &cfg)?);
+        tracing::info!(
+            "{}: acquired, Doppler {:.0} Hz, C/N0 {:.1} dB-Hz",
+            r.prn,
+            r.doppler_hz,
+            r.cn0_dbhz.unwrap_or(f64::NAN)
+        );
+    }
+    let src_cfg = args.acquisition.source.to_config()?;
+    let mut src =
+        open_source(&src_cfg).with_context(|| format!("cannot read {}", src_cfg.path.display()))?;
+    let mut writer = match &args.out {
+        Some(p) => {
+            let f = std::fs::File::create(p)
+                .with_context(|| format!("cannot create {}", p.display()))?;
+            let mut w = std::io::BufWriter::new(f);
+            writeln!(w, "{CSV_HEADER}")?;
+            Some(w)
+        }
+        None => None,
+    };
+    // Lost satellites (and ones not found at the start) are searched for again every second,
+    // with the integration and Doppler range of the first search.
+    let engine = gpsrx_dsp::acquisition::AcquisitionEngine::new(
+        fs,
+        gpsrx_dsp::acquisition::AcqConfig {
+            coherent_ms: acq.coherent_ms,
+            noncoherent: acq.noncoherent,
+            doppler_center_hz: args.acquisition.doppler_center,
+            doppler_max_hz: args.acquisition.doppler_max,
+            ..gpsrx_dsp::acquisition::AcqConfig::default()
+        },
+    )?;
+    let prns = args
+        .acquisition
+        .prn
+        .iter()
+        .filter_map(|&p| gpsrx_dsp::Prn::new(p).ok())
+        .collect();
+    let reacq = Reacquisition {
+        engine: &engine,
+        interval_s: 1.0,
+        channel_config: cfg,
+        prns,
+    };
+    let mut summaries: BTreeMap<u8, ChannelSummary> = BTreeMap::new();
+    let mut write_err = None;
+    track_with_reacquisition(src.as_mut(), channels, None, Some(&reacq), |_, e| {
+        let s = summaries.entry(e.prn).or_insert_with(|| ChannelSummary {
+            prn: e.prn,
+            ..Default::default()
+        });
+        s.state = format!("{:?}", e.state);
+        s.cn0_dbhz = e.cn0_dbhz;
+        s.doppler_hz = e.doppler_hz;
+        if e.pll_lock && s.first_lock_s.is_none() {
+            s.first_lock_s = Some(e.t_rx_s);
+        }
+        if let Some(b) = e.bit {
+            s.bits += 1;
+            s.bit_edge_ms_mod_20 = Some((b.t_s * 1e3).rem_euclid(20.0));
+        }
+        if let Some(w) = writer.as_mut() {
+            if let Err(err) = writeln!(w, "{}", csv_row(e)) {
+                write_err.get_or_insert(err);
+            }
+        }
+    })?;
+    if let Some(e) = write_err {
+        return Err(e).context("cannot write the tracking CSV");
+    }
+    if let Some(mut w) = writer {
+        w.flush()?;
+    }
+    Ok(summaries.into_values().collect())
+}
+
+/// Runs `gpsrx track`.
+pub fn run(args: &TrackArgs) -> anyhow::Result<()> {
+    let summaries = track_file(args)?;
+    if args.acquisition.json {
+        println!("{}", serde_json::to_string_pretty(&summaries)?);
+        return Ok(());
+    }
+    println!("PRN  state    C/N0(dB-Hz)  Doppler(Hz)  first lock(s)  bit edge(ms mod 20)  bits");
+    for s in &summaries {
+        println!(
+            "{:3}  {:7}  {:11.1}  {:11.1}  {:>13}  {:>19}  {:4}",
+            s.prn,
+            s.state,
+            s.cn0_dbhz,
+            s.doppler_hz,
+            s.first_lock_s
+                .map(|t| format!("{t:.3}"))
+                .unwrap_or_else(|| "-".into()),
+            s.bit_edge_ms_mod_20
+                .map(|t| format!("{t:.2}"))
+                .unwrap_or_else(|| "-".into()),
+            s.bits
+        );
+    }
+    if let Some(p) = &args.out {
+        println!("every integration interval written to {}", p.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,2 @@
+//! Integration tests of the receiver library: the pipeline driven in memory against the
+//! simulator's truth.
