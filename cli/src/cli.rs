@@ -1,6 +1,7 @@
 //! Command-line arguments of `gpsrx`.
 
 use clap::{Args, Parser, Subcommand};
+use gpsrx_receiver::ReceiverConfig;
 use gpsrx_samples::{SampleFormat, SourceConfig};
 use std::path::PathBuf;
 
@@ -193,46 +194,27 @@ pub struct LoopArgs {
     pub aided_pll_order: Option<u8>,
 }
 
-/// A configuration file: `[tracking]` and `[run]` tables.
-#[derive(Debug, Default, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ConfigFile {
-    #[serde(default)]
-    tracking: Option<gpsrx_tracking::ChannelConfig>,
-    #[serde(default)]
-    run: Option<crate::commands::run::RunConfig>,
-    #[serde(default)]
-    dr: Option<crate::commands::run::DrRunConfig>,
-}
-
 impl LoopArgs {
-    fn config_file(&self) -> anyhow::Result<Option<ConfigFile>> {
-        let Some(path) = &self.config else {
-            return Ok(None);
+    /// The configuration: defaults, then the config file (`--config`), then these options.
+    pub fn receiver_config(&self) -> anyhow::Result<ReceiverConfig> {
+        let mut config = match &self.config {
+            Some(path) => ReceiverConfig::load(path)?,
+            None => ReceiverConfig::default(),
         };
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
-        let file: ConfigFile =
-            toml::from_str(&text).map_err(|e| anyhow::anyhow!("config {}: {e}", path.display()))?;
-        Ok(Some(file))
-    }
-
-    /// The `[dr]` table of the configuration file, if any.
-    pub fn dr_config(&self) -> anyhow::Result<Option<crate::commands::run::DrRunConfig>> {
-        Ok(self.config_file()?.and_then(|f| f.dr))
-    }
-
-    /// The `[run]` table of the configuration file, if any.
-    pub fn run_config(&self) -> anyhow::Result<Option<crate::commands::run::RunConfig>> {
-        Ok(self.config_file()?.and_then(|f| f.run))
+        config.tracking = self.apply(config.tracking)?;
+        Ok(config)
     }
 
     /// The channel configuration: defaults, then the config file, then these options.
     pub fn channel_config(&self) -> anyhow::Result<gpsrx_tracking::ChannelConfig> {
-        let mut cfg = self
-            .config_file()?
-            .and_then(|f| f.tracking)
-            .unwrap_or_default();
+        Ok(self.receiver_config()?.tracking)
+    }
+
+    /// `cfg` with these options applied, validated.
+    fn apply(
+        &self,
+        mut cfg: gpsrx_tracking::ChannelConfig,
+    ) -> anyhow::Result<gpsrx_tracking::ChannelConfig> {
         let t = &mut cfg.track;
         if let Some(v) = self.pll_order {
             t.pll_order = v;

@@ -293,9 +293,9 @@ fn aided_loops_are_used_while_the_aid_is_on() {
         cn0_dbhz: f64::NAN,
     };
     let ch = Channel::new(&start, fs, &cfg).unwrap_or_else(|e| panic!("{e}"));
-    let aid = |prn: u8, t: f64| {
+    let aid = |prn: gpsrx_dsp::Prn, t: f64| {
         (t < 5.0).then(|| DopplerAid {
-            doppler_hz: truth_doppler(prn, t).unwrap_or(0.0),
+            doppler_hz: truth_doppler(prn.get(), t).unwrap_or(0.0),
             doppler_rate_hz_s: 0.0,
         })
     };

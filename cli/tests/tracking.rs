@@ -396,8 +396,8 @@ rate_hz = 1.0
         .run(dir.path(), &|_| {})
         .unwrap_or_else(|e| panic!("{e}"));
     let cfg = loop_cfg(2, 3.0, 1.0, 1.0);
-    let truth_aid = |prn: u8, t: f64| {
-        let sat = sim.satellites.iter().find(|s| s.prn.get() == prn)?;
+    let truth_aid = |prn: gpsrx_dsp::Prn, t: f64| {
+        let sat = sim.satellites.iter().find(|s| s.prn == prn)?;
         let h = 1e-3;
         let (a, _) = sim.observe(sat, t - h);
         let (b, _) = sim.observe(sat, t);
@@ -582,29 +582,21 @@ fn a_lost_satellite_is_released_and_reacquired_when_it_returns() {
         8.0,
         dir.path(),
     );
-    let cfg = ChannelConfig::default();
-    let channels = channels_from_truth(&sim, fs, &cfg);
-    let engine = gpsrx_dsp::acquisition::AcquisitionEngine::new(
-        fs,
-        gpsrx_dsp::acquisition::AcqConfig::default(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let reacq = gpsrx_receiver::pipeline::tracker::Reacquisition {
-        engine: &engine,
-        interval_s: 0.5,
-        channel_config: cfg,
-        prns: sim.satellites.iter().map(|s| s.prn).collect(),
-    };
+    // The whole receiver: cold start by search, re-acquisition every second of signal.
+    let mut config = gpsrx_receiver::ReceiverConfig::default();
+    config.run.prns = sim.satellites.iter().map(|s| s.prn.get()).collect();
     let mut src = open_source(&SourceConfig::new(data)).unwrap_or_else(|e| panic!("{e}"));
+    let mut receiver =
+        gpsrx_receiver::Receiver::new(&config, fs, gpsrx_receiver::Assistance::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+    let mut sink = gpsrx_receiver::MemorySink::new().with_channel_epochs();
+    receiver
+        .run(src.as_mut(), &mut sink)
+        .unwrap_or_else(|e| panic!("{e}"));
     let mut per_channel: BTreeMap<usize, Vec<ChannelEpoch>> = BTreeMap::new();
-    let final_channels = gpsrx_receiver::pipeline::tracker::track_with_reacquisition(
-        src.as_mut(),
-        channels,
-        None,
-        Some(&reacq),
-        |i, e| per_channel.entry(i).or_default().push(*e),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    for (i, e) in &sink.channel_epochs {
+        per_channel.entry(*i).or_default().push(*e);
+    }
     let g26: Vec<(usize, &Vec<ChannelEpoch>)> = per_channel
         .iter()
         .filter(|(_, v)| v[0].prn == 26)
@@ -615,11 +607,17 @@ fn a_lost_satellite_is_released_and_reacquired_when_it_returns() {
         "PRN 26 was not re-acquired: {} channel(s)",
         g26.len()
     );
-    let (first_idx, _) = g26[0];
+    let (_, first) = g26[0];
     assert_eq!(
-        final_channels[first_idx].state(),
-        ChannelState::Lost,
+        first.last().map(|e| e.state),
+        Some(ChannelState::Lost),
         "the first channel must be released"
+    );
+    assert!(
+        sink.events
+            .iter()
+            .any(|e| matches!(e, gpsrx_receiver::pipeline::ReceiverEvent::Lost { prn: 26, .. })),
+        "no event for the loss of G26"
     );
     let (_, again) = g26.last().unwrap_or_else(|| panic!("no channel"));
     let start_t = again[0].t_rx_s;

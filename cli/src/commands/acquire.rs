@@ -173,26 +173,7 @@ pub fn acquire(args: &AcquireArgs) -> anyhow::Result<AcquireReport> {
     let mut source =
         open_source(&cfg).with_context(|| format!("cannot read {}", cfg.path.display()))?;
     let fs_hz = source.fs_hz();
-    let predictions = match &args.nav {
-        Some(path) => Some(predictions(args, path)?),
-        None => None,
-    };
-    let targets = targets(args, predictions.as_deref())?;
-    let mut config = AcqConfig {
-        coherent_ms: args.coherent_ms,
-        noncoherent: args.noncoherent,
-        doppler_center_hz: args.doppler_center,
-        doppler_max_hz: args.doppler_max,
-        doppler_step_hz: args.doppler_step,
-        pfa: args.pfa,
-        bit_edge_offsets: Some(!args.no_bit_offsets),
-        refine_ms: args.refine_ms,
-        xcorr_margin_db: (args.xcorr_margin != 0.0).then_some(args.xcorr_margin),
-    };
-    if let Some((lo, hi)) = window_span(&targets) {
-        config.doppler_center_hz = 0.5 * (lo + hi);
-        config.doppler_max_hz = 0.5 * (hi - lo);
-    }
+    let (mut config, targets, predictions) = search_plan(args)?;
     let mut engine = AcquisitionEngine::new(fs_hz, config.clone())?;
     let (first_sample, samples) = read_samples(source.as_mut(), engine.samples_wanted())?;
     let mut warnings = source.warnings();
@@ -238,6 +219,34 @@ pub fn acquire(args: &AcquireArgs) -> anyhow::Result<AcquireReport> {
         rows,
         warnings,
     })
+}
+
+/// The search the options describe: the engine's settings, the targets (all PRNs, `--prn`,
+/// or the predicted visible ones with their Doppler windows) and the predictions (`--nav`).
+pub fn search_plan(
+    args: &AcquireArgs,
+) -> anyhow::Result<(AcqConfig, Vec<SearchTarget>, Option<Vec<Prediction>>)> {
+    let predictions = match &args.nav {
+        Some(path) => Some(predictions(args, path)?),
+        None => None,
+    };
+    let targets = targets(args, predictions.as_deref())?;
+    let mut config = AcqConfig {
+        coherent_ms: args.coherent_ms,
+        noncoherent: args.noncoherent,
+        doppler_center_hz: args.doppler_center,
+        doppler_max_hz: args.doppler_max,
+        doppler_step_hz: args.doppler_step,
+        pfa: args.pfa,
+        bit_edge_offsets: Some(!args.no_bit_offsets),
+        refine_ms: args.refine_ms,
+        xcorr_margin_db: (args.xcorr_margin != 0.0).then_some(args.xcorr_margin),
+    };
+    if let Some((lo, hi)) = window_span(&targets) {
+        config.doppler_center_hz = 0.5 * (lo + hi);
+        config.doppler_max_hz = 0.5 * (hi - lo);
+    }
+    Ok((config, targets, predictions))
 }
 
 fn predictions(args: &AcquireArgs, path: &std::path::Path) -> anyhow::Result<Vec<Prediction>> {

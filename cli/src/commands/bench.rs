@@ -11,13 +11,12 @@
 //!   few runs;
 //! - the end-to-end real-time factor: the built-in 4 MHz ci8 12-satellite scenario
 //!   (`samples/scenarios/static-seoul-4msps.toml`) simulated into a temporary directory, then
-//!   [`run_file`] (what `gpsrx run` does) timed from file to fixes, with the peak resident
+//!   [`Receiver::run`] (what `gpsrx run` does) timed from file to fixes, with the peak resident
 //!   memory of that run (`VmHWM` after resetting it through `/proc/self/clear_refs`).
 
-use crate::commands::run::{run_file, RunArgs};
+use gpsrx_receiver::output::FileSink;
+use gpsrx_receiver::{Assistance, Receiver};
 use crate::commands::simulate::simulate;
-use anyhow::Context;
-use clap::Parser;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
 use gpsrx_dsp::ca_code::CaCode;
 use gpsrx_dsp::correlator::{
@@ -426,36 +425,22 @@ fn bench_acquisition(file: &Path, runs: usize) -> anyhow::Result<AcquisitionBenc
     })
 }
 
-/// `gpsrx run`'s options, parsed as the command line would be (so new options keep their
-/// defaults).
-#[derive(Debug, Parser)]
-struct RunOnly {
-    #[command(flatten)]
-    run: RunArgs,
-}
-
-/// Times [`run_file`] on `file`.
+/// Times the receiver ([`Receiver::run`], what `gpsrx run` does) on `file`.
 fn bench_end_to_end(
     file: &Path,
     out: &Path,
     week: u32,
     truth_llh_deg: Option<[f64; 3]>,
 ) -> anyhow::Result<EndToEnd> {
-    let file_arg = file.to_string_lossy().into_owned();
-    let out_arg = out.to_string_lossy().into_owned();
-    let week_arg = week.to_string();
-    let args = RunOnly::try_parse_from([
-        "gpsrx-run",
-        file_arg.as_str(),
-        "--out",
-        out_arg.as_str(),
-        "--week",
-        week_arg.as_str(),
-    ])
-    .context("cannot build the run options")?
-    .run;
+    let src_cfg = SourceConfig::new(file.to_path_buf());
+    let mut config = gpsrx_receiver::ReceiverConfig::default();
+    config.run.week = Some(week);
     let peak_rss_reset = std::fs::write("/proc/self/clear_refs", "5").is_ok();
-    let (summary, fixes) = run_file(&args, false)?;
+    let mut source = open_source(&src_cfg)?;
+    let mut receiver = Receiver::new(&config, source.fs_hz(), Assistance::default())?;
+    let mut sink = FileSink::create(out, config.run.rate_hz)?;
+    let summary = receiver.run(source.as_mut(), &mut sink)?;
+    let fixes = sink.into_fixes();
     let peak_rss_mb = peak_rss_kb().map(|kb| kb as f64 / 1024.0);
     let src = open_source(&SourceConfig::new(file.to_path_buf()))?;
     let mean_horizontal_error_m = match (summary.mean_llh, truth_llh_deg) {

@@ -65,7 +65,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         ins_band_limit: None,
         ins_max_gap: 0.5,
     };
-    let (summary, fixes) = run_file(&run_args, true)?;
+    let (run_report, fixes) = run_file(&run_args, true)?;
+    let summary = &run_report.receiver;
     println!(
         "processed {:.1} s in {:.1} s ({:.1}x real time); satellites tracked: {:?}",
         summary.duration_s,

@@ -7,6 +7,7 @@ pub mod demo;
 pub mod info;
 pub mod run;
 pub mod simulate;
+pub mod source;
 pub mod track;
 
 /// The working directory of a command with `--keep DIR`: that directory, or a temporary one

@@ -2,11 +2,12 @@
 //! integration interval of every channel to CSV for loop studies.
 
 use crate::cli::LoopArgs;
-use crate::commands::acquire::{acquire, AcquireArgs};
-use gpsrx_receiver::pipeline::tracker::{track_with_reacquisition, Reacquisition};
+use crate::commands::acquire::{search_plan, AcquireArgs};
+use crate::commands::source::open_interruptible;
 use anyhow::Context;
-use gpsrx_samples::open_source;
-use gpsrx_tracking::{Channel, ChannelEpoch, ChannelStart, ChannelState};
+use gpsrx_receiver::pipeline::{FixReport, SearchSettings, Sink, SinkError};
+use gpsrx_receiver::{Assistance, Receiver};
+use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::PathBuf;
@@ -81,75 +82,19 @@ fn csv_row(e: &ChannelEpoch) -> String {
     )
 }
 
-/// Acquires and tracks; returns the per-channel summaries.
-pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
-    let cfg = args.loops.channel_config()?;
-    let acq = acquire(&args.acquisition)?;
-    let found: Vec<_> = acq.rows.iter().filter(|r| r.detected).collect();
-    if found.is_empty() {
-        anyhow::bail!(
-            "no satellite found in the first {} ms: check --format, --fs, --if, --invert-q, or search wider (--doppler-max) or longer (--coherent-ms 10)",
-            acq.coherent_ms * acq.noncoherent
-        );
+/// The sink of `gpsrx track`: every channel report to the CSV and into the summaries.
+struct TrackSink {
+    summaries: BTreeMap<u8, ChannelSummary>,
+    writer: Option<std::io::BufWriter<std::fs::File>>,
+}
+
+impl Sink for TrackSink {
+    fn fix(&mut self, _report: &FixReport) -> Result<(), SinkError> {
+        Ok(())
     }
-    let fs = acq.fs_hz;
-    let mut channels = Vec::new();
-    for r in &found {
-        let start = ChannelStart {
-            prn: r.prn,
-            code_start_sample: acq.first_sample + r.code_phase_samples.round().max(0.0) as u64,
-            doppler_hz: r.doppler_hz,
-            cn0_dbhz: r.cn0_dbhz.unwrap_or(f64::NAN),
-        };
-        channels.push(Channel::new(&start, fs, &cfg)?);
-        tracing::info!(
-            "{}: acquired, Doppler {:.0} Hz, C/N0 {:.1} dB-Hz",
-            r.prn,
-            r.doppler_hz,
-            r.cn0_dbhz.unwrap_or(f64::NAN)
-        );
-    }
-    let src_cfg = args.acquisition.source.to_config()?;
-    let mut src =
-        open_source(&src_cfg).with_context(|| format!("cannot read {}", src_cfg.path.display()))?;
-    let mut writer = match &args.out {
-        Some(p) => {
-            let f = std::fs::File::create(p)
-                .with_context(|| format!("cannot create {}", p.display()))?;
-            let mut w = std::io::BufWriter::new(f);
-            writeln!(w, "{CSV_HEADER}")?;
-            Some(w)
-        }
-        None => None,
-    };
-    // Lost satellites (and ones not found at the start) are searched for again every second,
-    // with the integration and Doppler range of the first search.
-    let engine = gpsrx_dsp::acquisition::AcquisitionEngine::new(
-        fs,
-        gpsrx_dsp::acquisition::AcqConfig {
-            coherent_ms: acq.coherent_ms,
-            noncoherent: acq.noncoherent,
-            doppler_center_hz: args.acquisition.doppler_center,
-            doppler_max_hz: args.acquisition.doppler_max,
-            ..gpsrx_dsp::acquisition::AcqConfig::default()
-        },
-    )?;
-    let prns = args
-        .acquisition
-        .prn
-        .iter()
-        .filter_map(|&p| gpsrx_dsp::Prn::new(p).ok())
-        .collect();
-    let reacq = Reacquisition {
-        engine: &engine,
-        interval_s: 1.0,
-        channel_config: cfg,
-        prns,
-    };
-    let mut summaries: BTreeMap<u8, ChannelSummary> = BTreeMap::new();
-    let mut write_err = None;
-    track_with_reacquisition(src.as_mut(), channels, None, Some(&reacq), |_, e| {
-        let s = summaries.entry(e.prn).or_insert_with(|| ChannelSummary {
+
+    fn channel_epoch(&mut self, _channel: usize, e: &ChannelEpoch) -> Result<(), SinkError> {
+        let s = self.summaries.entry(e.prn).or_insert_with(|| ChannelSummary {
             prn: e.prn,
             ..Default::default()
         });
@@ -163,19 +108,66 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
             s.bits += 1;
             s.bit_edge_ms_mod_20 = Some((b.t_s * 1e3).rem_euclid(20.0));
         }
-        if let Some(w) = writer.as_mut() {
-            if let Err(err) = writeln!(w, "{}", csv_row(e)) {
-                write_err.get_or_insert(err);
-            }
+        if let Some(w) = self.writer.as_mut() {
+            writeln!(w, "{}", csv_row(e))?;
         }
-    })?;
-    if let Some(e) = write_err {
-        return Err(e).context("cannot write the tracking CSV");
+        Ok(())
     }
-    if let Some(mut w) = writer {
-        w.flush()?;
+}
+
+/// Acquires and tracks through the recording with the receiver pipeline (the search of
+/// `gpsrx acquire` for the cold start, re-acquisition every second of signal); returns a
+/// summary per satellite and writes every report to `--out`.
+pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
+    let mut config = gpsrx_receiver::ReceiverConfig {
+        tracking: args.loops.channel_config()?,
+        ..Default::default()
+    };
+    config.run.prns = args.acquisition.prn.clone();
+    let src_cfg = args.acquisition.source.to_config()?;
+    let mut src = open_interruptible(&src_cfg)?;
+    let (acq, targets, _) = search_plan(&args.acquisition)?;
+    let prns = args
+        .acquisition
+        .prn
+        .iter()
+        .filter_map(|&p| gpsrx_dsp::Prn::new(p).ok())
+        .collect();
+    let search = SearchSettings {
+        acq,
+        weak_fallback: false,
+        reacquisition_interval_s: Some(1.0),
+        prns,
+        cold_targets: Some(targets),
+    };
+    let mut receiver =
+        Receiver::new(&config, src.fs_hz(), Assistance::default())?.with_search(search)?;
+    let writer = match &args.out {
+        Some(p) => {
+            let f = std::fs::File::create(p)
+                .with_context(|| format!("cannot create {}", p.display()))?;
+            let mut w = std::io::BufWriter::new(f);
+            writeln!(w, "{CSV_HEADER}")?;
+            Some(w)
+        }
+        None => None,
+    };
+    let mut sink = TrackSink {
+        summaries: BTreeMap::new(),
+        writer,
+    };
+    receiver
+        .run(src.as_mut(), &mut sink)
+        .context("tracking (or writing the tracking CSV) failed")?;
+    if let Some(mut w) = sink.writer {
+        w.flush().context("cannot write the tracking CSV")?;
     }
-    Ok(summaries.into_values().collect())
+    if sink.summaries.is_empty() {
+        anyhow::bail!(
+            "no satellite found: check --format, --fs, --if, --invert-q, or search wider (--doppler-max) or longer (--coherent-ms 10)"
+        );
+    }
+    Ok(sink.summaries.into_values().collect())
 }
 
 /// Runs `gpsrx track`.

@@ -29,7 +29,7 @@ pub(super) fn run_case(case: &Case, aided: bool) -> anyhow::Result<Vec<CellMeasu
             });
         }
     }
-    let aid_fn = |prn: u8, t: f64| truth.aid(prn, t);
+    let aid_fn = |prn: gpsrx_dsp::Prn, t: f64| truth.aid(prn.get(), t);
     let aid: Option<gpsrx_receiver::pipeline::tracker::AidSource<'_>> =
         if aided { Some(&aid_fn) } else { None };
     let mut src = SimSource::new(&sim);

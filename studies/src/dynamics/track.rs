@@ -72,7 +72,7 @@ pub(super) fn run_case(p: &Prepared, case: &Case) -> anyhow::Result<CaseResult> 
         Aiding::Ins1 => Some(&p.feedforwards[0]),
         Aiding::Ins2 => Some(&p.feedforwards[1]),
     };
-    let aid_fn = |prn: u8, t: f64| ff.and_then(|f| f.aid(prn, t));
+    let aid_fn = |prn: gpsrx_dsp::Prn, t: f64| ff.and_then(|f| f.aid(prn.get(), t));
     let aid: Option<AidSource<'_>> = ff.map(|_| &aid_fn as AidSource<'_>);
     track(&mut src, channels, aid, |i, e: &ChannelEpoch| {
         let log = &mut logs[i];

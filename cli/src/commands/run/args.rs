@@ -1,6 +1,7 @@
 //! The command line of `gpsrx run`.
 
 use crate::cli::{LoopArgs, SourceArgs};
+use gpsrx_receiver::config::{self, ReceiverConfig};
 use std::path::PathBuf;
 
 /// Ionosphere model switch.
@@ -122,4 +123,59 @@ pub enum DrFilterChoice {
     Proposed,
     /// The conventional 4-state filter (seed 000 eq. 7): position updates only.
     Conventional,
+}
+
+impl From<IonoModel> for config::IonoModel {
+    fn from(m: IonoModel) -> Self {
+        match m {
+            IonoModel::Klobuchar => config::IonoModel::Klobuchar,
+            IonoModel::None => config::IonoModel::None,
+        }
+    }
+}
+
+impl From<TropoModel> for config::TropoModel {
+    fn from(m: TropoModel) -> Self {
+        match m {
+            TropoModel::Saastamoinen => config::TropoModel::Saastamoinen,
+            TropoModel::None => config::TropoModel::None,
+        }
+    }
+}
+
+impl RunArgs {
+    /// The receiver configuration: defaults, then the config file, then these options;
+    /// validated.
+    pub fn receiver_config(&self) -> anyhow::Result<ReceiverConfig> {
+        let mut c = self.loops.receiver_config()?;
+        let r = &mut c.run;
+        let set = |field: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *field = v;
+            }
+        };
+        set(&mut r.rate_hz, self.rate);
+        set(&mut r.elevation_mask_deg, self.elevation_mask);
+        set(&mut r.raim_pfa, self.raim_pfa);
+        set(&mut r.doppler_max_hz, self.doppler_max);
+        set(&mut r.doppler_center_hz, self.doppler_center);
+        if let Some(v) = self.acq_coherent_ms {
+            r.acq_coherent_ms = v;
+        }
+        if let Some(v) = self.acq_noncoherent {
+            r.acq_noncoherent = v;
+        }
+        if let Some(v) = self.iono {
+            r.iono = v.into();
+        }
+        if let Some(v) = self.tropo {
+            r.tropo = v.into();
+        }
+        if self.week.is_some() {
+            r.week = self.week;
+        }
+        r.allow_unhealthy |= self.allow_unhealthy;
+        c.validate()?;
+        Ok(c)
+    }
 }

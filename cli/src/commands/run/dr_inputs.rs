@@ -8,10 +8,11 @@ use gpsrx_receiver::fusion::gnss::GnssFix;
 use gpsrx_receiver::fusion::speed::{attach_speed, speed_track};
 use gpsrx_receiver::output::{self, create_file, NmeaOptions, NmeaWriter};
 use anyhow::Context;
+use gpsrx_receiver::ReceiverConfig;
 use gpsrx_ins_aiding::{
     read_accel_csv, read_dr_csv, AccelLog, DrFilterKind, DrLog, DrParams, FixSource,
 };
-use std::path::PathBuf;
+use std::path::Path;
 
 /// The DR inputs of a run, read and checked before tracking starts.
 pub(super) struct DrInputs {
@@ -21,11 +22,12 @@ pub(super) struct DrInputs {
 }
 
 impl DrInputs {
-    pub(super) fn load(args: &RunArgs, rate_hz: f64) -> anyhow::Result<Option<DrInputs>> {
+    pub(super) fn load(args: &RunArgs, config: &ReceiverConfig) -> anyhow::Result<Option<DrInputs>> {
+        let rate_hz = config.run.rate_hz;
         if args.dr.is_none() && args.accel.is_none() {
             return Ok(None);
         }
-        let file = args.loops.dr_config()?.unwrap_or_default();
+        let file = &config.dr;
         let nominal = DrParams::default();
         let params = DrParams {
             sf_g_dps_per_v: file.sf_g_dps_per_v.unwrap_or(nominal.sf_g_dps_per_v),
@@ -72,8 +74,9 @@ impl DrInputs {
 pub(super) fn write_fused_outputs(
     inputs: &DrInputs,
     gnss: &[GnssFix],
-    out: &dyn Fn(&str) -> PathBuf,
+    dir: &Path,
 ) -> anyhow::Result<([usize; 3], Option<DrParams>)> {
+    let out = |name: &str| dir.join(name);
     let mut result = fuse_dr(gnss, inputs.dr.as_ref(), &inputs.settings)?;
     if let Some(accel) = &inputs.accel {
         let track = speed_track(gnss, accel, inputs.settings.update_interval_s)?;
