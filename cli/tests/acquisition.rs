@@ -5,9 +5,9 @@
 //! with CI=true, where they fail.
 
 use clap::Parser;
+use gpsrx_cli::commands::acquire::{acquire, render_table, AcquireArgs, AcquireReport};
 use gpsrx_dsp::acquisition::{stats, AcqConfig, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::Prn;
-use gpsrx_cli::commands::acquire::{acquire, render_table, AcquireArgs, AcquireReport};
 use gpsrx_samples::sim::{Scenario, Simulator};
 use num_complex::Complex32;
 use std::path::{Path, PathBuf};

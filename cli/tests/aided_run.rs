@@ -2,10 +2,10 @@
 //! `gpsrx run --ins` through a 5 g turn with narrow loops, aided and unaided.
 
 use crate::common::{run, truth};
+use gpsrx_cli::commands::simulate::write_ins_for;
 use gpsrx_ins_aiding::error_model::InsErrorConfig;
 use gpsrx_ins_aiding::read_ins_csv;
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
-use gpsrx_cli::commands::simulate::write_ins_for;
 use gpsrx_receiver::output::Fix;
 use gpsrx_receiver::pipeline::aiding::InsFeedForward;
 use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;

@@ -2,8 +2,8 @@
 //! satellite and its DR and accelerometer logs from the simulator, against the truth.
 
 use crate::common::{run, truth};
-use gpsrx_nav::frames::{enu_rotation, Llh, Vector3};
 use gpsrx_cli::commands::simulate::simulate_with_sensors;
+use gpsrx_nav::frames::{enu_rotation, Llh, Vector3};
 use gpsrx_samples::sim::Scenario;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! `gpsrx simulate` with an `[ins]` table: `ins.csv` against `truth.csv`.
 
-use gpsrx_ins_aiding::read_ins_csv;
 use gpsrx_cli::commands::simulate::{ins_config, simulate, simulate_with_ins};
+use gpsrx_ins_aiding::read_ins_csv;
 use gpsrx_samples::sim::Scenario;
 use std::path::Path;
 

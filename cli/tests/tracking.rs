@@ -2,14 +2,12 @@
 
 use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
 use gpsrx_receiver::pipeline::tracker::track;
+use gpsrx_samples::sim::{Scenario, SimSatellite, Simulator};
+use gpsrx_samples::{open_source, SourceConfig};
 use gpsrx_studies::bandwidth::{
     dll_jitter_chips as dll_sigma_chips, pll_jitter_deg as pll_sigma_deg,
 };
-use gpsrx_studies::if_sim::{
-    self, start_from_truth, std_dev, track_config, ChannelSpec, Truth,
-};
-use gpsrx_samples::sim::{Scenario, SimSatellite, Simulator};
-use gpsrx_samples::{open_source, SourceConfig};
+use gpsrx_studies::if_sim::{self, start_from_truth, std_dev, track_config, ChannelSpec, Truth};
 use gpsrx_tracking::{Channel, ChannelConfig, ChannelEpoch, ChannelState};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -614,9 +612,10 @@ fn a_lost_satellite_is_released_and_reacquired_when_it_returns() {
         "the first channel must be released"
     );
     assert!(
-        sink.events
-            .iter()
-            .any(|e| matches!(e, gpsrx_receiver::pipeline::ReceiverEvent::Lost { prn: 26, .. })),
+        sink.events.iter().any(|e| matches!(
+            e,
+            gpsrx_receiver::pipeline::ReceiverEvent::Lost { prn: 26, .. }
+        )),
         "no event for the loss of G26"
     );
     let (_, again) = g26.last().unwrap_or_else(|| panic!("no channel"));

@@ -21,10 +21,10 @@
 //! constant (the unknown initial phase) and, for a Costas loop, the half-cycle ambiguity, which
 //! [`folded_phase_deg`] removes.
 
-use gpsrx_receiver::pipeline::tracker::{track, AidSource};
 use anyhow::Context;
 use gpsrx_dsp::constants::CA_CODE_LENGTH;
 use gpsrx_dsp::Prn;
+use gpsrx_receiver::pipeline::tracker::{track, AidSource};
 use gpsrx_samples::sim::{Scenario, SimSatellite, Simulator};
 use gpsrx_samples::{SampleError, SampleFormat, SampleSource};
 use gpsrx_tracking::{Channel, ChannelConfig, ChannelStart, ChannelState, ConfigError, DopplerAid};

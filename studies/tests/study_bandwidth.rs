@@ -1,8 +1,8 @@
 //! `gpsrx study bandwidth --quick`: simulated IF, tracked by the real channels, against the
 //! thermal-noise formulas (oracles.md "Noise") and seed 004 Table 2's trend.
 
-use clap::Parser;
 use crate::{Cli, Command};
+use clap::Parser;
 use std::collections::HashMap;
 use std::path::Path;
 

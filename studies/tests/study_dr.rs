@@ -5,8 +5,8 @@
 //! seconds after a satellite-set change) and the speed filter through 20-60 s gaps, one noise
 //! seed. The assertions read `study.json` and check the files.
 
-use clap::Parser;
 use crate::{Cli, Command};
+use clap::Parser;
 use serde_json::Value;
 use std::time::Instant;
 

@@ -4,8 +4,8 @@
 //! 2nd-order PLL at 3 Hz unaided and aided by INS 1 (accelerometer bias B) and INS 2 (2B), and
 //! by a 1st-order PLL at 18 Hz aided by each INS. The assertions read `study.json`.
 
-use clap::Parser;
 use crate::{Cli, Command};
+use clap::Parser;
 use serde_json::Value;
 use std::time::Instant;
 

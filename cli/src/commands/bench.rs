@@ -14,8 +14,6 @@
 //!   [`Receiver::run`] (what `gpsrx run` does) timed from file to fixes, with the peak resident
 //!   memory of that run (`VmHWM` after resetting it through `/proc/self/clear_refs`).
 
-use gpsrx_receiver::output::FileSink;
-use gpsrx_receiver::{Assistance, Receiver};
 use crate::commands::simulate::simulate;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
 use gpsrx_dsp::ca_code::CaCode;
@@ -23,6 +21,8 @@ use gpsrx_dsp::correlator::{
     correlate, Arithmetic, Correlator, Isa, PackedCode, ReplicaState, SampleSlice,
 };
 use gpsrx_dsp::Prn;
+use gpsrx_receiver::output::FileSink;
+use gpsrx_receiver::{Assistance, Receiver};
 use gpsrx_samples::sim::scenario::ReceiverConfig;
 use gpsrx_samples::sim::Scenario;
 use gpsrx_samples::{open_source, SourceConfig};

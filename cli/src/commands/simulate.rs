@@ -5,13 +5,13 @@
 //! (longitudinal accelerometer).
 
 use crate::cli::SimulateArgs;
-use gpsrx_receiver::fusion::vehicle::{vehicle_truth, EcefState};
 use anyhow::Context;
 use gpsrx_ins_aiding::{
     simulate_accel, simulate_dr, simulate_ins, write_accel_csv, write_dr_csv, write_ins_csv,
     AccelSensorConfig, DrSensorConfig, InsErrorConfig, TruthState, VehicleTruth,
 };
 use gpsrx_nav::frames::Llh;
+use gpsrx_receiver::fusion::vehicle::{vehicle_truth, EcefState};
 use gpsrx_samples::sim::{Scenario, SimReport, Simulator};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};

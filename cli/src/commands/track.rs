@@ -94,10 +94,13 @@ impl Sink for TrackSink {
     }
 
     fn channel_epoch(&mut self, _channel: usize, e: &ChannelEpoch) -> Result<(), SinkError> {
-        let s = self.summaries.entry(e.prn).or_insert_with(|| ChannelSummary {
-            prn: e.prn,
-            ..Default::default()
-        });
+        let s = self
+            .summaries
+            .entry(e.prn)
+            .or_insert_with(|| ChannelSummary {
+                prn: e.prn,
+                ..Default::default()
+            });
         s.state = format!("{:?}", e.state);
         s.cn0_dbhz = e.cn0_dbhz;
         s.doppler_hz = e.doppler_hz;

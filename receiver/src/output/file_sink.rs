@@ -148,7 +148,12 @@ impl Sink for FileSink {
             }
             None => {}
         }
-        let records: Vec<NavRecord> = end.ephemerides.iter().cloned().map(NavRecord::from).collect();
+        let records: Vec<NavRecord> = end
+            .ephemerides
+            .iter()
+            .cloned()
+            .map(NavRecord::from)
+            .collect();
         let header = NavHeader {
             iono: end.iono,
             utc: end.utc,

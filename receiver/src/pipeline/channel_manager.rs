@@ -15,7 +15,9 @@
 use crate::pipeline::ring::SampleView;
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::Prn;
-use gpsrx_tracking::{AidingPort, Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState};
+use gpsrx_tracking::{
+    AidingPort, Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState,
+};
 use num_complex::Complex32;
 use rayon::prelude::*;
 
@@ -186,9 +188,9 @@ impl ChannelManager {
                 wanted_prns(prns).map(SearchTarget::full).collect()
             }
         };
-        let mut found =
-            cold.engine
-                .search(&samples[..n.min(cold.engine.samples_wanted())], &targets)?;
+        let mut found = cold
+            .engine
+            .search(&samples[..n.min(cold.engine.samples_wanted())], &targets)?;
         let detected = found.iter().filter(|d| d.detected).count();
         let engine = match cold.weak {
             Some(weak) if detected < WEAK_SEARCH_BELOW && n >= weak.samples_needed() => {
@@ -226,7 +228,10 @@ impl ChannelManager {
                 d.cn0_dbhz.unwrap_or(f64::NAN)
             );
         }
-        if let Some(interval_s) = self.settings.as_ref().and_then(|s| s.reacquisition_interval_s)
+        if let Some(interval_s) = self
+            .settings
+            .as_ref()
+            .and_then(|s| s.reacquisition_interval_s)
         {
             self.schedule = Some(SearchSchedule::new(interval_s, &self.channels, self.fs_hz));
         }
@@ -245,7 +250,11 @@ impl ChannelManager {
     /// The search due now that the window is `window`, if one is.
     pub fn due_search(&mut self, window: SampleView<'_>) -> Option<DueSearch> {
         let keep = self.search_samples();
-        let prns = self.settings.as_ref().map(|s| s.prns.as_slice()).unwrap_or(&[]);
+        let prns = self
+            .settings
+            .as_ref()
+            .map(|s| s.prns.as_slice())
+            .unwrap_or(&[]);
         let schedule = self.schedule.as_mut()?;
         schedule.due(prns, window, keep, &self.channels)
     }
@@ -334,7 +343,10 @@ impl ChannelManager {
     /// The oldest sample still needed: the slowest live channel's next code period, and the
     /// samples the next search will read. `end` is the window's end.
     pub fn oldest_needed(&self, end: u64) -> u64 {
-        let live = self.channels.iter().filter(|c| c.state() != ChannelState::Lost);
+        let live = self
+            .channels
+            .iter()
+            .filter(|c| c.state() != ChannelState::Lost);
         let oldest = live.map(|c| c.next_span().0).min().unwrap_or(end);
         let keep = self.search_samples() as u64;
         let search_from = self
@@ -348,7 +360,10 @@ impl ChannelManager {
     pub fn finished(&self) -> bool {
         self.schedule.is_none()
             && self.cold.is_none()
-            && self.channels.iter().all(|c| c.state() == ChannelState::Lost)
+            && self
+                .channels
+                .iter()
+                .all(|c| c.state() == ChannelState::Lost)
     }
 
     /// The channels, in the order they were started.
@@ -366,7 +381,9 @@ impl ChannelManager {
 #[derive(Debug, thiserror::Error)]
 pub enum ColdStartError {
     /// Fewer samples than one search needs.
-    #[error("the recording is too short for acquisition ({samples} samples; at least {needed} needed)")]
+    #[error(
+        "the recording is too short for acquisition ({samples} samples; at least {needed} needed)"
+    )]
     TooShort {
         /// Samples available.
         samples: usize,

@@ -90,7 +90,8 @@ impl NavigationProcessor {
         nav_assist: Option<NavData>,
         landmarks: Vec<LandmarkObservation>,
     ) -> Self {
-        let builder = ObservableBuilder::new(fs_hz, settings.rate_hz).with_min_cn0_dbhz(cn0_lost_dbhz);
+        let builder =
+            ObservableBuilder::new(fs_hz, settings.rate_hz).with_min_cn0_dbhz(cn0_lost_dbhz);
         Self {
             fs_hz,
             settings,
@@ -159,7 +160,11 @@ impl NavigationProcessor {
                 sample_index: s,
                 satellites: self.decoders.len(),
                 frame_synced: self.decoders.values().filter(|d| d.synced()).count(),
-                with_ephemeris: self.decoders.values().filter(|d| d.ephemeris.is_some()).count(),
+                with_ephemeris: self
+                    .decoders
+                    .values()
+                    .filter(|d| d.ephemeris.is_some())
+                    .count(),
                 fixes: self.stats.fixes,
             })?;
         }

@@ -154,7 +154,12 @@ impl Receiver {
             })
             .unwrap_or_else(current_gps_week);
         let aiding = match assistance.ins {
-            Some(ins) => Some(Self::feedforward(ins, &assistance.nav, reference_week, run)?),
+            Some(ins) => Some(Self::feedforward(
+                ins,
+                &assistance.nav,
+                reference_week,
+                run,
+            )?),
             None => None,
         };
         let nav = NavigationProcessor::new(
@@ -264,7 +269,11 @@ impl Receiver {
 
     /// Takes the next samples of the stream (any number: the processing is cut into 10 ms
     /// blocks of the stream, whatever the chunking). The first sample pushed has index 0.
-    pub fn push(&mut self, samples: &[Complex32], sink: &mut dyn Sink) -> Result<(), ReceiverError> {
+    pub fn push(
+        &mut self,
+        samples: &[Complex32],
+        sink: &mut dyn Sink,
+    ) -> Result<(), ReceiverError> {
         self.window.push(samples);
         self.first_sample.get_or_insert(self.window.start());
         if self.manager.cold_start_pending() {

@@ -1,9 +1,7 @@
 //! Measurement: a cell's channel traces against truth, reduced to its error statistics.
 
 use super::{Cell, LONG_INTERVAL_S, OBS_INTERVAL_S};
-use crate::if_sim::{
-    self, differenced_rate, folded_phase_deg, half_cycle_slips, ChannelTrace,
-};
+use crate::if_sim::{self, differenced_rate, folded_phase_deg, half_cycle_slips, ChannelTrace};
 use gpsrx_dsp::constants::LAMBDA_L1_M;
 use gpsrx_tracking::ChannelState;
 

@@ -3,10 +3,10 @@
 
 use super::aiding::{bias_direction_enu, Aiding};
 use super::params::{CLOCK_DRIFT_S_S, DURATION_S, INS_RATE_HZ};
-use gpsrx_receiver::pipeline::aiding::InsFeedForward;
 use gpsrx_dsp::constants::SPEED_OF_LIGHT_MPS;
 use gpsrx_ins_aiding::{simulate_ins, InsErrorConfig, InsTrack, TruthState};
 use gpsrx_nav::rinex_nav::NavData;
+use gpsrx_receiver::pipeline::aiding::InsFeedForward;
 use gpsrx_samples::sim::Simulator;
 
 /// The INS of `aiding` made from the simulator's truth (bias only: the effect studied), as the

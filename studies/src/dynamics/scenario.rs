@@ -7,9 +7,9 @@ use super::ins::feedforward;
 use super::params::{
     ALLAN_DEVIATION_1S, CLOCK_DRIFT_S_S, DURATION_S, FS_HZ, RAMP_S, SPEED_MPS, START_TOW_S,
 };
-use gpsrx_receiver::pipeline::aiding::InsFeedForward;
 use crate::if_sim::{self, Truth};
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
+use gpsrx_receiver::pipeline::aiding::InsFeedForward;
 use gpsrx_tracking::ChannelStart;
 use num_complex::Complex32;
 use rayon::prelude::*;

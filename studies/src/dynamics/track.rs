@@ -6,9 +6,9 @@ use super::mem_source::MemSource;
 use super::params::{DURATION_S, FS_HZ, TICK_S};
 use super::result::{summarise, CaseResult};
 use super::scenario::Prepared;
-use gpsrx_receiver::pipeline::tracker::{track, AidSource};
 use crate::if_sim;
 use gpsrx_dsp::constants::LAMBDA_L1_M;
+use gpsrx_receiver::pipeline::tracker::{track, AidSource};
 use gpsrx_samples::SampleFormat;
 use gpsrx_tracking::{Channel, ChannelEpoch, ChannelState};
 

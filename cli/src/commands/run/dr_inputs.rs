@@ -2,16 +2,16 @@
 //! and the fused outputs written after it.
 
 use super::args::{DrFilterChoice, RunArgs};
+use anyhow::Context;
+use gpsrx_ins_aiding::{
+    read_accel_csv, read_dr_csv, AccelLog, DrFilterKind, DrLog, DrParams, FixSource,
+};
 use gpsrx_receiver::fusion::fuse::{fuse_dr, DrFusionSettings};
 use gpsrx_receiver::fusion::fused_csv::{fused_as_fixes, write_fused_csv};
 use gpsrx_receiver::fusion::gnss::GnssFix;
 use gpsrx_receiver::fusion::speed::{attach_speed, speed_track};
 use gpsrx_receiver::output::{self, create_file, NmeaOptions, NmeaWriter};
-use anyhow::Context;
 use gpsrx_receiver::ReceiverConfig;
-use gpsrx_ins_aiding::{
-    read_accel_csv, read_dr_csv, AccelLog, DrFilterKind, DrLog, DrParams, FixSource,
-};
 use std::path::Path;
 
 /// The DR inputs of a run, read and checked before tracking starts.
@@ -22,7 +22,10 @@ pub(super) struct DrInputs {
 }
 
 impl DrInputs {
-    pub(super) fn load(args: &RunArgs, config: &ReceiverConfig) -> anyhow::Result<Option<DrInputs>> {
+    pub(super) fn load(
+        args: &RunArgs,
+        config: &ReceiverConfig,
+    ) -> anyhow::Result<Option<DrInputs>> {
         let rate_hz = config.run.rate_hz;
         if args.dr.is_none() && args.accel.is_none() {
             return Ok(None);

@@ -9,11 +9,11 @@
 use crate::commands::source::open_interruptible;
 use anyhow::Context;
 use gpsrx_ins_aiding::{read_ins_csv, DrParams};
+use gpsrx_nav::rinex_nav::read_rinex_nav;
 use gpsrx_receiver::fusion::gnss::GnssFix;
 use gpsrx_receiver::output::{FileSink, Fix};
 use gpsrx_receiver::pipeline::{FixReport, Progress, Sink, SinkError, Tee};
 use gpsrx_receiver::{Assistance, Receiver, RunSummary};
-use gpsrx_nav::rinex_nav::read_rinex_nav;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 
@@ -76,7 +76,11 @@ fn assistance(args: &RunArgs) -> anyhow::Result<Assistance> {
         Some(path) => {
             let track = read_ins_csv(path, args.ins_max_gap)?;
             let (a, b) = track.span_s();
-            let off = if args.no_aiding { " (aiding off: --no-aiding)" } else { "" };
+            let off = if args.no_aiding {
+                " (aiding off: --no-aiding)"
+            } else {
+                ""
+            };
             tracing::info!(
                 "INS {}: {} rows from {a:.2} to {b:.2} s{off}",
                 path.display(),
@@ -166,7 +170,10 @@ fn print_report(out: &mut dyn Write, report: &RunReport, args: &RunArgs) -> std:
         )?,
     }
     if let Some([g, f, d]) = report.fused_rows {
-        writeln!(out, "fused.csv: {f} fused rows, {d} dead-reckoning only, {g} GNSS only")?;
+        writeln!(
+            out,
+            "fused.csv: {f} fused rows, {d} dead-reckoning only, {g} GNSS only"
+        )?;
     }
     if let Some(p) = &report.dr_params {
         writeln!(
