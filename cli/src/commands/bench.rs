@@ -30,8 +30,10 @@ use num_complex::Complex32;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::hint::black_box;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
+
+pub use crate::cli::BenchArgs;
 
 /// The end-to-end scenario: 60 s, 4 MHz ci8, 12 satellites over Seoul.
 const SEOUL_SCENARIO_TOML: &str =
@@ -45,28 +47,6 @@ const BLOCK_SAMPLES: usize = 4000;
 
 /// Tap sets measured: prompt; early/prompt/late; very early to very late.
 const TAP_SETS: [&[f64]; 3] = [&[0.0], &[-0.5, 0.0, 0.5], &[-1.0, -0.5, 0.0, 0.5, 1.0]];
-
-/// `gpsrx bench`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct BenchArgs {
-    /// Short runs (a few seconds in all; rougher numbers): correlators timed for 10 ms each,
-    /// 3 acquisition runs, a 1 s end-to-end recording.
-    #[arg(long)]
-    pub quick: bool,
-    /// Length of the simulated end-to-end recording, s [default: 60, or 1 with --quick].
-    #[arg(long, value_name = "S")]
-    pub duration: Option<f64>,
-    /// Skip the end-to-end run (correlators and acquisition only).
-    #[arg(long)]
-    pub no_end_to_end: bool,
-    /// Keep the simulated recording and the run's outputs in this directory (default: a
-    /// temporary directory, removed).
-    #[arg(long, value_name = "DIR")]
-    pub keep: Option<PathBuf>,
-    /// Print the report as JSON on stdout.
-    #[arg(long)]
-    pub json: bool,
-}
 
 /// One correlator measurement.
 #[derive(Debug, Clone, serde::Serialize)]

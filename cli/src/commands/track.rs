@@ -1,8 +1,7 @@
 //! `gpsrx track`: acquire, then track satellites through a recording, and write every
 //! integration interval of every channel to CSV for loop studies.
 
-use crate::cli::LoopArgs;
-use crate::commands::acquire::{search_plan, AcquireArgs};
+use crate::commands::acquire::search_plan;
 use crate::commands::source::open_interruptible;
 use anyhow::Context;
 use gpsrx_receiver::pipeline::{FixReport, SearchSettings, Sink, SinkError};
@@ -10,21 +9,8 @@ use gpsrx_receiver::{Assistance, Receiver};
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::PathBuf;
 
-/// `gpsrx track`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct TrackArgs {
-    /// The recording, how to read it, and the acquisition settings (`--prn` limits the PRNs).
-    #[command(flatten)]
-    pub acquisition: AcquireArgs,
-    /// Loop settings.
-    #[command(flatten)]
-    pub loops: LoopArgs,
-    /// Write every integration interval of every channel to this CSV file.
-    #[arg(long, value_name = "FILE")]
-    pub out: Option<PathBuf>,
-}
+pub use crate::cli::TrackArgs;
 
 /// Per-channel summary of a tracking run.
 #[derive(Debug, Clone, Default, serde::Serialize)]

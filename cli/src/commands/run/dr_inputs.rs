@@ -1,7 +1,7 @@
 //! `gpsrx run --dr --accel`: the DR and accelerometer logs, read and checked before tracking,
 //! and the fused outputs written after it.
 
-use super::args::{DrFilterChoice, RunArgs};
+use crate::cli::{DrFilterChoice, RunArgs};
 use anyhow::Context;
 use gpsrx_ins_aiding::{
     read_accel_csv, read_dr_csv, AccelLog, DrFilterKind, DrLog, DrParams, FixSource,

@@ -17,10 +17,9 @@ use gpsrx_receiver::{Assistance, Receiver, RunSummary};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 
-mod args;
 mod dr_inputs;
 
-pub use args::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
+pub use crate::cli::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
 use dr_inputs::{write_fused_outputs, DrInputs};
 
 /// What `gpsrx run` produced: the receiver's summary and, with `--dr`/`--accel`, the fusion's.

@@ -1,6 +1,6 @@
 //! The command line of `gpsrx run`.
 
-use crate::cli::{LoopArgs, SourceArgs};
+use super::{LoopArgs, SourceArgs};
 use gpsrx_receiver::config::{self, ReceiverConfig};
 use std::path::PathBuf;
 

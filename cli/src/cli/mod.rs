@@ -1,5 +1,15 @@
 //! Command-line arguments of `gpsrx`.
 
+mod acquire;
+mod bench;
+mod run;
+mod track;
+
+pub use acquire::AcquireArgs;
+pub use bench::BenchArgs;
+pub use run::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
+pub use track::TrackArgs;
+
 use clap::{Args, Parser, Subcommand};
 use gpsrx_receiver::ReceiverConfig;
 use gpsrx_samples::{SampleFormat, SourceConfig};
@@ -27,17 +37,17 @@ pub enum Command {
     /// Simulate the built-in demo scenario and show what was made.
     Demo(DemoArgs),
     /// Search a recording for satellites (FFT parallel code-phase search).
-    Acquire(crate::commands::acquire::AcquireArgs),
+    Acquire(AcquireArgs),
     /// Acquire and track satellites; write every integration interval to CSV.
-    Track(crate::commands::track::TrackArgs),
+    Track(TrackArgs),
     /// Process a recording into position fixes and standard files (RINEX, NMEA, GeoJSON, KML, CSV).
-    Run(crate::commands::run::RunArgs),
+    Run(RunArgs),
     /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
     Config(ConfigArgs),
     /// Loop studies: steady-state errors, bandwidth vs noise, high dynamics (seed 004).
     Study(gpsrx_studies::StudyArgs),
     /// Measure this machine: correlator kernels, acquisition, end-to-end real-time factor.
-    Bench(crate::commands::bench::BenchArgs),
+    Bench(BenchArgs),
 }
 
 /// `gpsrx config`.
