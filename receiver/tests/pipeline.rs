@@ -2,7 +2,7 @@
 //! chunking, or read through a source, give the same fixes, and they land on the truth.
 
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
-use gpsrx_receiver::pipeline::{MemorySink, ReceiverEvent};
+use gpsrx_receiver::pipeline::{MemorySink, ReceiverEvent, Sink};
 use gpsrx_receiver::{Assistance, Receiver, ReceiverConfig};
 use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
 use gpsrx_samples::sim::{Scenario, Simulator};
@@ -232,4 +232,109 @@ fn an_invalid_configuration_names_the_setting() {
         .err()
         .unwrap_or_else(|| panic!("unknown key accepted"));
     assert!(err.to_string().contains("rate"), "{err}");
+}
+
+#[test]
+fn the_channel_manager_alone_finds_the_simulated_satellites_at_their_doppler() {
+    use gpsrx_dsp::acquisition::AcqConfig;
+    use gpsrx_receiver::pipeline::channel_manager::{ChannelManager, SearchSettings};
+    let sim = simulator(0.5);
+    let fs = 2.048e6;
+    let settings = SearchSettings {
+        acq: AcqConfig::default(),
+        weak_fallback: true,
+        reacquisition_interval_s: Some(1.0),
+        prns: Vec::new(),
+        cold_targets: None,
+    };
+    let mut manager = ChannelManager::new(fs, gpsrx_tracking::ChannelConfig::default(), settings)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut samples = vec![Complex32::new(0.0, 0.0); manager.cold_start_samples()];
+    let (first, n) = SimSource::new(&sim)
+        .read(&mut samples)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let found = manager
+        .cold_start(&samples[..n], first)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(found.len() >= 6, "{} found", found.len());
+    assert_eq!(manager.channels().len(), found.len());
+    for d in &found {
+        // Truth Doppler: the rate of the simulated carrier phase at the middle of the search.
+        let sat = sim
+            .satellites
+            .iter()
+            .find(|s| s.prn == d.prn)
+            .unwrap_or_else(|| panic!("{}: not simulated (a false acquisition)", d.prn));
+        let t = n as f64 / fs / 2.0;
+        let (a, _) = sim.observe(sat, t - 0.5e-3);
+        let (b, _) = sim.observe(sat, t + 0.5e-3);
+        let truth_hz = (b.carrier_cycles - a.carrier_cycles) / 1e-3;
+        assert!(
+            (d.doppler_hz - truth_hz).abs() < 100.0,
+            "{}: Doppler {:.0} Hz, truth {truth_hz:.0} Hz",
+            d.prn,
+            d.doppler_hz
+        );
+    }
+}
+
+#[test]
+fn the_navigation_processor_alone_and_the_file_sink_alone_reproduce_a_run() {
+    use gpsrx_receiver::output::FileSink;
+    use gpsrx_receiver::pipeline::navigation::NavigationProcessor;
+    use gpsrx_receiver::pipeline::Tee;
+    let sim = simulator(13.0);
+    let fs = 2.048e6;
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    // A run writing files and keeping every channel report.
+    let mut sink = Tee(
+        FileSink::create(&dir.path().join("run"), 10.0).unwrap_or_else(|e| panic!("{e}")),
+        MemorySink::new().with_channel_epochs(),
+    );
+    let summary = receiver(fs)
+        .run(&mut SimSource::new(&sim), &mut sink)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let Tee(_, memory) = sink;
+    assert!(summary.fixes > 5, "{} fixes", summary.fixes);
+    // The navigation processor on the recorded reports alone (no samples, no tracking) into a
+    // second file sink: the same fixes and the same files.
+    let mut config = ReceiverConfig::default();
+    config.run.tropo = gpsrx_receiver::config::TropoModel::None;
+    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let mut alone = NavigationProcessor::new(
+        fs,
+        config.run.clone(),
+        config.tracking.cn0_lost_dbhz,
+        2190,
+        Some(nav),
+        Vec::new(),
+    );
+    let mut replay = Tee(
+        FileSink::create(&dir.path().join("replay"), 10.0).unwrap_or_else(|e| panic!("{e}")),
+        MemorySink::new(),
+    );
+    for (i, e) in &memory.channel_epochs {
+        alone
+            .on_report(*i, e, None, &mut replay)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    replay
+        .finish(&alone.end())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(replay.1.fixes.len(), memory.fixes.len());
+    for (a, b) in replay.1.fixes.iter().zip(&memory.fixes) {
+        assert_eq!(a.fix.ecef_m, b.fix.ecef_m);
+    }
+    for name in [
+        "pvt.csv",
+        "pvt.nmea",
+        "channels.csv",
+        "track.geojson",
+        "track.kml",
+    ] {
+        let read = |d: &str| {
+            std::fs::read(dir.path().join(d).join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+        };
+        assert_eq!(read("run"), read("replay"), "{name} differs");
+    }
 }
