@@ -218,6 +218,30 @@ fn a_stream_shorter_than_one_search_is_an_error_naming_it() {
 }
 
 #[test]
+fn non_finite_samples_read_as_zero_and_samples_after_the_end_are_refused() {
+    let mut rx = receiver(2.048e6);
+    let mut sink = MemorySink::new();
+    let nan = Complex32::new(f32::NAN, f32::INFINITY);
+    // Half a second of NaN and infinity: no panic, no satellite, no fix.
+    for _ in 0..50 {
+        rx.push(&[nan; 20_480], &mut sink)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    let summary = rx.finish(&mut sink).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        summary.tracked_prns.is_empty(),
+        "{:?}",
+        summary.tracked_prns
+    );
+    assert_eq!(summary.fixes, 0);
+    let err = rx
+        .push(&[Complex32::new(1.0, 0.0); 10], &mut sink)
+        .err()
+        .unwrap_or_else(|| panic!("samples accepted after finish"));
+    assert!(err.to_string().contains("ended"), "{err}");
+}
+
+#[test]
 fn an_invalid_configuration_names_the_setting() {
     let mut config = ReceiverConfig::default();
     config.run.rate_hz = 100.0;

@@ -59,6 +59,9 @@ pub enum ReceiverError {
     /// The INS input cannot be used.
     #[error("INS: {0}")]
     Ins(String),
+    /// Samples after the end of the stream.
+    #[error("the stream has ended (finish was called): make a new Receiver for another stream")]
+    Finished,
 }
 
 /// Inputs beside the samples: assistance data, the INS, landmark ranges.
@@ -116,6 +119,7 @@ pub struct Receiver {
     first_sample: Option<u64>,
     started: std::time::Instant,
     finished: bool,
+    non_finite_said: bool,
 }
 
 impl Receiver {
@@ -182,6 +186,7 @@ impl Receiver {
             first_sample: None,
             started: std::time::Instant::now(),
             finished: false,
+            non_finite_said: false,
         })
     }
 
@@ -228,6 +233,9 @@ impl Receiver {
         source: &mut dyn SampleSource,
         sink: &mut dyn Sink,
     ) -> Result<RunSummary, ReceiverError> {
+        if self.finished {
+            return Err(ReceiverError::Finished);
+        }
         if (source.fs_hz() - self.fs_hz).abs() > 1e-6 * self.fs_hz {
             return Err(ReceiverError::RateMismatch {
                 source_hz: source.fs_hz(),
@@ -269,12 +277,36 @@ impl Receiver {
 
     /// Takes the next samples of the stream (any number: the processing is cut into 10 ms
     /// blocks of the stream, whatever the chunking). The first sample pushed has index 0.
+    ///
+    /// Non-finite values (NaN, infinity) are read as 0, with a warning, as sources do.
     pub fn push(
         &mut self,
         samples: &[Complex32],
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
-        self.window.push(samples);
+        if self.finished {
+            return Err(ReceiverError::Finished);
+        }
+        let finite = |c: &Complex32| c.re.is_finite() && c.im.is_finite();
+        if samples.iter().all(finite) {
+            self.window.push(samples);
+        } else {
+            let clean: Vec<Complex32> = samples
+                .iter()
+                .map(|c| {
+                    if finite(c) {
+                        *c
+                    } else {
+                        Complex32::new(0.0, 0.0)
+                    }
+                })
+                .collect();
+            if !self.non_finite_said {
+                tracing::warn!("non-finite samples (NaN or infinity) pushed: read as 0");
+                self.non_finite_said = true;
+            }
+            self.window.push(&clean);
+        }
         self.first_sample.get_or_insert(self.window.start());
         if self.manager.cold_start_pending() {
             if self.window.end() - self.window.start() < self.cold_samples() {
