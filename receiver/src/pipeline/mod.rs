@@ -22,7 +22,9 @@ pub mod sink;
 pub mod tracker;
 
 pub use channel_manager::SearchSettings;
-pub use receiver::{Assistance, InsAiding, Receiver, ReceiverError, RunSummary};
+pub use receiver::{
+    Assistance, AssistanceError, AssistanceFiles, InsAiding, Receiver, ReceiverError, RunSummary,
+};
 pub use sink::{
     FixReport, MemorySink, NavigationEnd, ObservablesReport, Progress, ReceiverEvent, Sink,
     SinkError, Tee,

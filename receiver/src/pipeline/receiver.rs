@@ -22,6 +22,7 @@ use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_samples::{SampleError, SampleSource};
 use gpsrx_tracking::AidingPort;
 use num_complex::Complex32;
+use std::path::Path;
 
 /// Samples processed per block, as a fraction of a second (10 ms). 40 ms blocks measured no
 /// faster on 2 cores, with more memory.
@@ -73,6 +74,88 @@ pub struct Assistance {
     pub ins: Option<InsAiding>,
     /// Landmark range observations (seed 001).
     pub landmarks: Vec<LandmarkObservation>,
+}
+
+/// The files [`Assistance::read`] takes: each is optional.
+#[derive(Debug, Clone, Default)]
+pub struct AssistanceFiles<'a> {
+    /// A RINEX 2/3 navigation file.
+    pub nav: Option<&'a Path>,
+    /// An INS CSV (`t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps[,gps_tow_s]`, ECEF).
+    pub ins: Option<&'a Path>,
+    /// Longest gap allowed between INS rows, s.
+    pub ins_max_gap_s: f64,
+    /// Band limit of the INS feed-forward, rad/s (seed 004 eq. 8).
+    pub ins_band_limit_rad_s: Option<f64>,
+    /// Read the INS but do not aid the loops (to compare aided and unaided runs).
+    pub no_aiding: bool,
+    /// A landmark CSV (`tow_s,x_m,y_m,z_m,range_m,sigma_m`, seed 001).
+    pub landmarks: Option<&'a Path>,
+}
+
+/// An assistance file that cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum AssistanceError {
+    /// The navigation file.
+    #[error("cannot read the navigation file {path}: {source}")]
+    Nav {
+        /// The file.
+        path: String,
+        /// Why.
+        #[source]
+        source: gpsrx_nav::rinex_nav::RinexError,
+    },
+    /// The INS file.
+    #[error(transparent)]
+    Ins(#[from] gpsrx_ins_aiding::InsError),
+    /// The landmark file.
+    #[error(transparent)]
+    Landmarks(#[from] crate::landmarks::LandmarkError),
+}
+
+impl Assistance {
+    /// Reads the assistance files (each optional), checking each; the INS span is logged.
+    pub fn read(files: &AssistanceFiles<'_>) -> Result<Self, AssistanceError> {
+        let nav = match files.nav {
+            Some(p) => Some(gpsrx_nav::rinex_nav::read_rinex_nav(p).map_err(|source| {
+                AssistanceError::Nav {
+                    path: p.display().to_string(),
+                    source,
+                }
+            })?),
+            None => None,
+        };
+        let landmarks = match files.landmarks {
+            Some(p) => crate::landmarks::read_landmarks(p)?,
+            None => Vec::new(),
+        };
+        let ins = match files.ins {
+            Some(path) => {
+                let track = gpsrx_ins_aiding::read_ins_csv(path, files.ins_max_gap_s)?;
+                let (a, b) = track.span_s();
+                let off = if files.no_aiding {
+                    " (aiding off: --no-aiding)"
+                } else {
+                    ""
+                };
+                tracing::info!(
+                    "INS {}: {} rows from {a:.2} to {b:.2} s{off}",
+                    path.display(),
+                    track.samples().len()
+                );
+                (!files.no_aiding).then_some(InsAiding {
+                    track,
+                    band_limit_rad_s: files.ins_band_limit_rad_s,
+                })
+            }
+            None => None,
+        };
+        Ok(Self {
+            nav,
+            ins,
+            landmarks,
+        })
+    }
 }
 
 /// The INS input of [`Assistance`].

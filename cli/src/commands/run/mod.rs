@@ -8,11 +8,10 @@
 
 use crate::commands::source::open_interruptible;
 use anyhow::Context;
-use gpsrx_ins_aiding::{read_ins_csv, DrParams};
-use gpsrx_nav::rinex_nav::read_rinex_nav;
+use gpsrx_ins_aiding::DrParams;
 use gpsrx_receiver::fusion::gnss::GnssFix;
 use gpsrx_receiver::output::{FileSink, Fix};
-use gpsrx_receiver::pipeline::{FixReport, Progress, Sink, SinkError, Tee};
+use gpsrx_receiver::pipeline::{AssistanceFiles, FixReport, Progress, Sink, SinkError, Tee};
 use gpsrx_receiver::{Assistance, Receiver, RunSummary};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
@@ -60,43 +59,14 @@ impl Sink for CommandSink {
 
 /// The assistance inputs named on the command line.
 fn assistance(args: &RunArgs) -> anyhow::Result<Assistance> {
-    let nav = match &args.nav {
-        Some(p) => Some(
-            read_rinex_nav(p)
-                .with_context(|| format!("cannot read the navigation file {}", p.display()))?,
-        ),
-        None => None,
-    };
-    let landmarks = match &args.landmarks {
-        Some(p) => gpsrx_receiver::landmarks::read_landmarks(p)?,
-        None => Vec::new(),
-    };
-    let ins = match &args.ins {
-        Some(path) => {
-            let track = read_ins_csv(path, args.ins_max_gap)?;
-            let (a, b) = track.span_s();
-            let off = if args.no_aiding {
-                " (aiding off: --no-aiding)"
-            } else {
-                ""
-            };
-            tracing::info!(
-                "INS {}: {} rows from {a:.2} to {b:.2} s{off}",
-                path.display(),
-                track.samples().len()
-            );
-            (!args.no_aiding).then_some(gpsrx_receiver::pipeline::InsAiding {
-                track,
-                band_limit_rad_s: args.ins_band_limit,
-            })
-        }
-        None => None,
-    };
-    Ok(Assistance {
-        nav,
-        ins,
-        landmarks,
-    })
+    Ok(Assistance::read(&AssistanceFiles {
+        nav: args.nav.as_deref(),
+        ins: args.ins.as_deref(),
+        ins_max_gap_s: args.ins_max_gap,
+        ins_band_limit_rad_s: args.ins_band_limit,
+        no_aiding: args.no_aiding,
+        landmarks: args.landmarks.as_deref(),
+    })?)
 }
 
 /// Runs the receiver on the recording of `args`; returns the report and the fixes.
