@@ -38,7 +38,7 @@ if ! command -v volk_gnsssdr_profile >/dev/null || ! command -v gnss-sdr >/dev/n
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends gnss-sdr
 fi
 command -v python3 >/dev/null || die "python3 is required"
-(cd "$ROOT" && cargo build --release -p gpsrx-receiver >&2)
+(cd "$ROOT" && cargo build --release -p gpsrx-cli >&2)
 GPSRX=${CARGO_TARGET_DIR:-$ROOT/target}/release/gpsrx
 [[ -x $GPSRX ]] || die "no binary at $GPSRX"
 

@@ -25,8 +25,8 @@ if [ ! -d "$DATA" ]; then
   exit 0
 fi
 
-cargo build --release -q -p gpsrx-receiver || { bad "cargo build"; echo "cross-check: $pass passed, $fail failed"; exit 1; }
-GPSRX="${CARGO_TARGET_DIR:-$ROOT/target}/release/gpsrx"
+cargo build --profile ci -q -p gpsrx-cli || { bad "cargo build"; echo "cross-check: $pass passed, $fail failed"; exit 1; }
+GPSRX="${CARGO_TARGET_DIR:-$ROOT/target}/ci/gpsrx"
 
 # --- 1. gpsrx info on the real PocketSDR capture: 2,000,000 samples, 0.5 s, values -3,-1,1,3.
 POCKET="$DATA/real/pocketsdr_L1_20211202_084700_4MHz_IQ.bin"

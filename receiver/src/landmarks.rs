@@ -5,7 +5,6 @@
 //! antenna), `sigma_m` (its standard deviation). Each observation joins the fix whose epoch is
 //! within half an epoch interval of `tow_s`.
 
-use anyhow::{bail, Context};
 use gpsrx_nav::frames::Vector3;
 use gpsrx_nav::pvt::Landmark;
 use std::path::Path;
@@ -19,20 +18,28 @@ pub struct LandmarkObservation {
     pub landmark: Landmark,
 }
 
+/// A landmark file that cannot be used: the message names the file, the line and the problem.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct LandmarkError(String);
+
 /// Reads a landmark CSV; bad rows are errors naming the line.
-pub fn read_landmarks(path: &Path) -> anyhow::Result<Vec<LandmarkObservation>> {
+pub fn read_landmarks(path: &Path) -> Result<Vec<LandmarkObservation>, LandmarkError> {
+    let fail = |what: String| LandmarkError(format!("{}: {what}", path.display()));
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
         .from_path(path)
-        .with_context(|| format!("cannot read landmarks {}", path.display()))?;
-    let headers = rdr.headers()?.clone();
+        .map_err(|e| fail(format!("cannot read landmarks: {e}")))?;
+    let headers = rdr
+        .headers()
+        .map_err(|e| fail(format!("no header line: {e}")))?
+        .clone();
     let col = |name: &str| {
-        headers.iter().position(|h| h == name).with_context(|| {
-            format!(
-                "{}: no column `{name}` (need tow_s,x_m,y_m,z_m,range_m,sigma_m)",
-                path.display()
-            )
+        headers.iter().position(|h| h == name).ok_or_else(|| {
+            fail(format!(
+                "no column `{name}` (need tow_s,x_m,y_m,z_m,range_m,sigma_m)"
+            ))
         })
     };
     let idx = [
@@ -46,23 +53,23 @@ pub fn read_landmarks(path: &Path) -> anyhow::Result<Vec<LandmarkObservation>> {
     let mut out = Vec::new();
     for (i, rec) in rdr.records().enumerate() {
         let line = i + 2;
-        let rec = rec.with_context(|| format!("{} line {line}", path.display()))?;
+        let rec = rec.map_err(|e| fail(format!("line {line}: {e}")))?;
         let mut v = [0.0; 6];
         for (k, &c) in idx.iter().enumerate() {
             let field = rec.get(c).unwrap_or("");
             v[k] = match field.parse::<f64>() {
                 Ok(x) if x.is_finite() => x,
-                _ => bail!(
-                    "{} line {line}: `{field}` is not a finite number",
-                    path.display()
-                ),
+                _ => {
+                    return Err(fail(format!(
+                        "line {line}: `{field}` is not a finite number"
+                    )))
+                }
             };
         }
         if v[4] <= 0.0 || v[5] <= 0.0 {
-            bail!(
-                "{} line {line}: range and sigma must be positive",
-                path.display()
-            );
+            return Err(fail(format!(
+                "line {line}: range and sigma must be positive"
+            )));
         }
         out.push(LandmarkObservation {
             tow_s: v[0],

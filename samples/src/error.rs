@@ -76,6 +76,26 @@ pub enum SampleError {
         path: PathBuf,
     },
 
+    /// Samples streamed from standard input, a pipe or a device, without an explicit format or
+    /// sampling rate (a stream has no metadata beside it to take them from).
+    #[error("reading from {stream} needs --format and --fs (a stream has no metadata to take them from): give {missing}")]
+    StreamNeedsFormatAndRate {
+        /// What is being read: "standard input" or the pipe's path.
+        stream: String,
+        /// What was not given: "--format", "--fs" or "--format and --fs".
+        missing: &'static str,
+    },
+
+    /// A pipe or device path that names a metadata-bearing file (`.sigmf-meta`, `.wav`):
+    /// metadata is read only from regular files.
+    #[error("{path} is a pipe or device, not a regular file: {reason}")]
+    NotStreamable {
+        /// The path that was asked for.
+        path: PathBuf,
+        /// Why it cannot be streamed, and what to do.
+        reason: String,
+    },
+
     /// The sampling rate is not positive and finite, or too low to hold the C/A signal.
     #[error("sampling rate {fs_hz} Hz for {path} is {reason}: give --fs in Hz (at least {min_hz} Hz for {kind} samples)")]
     BadSampleRate {

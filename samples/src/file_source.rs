@@ -10,7 +10,9 @@ use crate::error::SampleError;
 use crate::format::SampleFormat;
 use crate::mixer::Mixer;
 use crate::resolve::{resolve, Resolved};
-use crate::source::{SampleSource, SourceConfig};
+use crate::source::{
+    non_finite_warning, to_baseband, trailing_bytes_warning, SampleSource, SourceConfig,
+};
 use crate::span::{bytes_for_samples, sample_position, Span};
 
 /// Streams samples from a file in chunks of at most 1 MiB.
@@ -110,25 +112,24 @@ impl SampleSource for FileSource {
 
     fn read(&mut self, out: &mut [Complex32]) -> Result<(u64, usize), SampleError> {
         let (first, n) = self.read_raw(out)?;
-        let block = &mut out[..n];
-        if self.resolved.invert_q {
-            for s in block.iter_mut() {
-                s.im = -s.im;
-            }
-        }
-        if let Some(m) = &self.mixer {
-            m.mix(first, block);
-        }
+        to_baseband(
+            &mut out[..n],
+            first,
+            self.resolved.invert_q,
+            self.mixer.as_ref(),
+        );
         Ok((first, n))
     }
 
     fn warnings(&self) -> Vec<String> {
         let mut w = self.resolved.warnings.clone();
-        let path = self.resolved.data_path.display();
+        let data_path = &self.resolved.data_path;
+        let path = data_path.display();
         if self.span.trailing_bytes > 0 {
-            w.push(format!(
-                "{path}: the last {} byte(s) do not make a whole {} sample and were dropped",
-                self.span.trailing_bytes, self.resolved.format
+            w.push(trailing_bytes_warning(
+                data_path,
+                self.span.trailing_bytes,
+                &self.resolved.format,
             ));
         }
         if self.span.duration_truncated {
@@ -139,10 +140,7 @@ impl SampleSource for FileSource {
             ));
         }
         if self.non_finite > 0 {
-            w.push(format!(
-                "{path}: {} non-finite value(s) (NaN or infinity) read as 0",
-                self.non_finite
-            ));
+            w.push(non_finite_warning(data_path, self.non_finite));
         }
         w
     }

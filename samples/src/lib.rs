@@ -3,6 +3,7 @@
 //!
 //! - [`format`](mod@format): the sample formats and their names (table there);
 //! - [`source`]: [`source::open_source`] streams complex baseband from any recording;
+//! - [`stream_source`]: [`ReaderSource`] reads standard input, a pipe or any `std::io::Read`;
 //! - [`writer`]: [`writer::create_writer`] / [`writer::create_wav_writer`];
 //! - [`sigmf`]: `.sigmf-meta` read/write; [`wav`]: WAV layout;
 //! - [`info`]: statistics, histogram and spectrum of a recording (`gpsrx info`).
@@ -22,10 +23,12 @@ pub mod sim;
 pub mod source;
 pub mod span;
 mod spectrum;
+pub mod stream_source;
 pub mod wav;
 pub mod writer;
 
 pub use error::SampleError;
 pub use format::SampleFormat;
 pub use source::{open_source, SampleSource, SourceConfig};
+pub use stream_source::ReaderSource;
 pub use writer::{create_wav_writer, create_writer, SampleWriter, WriteStats};

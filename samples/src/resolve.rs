@@ -121,6 +121,19 @@ pub fn validate_rates(
     Ok(())
 }
 
+/// Checks a sample format and the rates it is read at, as every source does before reading:
+/// the format's own parameters ([`SampleFormat::validate`]), then fs and IF
+/// ([`validate_rates`]). Errors name `path`.
+pub fn validate_format_and_rates(
+    path: &Path,
+    format: &SampleFormat,
+    fs_hz: f64,
+    if_hz: f64,
+) -> Result<(), SampleError> {
+    format.validate()?;
+    validate_rates(path, format, fs_hz, if_hz)
+}
+
 /// Resolves `cfg` into a readable recording (see the module documentation).
 pub fn resolve(cfg: &SourceConfig) -> Result<Resolved, SampleError> {
     let path = &cfg.path;
@@ -156,7 +169,6 @@ pub fn resolve(cfg: &SourceConfig) -> Result<Resolved, SampleError> {
         (None, Some((d, _))) => d?,
         (None, None) => return Err(SampleError::FormatUnknown { path: path.clone() }),
     };
-    format.validate()?;
 
     // Sampling rate likewise.
     let described_fs = meta
@@ -180,7 +192,7 @@ pub fn resolve(cfg: &SourceConfig) -> Result<Resolved, SampleError> {
         (_, if_hz) => if_hz,
     };
     let invert_q = cfg.invert_q || meta.as_ref().is_some_and(|m| m.invert_q);
-    validate_rates(path, &format, fs_hz, if_hz)?;
+    validate_format_and_rates(path, &format, fs_hz, if_hz)?;
 
     let file_len = std::fs::metadata(&data_path)
         .map_err(|e| SampleError::io("read the size of", &data_path, e))?

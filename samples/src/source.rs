@@ -4,18 +4,22 @@
 //! against what GPS L1 C/A needs, and returns a [`SampleSource`] that reads the file in bounded
 //! chunks (1 MiB) at `u64` offsets, so files beyond 4 GiB stream like small ones.
 
-use std::path::PathBuf;
+use std::fs::File;
+use std::path::{Path, PathBuf};
 
 use num_complex::Complex32;
 
 use crate::error::SampleError;
 use crate::file_source::FileSource;
 use crate::format::SampleFormat;
+use crate::mixer::Mixer;
+use crate::stream_source::{is_stdin_path, ReaderSource, StreamPlan};
 
 /// How to read one recording. Unset fields come from metadata beside the file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SourceConfig {
-    /// The data file, or its `.sigmf-meta`.
+    /// The data file, or its `.sigmf-meta`; `-` for standard input; or a named pipe or device
+    /// (streams need `format` and `fs_hz`).
     pub path: PathBuf,
     /// Sample format; `None` = from SigMF metadata or a WAV header.
     pub format: Option<SampleFormat>,
@@ -82,12 +86,95 @@ pub trait SampleSource: Send {
     fn warnings(&self) -> Vec<String>;
 }
 
+/// Turns decoded samples into complex baseband the way every source does: negates Q when
+/// asked, then mixes by the oscillator at absolute index `first` (so the result does not depend
+/// on which source delivered the block).
+pub(crate) fn to_baseband(
+    block: &mut [Complex32],
+    first: u64,
+    invert_q: bool,
+    mixer: Option<&Mixer>,
+) {
+    if invert_q {
+        for s in block.iter_mut() {
+            s.im = -s.im;
+        }
+    }
+    if let Some(m) = mixer {
+        m.mix(first, block);
+    }
+}
+
+/// The warning for bytes after the last whole sample.
+pub(crate) fn trailing_bytes_warning(
+    name: &Path,
+    trailing_bytes: u64,
+    format: &SampleFormat,
+) -> String {
+    format!(
+        "{}: the last {trailing_bytes} byte(s) do not make a whole {format} sample and were dropped",
+        name.display()
+    )
+}
+
+/// The warning for NaN or infinite values read as 0.
+pub(crate) fn non_finite_warning(name: &Path, non_finite: u64) -> String {
+    format!(
+        "{}: {non_finite} non-finite value(s) (NaN or infinity) read as 0",
+        name.display()
+    )
+}
+
 /// Opens a recording described by `cfg` (see [`crate::resolve`] for where the format and rate
 /// come from when `cfg` does not give them).
 ///
+/// - `cfg.path` = `-`: standard input, streamed by a [`ReaderSource`];
+/// - a path that exists but is neither a regular file nor a directory (a named pipe from
+///   `mkfifo`, `/dev/stdin` on a pipe, a device): opened and streamed by a [`ReaderSource`]
+///   (opening a named pipe waits for its writer);
+/// - a regular file: a [`FileSource`], with metadata as described in [`crate::resolve`].
+///
+/// Streams need `cfg.format` and `cfg.fs_hz` (there is no metadata on a pipe) and cannot be
+/// named `.sigmf-meta` or `.wav` (metadata is read from regular files only); see
+/// [`crate::stream_source`] for how they differ from files.
+///
 /// Errors: missing or unreadable file, empty file, unknown format or rate, a sampling rate below
 /// 1.023 MHz (complex) / 2.046 MHz (real), an IF beyond fs/2 (or not in (0, fs/2) for real
-/// samples), a skip beyond the end, SigMF metadata without its data file.
+/// samples), a skip beyond the end, SigMF metadata without its data file; for a stream, a
+/// missing format or rate (an empty stream or a skip beyond its end is reported by the first
+/// `read`).
 pub fn open_source(cfg: &SourceConfig) -> Result<Box<dyn SampleSource>, SampleError> {
+    if is_stdin_path(&cfg.path) {
+        let plan = StreamPlan::new(cfg)?;
+        return Ok(Box::new(ReaderSource::with_plan(std::io::stdin(), plan)));
+    }
+    // A missing path falls through to `FileSource`, which reports it.
+    if let Ok(meta) = std::fs::metadata(&cfg.path) {
+        let kind = meta.file_type();
+        if !kind.is_file() && !kind.is_dir() {
+            return open_stream_path(cfg);
+        }
+    }
     Ok(Box::new(FileSource::open(cfg)?))
+}
+
+/// Streams a pipe or device path through a [`ReaderSource`].
+fn open_stream_path(cfg: &SourceConfig) -> Result<Box<dyn SampleSource>, SampleError> {
+    let path = &cfg.path;
+    let names_metadata = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("sigmf-meta") || e.eq_ignore_ascii_case("wav"));
+    if names_metadata {
+        return Err(SampleError::NotStreamable {
+            path: path.clone(),
+            reason: "SigMF metadata and WAV headers are read from regular files only: \
+                     stream the raw samples instead and give --format and --fs"
+                .to_string(),
+        });
+    }
+    // Check the configuration first: opening a named pipe blocks until a writer opens it.
+    let plan = StreamPlan::new(cfg)?;
+    let file = File::open(path).map_err(|e| SampleError::io("open", path, e))?;
+    Ok(Box::new(ReaderSource::with_plan(file, plan)))
 }

@@ -60,6 +60,28 @@ pub fn seconds_to_samples(t_s: f64, fs_hz: f64) -> u64 {
     }
 }
 
+/// Checks a skip and a duration: both finite and non-negative (errors name `path`).
+pub fn validate_times(
+    path: &Path,
+    skip_s: f64,
+    duration_s: Option<f64>,
+) -> Result<(), SampleError> {
+    let bad = |what, value| SampleError::BadTimeSpan {
+        path: path.to_path_buf(),
+        what,
+        value,
+    };
+    if !(skip_s.is_finite() && skip_s >= 0.0) {
+        return Err(bad("skip", skip_s));
+    }
+    if let Some(d) = duration_s {
+        if !(d.is_finite() && d >= 0.0) {
+            return Err(bad("duration", d));
+        }
+    }
+    Ok(())
+}
+
 impl Span {
     /// Plans which samples to deliver from `data_bytes` bytes of `format` data at `fs_hz`,
     /// skipping `skip_s` seconds and keeping `duration_s` seconds (to the end when `None`).
@@ -73,19 +95,7 @@ impl Span {
         skip_s: f64,
         duration_s: Option<f64>,
     ) -> Result<Span, SampleError> {
-        let bad = |what, value| SampleError::BadTimeSpan {
-            path: path.to_path_buf(),
-            what,
-            value,
-        };
-        if !(skip_s.is_finite() && skip_s >= 0.0) {
-            return Err(bad("skip", skip_s));
-        }
-        if let Some(d) = duration_s {
-            if !(d.is_finite() && d >= 0.0) {
-                return Err(bad("duration", d));
-            }
-        }
+        validate_times(path, skip_s, duration_s)?;
         let (file_samples, trailing_bytes) = samples_in_bytes(format, data_bytes);
         if file_samples == 0 {
             return Err(SampleError::EmptyFile {

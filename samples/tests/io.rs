@@ -927,3 +927,404 @@ fn writer_and_reader_throughput() {
         );
     }
 }
+
+/// `ReaderSource`: the same samples as `FileSource` from any reader, skip/duration on a stream,
+/// the errors a stream gives, and a named pipe through `open_source`.
+mod stream {
+    use std::io::{ErrorKind, Read};
+    use std::path::Path;
+
+    use gpsrx_samples::file_source::FileSource;
+    use gpsrx_samples::{
+        open_source, ReaderSource, SampleError, SampleFormat, SampleSource, SourceConfig,
+    };
+    use num_complex::Complex32;
+    use rand::{Rng, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    use super::{c, read_all, FS};
+
+    /// A reader over bytes that returns 1..=`max` bytes per call (seeded) and now and then
+    /// fails with `Interrupted`, as a pipe may.
+    struct Trickle {
+        data: Vec<u8>,
+        at: usize,
+        max: usize,
+        rng: Xoshiro256PlusPlus,
+    }
+
+    impl Trickle {
+        fn new(data: Vec<u8>, max: usize, seed: u64) -> Self {
+            Trickle {
+                data,
+                at: 0,
+                max,
+                rng: Xoshiro256PlusPlus::seed_from_u64(seed),
+            }
+        }
+    }
+
+    impl Read for Trickle {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            if self.rng.random_range(0..10) == 0 {
+                return Err(std::io::Error::from(ErrorKind::Interrupted));
+            }
+            let n = self
+                .rng
+                .random_range(1..=self.max)
+                .min(buf.len())
+                .min(self.data.len() - self.at);
+            buf[..n].copy_from_slice(&self.data[self.at..self.at + n]);
+            self.at += n;
+            Ok(n)
+        }
+    }
+
+    /// Every `read` call's (first, n), and all samples, with buffer sizes drawn from `seed`.
+    type Calls = (Vec<(u64, usize)>, Vec<Complex32>);
+
+    fn read_in_random_blocks(
+        src: &mut dyn SampleSource,
+        max_block: usize,
+        seed: u64,
+    ) -> Result<Calls, SampleError> {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut calls = Vec::new();
+        let mut all = Vec::new();
+        let mut buf = vec![Complex32::default(); max_block];
+        loop {
+            let len = rng.random_range(1..=max_block);
+            let (first, n) = src.read(&mut buf[..len])?;
+            calls.push((first, n));
+            if n == 0 {
+                return Ok((calls, all));
+            }
+            all.extend_from_slice(&buf[..n]);
+        }
+    }
+
+    fn bits(x: &[Complex32]) -> Vec<(u32, u32)> {
+        x.iter().map(|s| (s.re.to_bits(), s.im.to_bits())).collect()
+    }
+
+    fn random_bytes(n: usize, seed: u64) -> Vec<u8> {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        (0..n).map(|_| rng.random::<u8>()).collect()
+    }
+
+    /// Reads `bytes` as a file and as a stream (trickled, or in large pieces) under `cfg`, with
+    /// the same sequence of read sizes, and checks both deliver the same bits at the same
+    /// indices, and the same warnings when read to the end.
+    fn compare(bytes: &[u8], cfg: &SourceConfig, trickle_max: usize, block_max: usize, seed: u64) {
+        std::fs::write(&cfg.path, bytes).expect("write");
+        let what = format!(
+            "{} skip {} dur {:?} if {} inv {}",
+            cfg.format.as_ref().map_or("?".into(), SampleFormat::name),
+            cfg.skip_s,
+            cfg.duration_s,
+            cfg.if_hz,
+            cfg.invert_q
+        );
+        let mut file = FileSource::open(cfg).expect("open file");
+        let reader = Trickle::new(bytes.to_vec(), trickle_max, seed ^ 0x5eed);
+        let mut stream = ReaderSource::new(reader, cfg).expect("open stream");
+        assert_eq!(stream.fs_hz(), file.fs_hz());
+        assert_eq!(stream.format(), file.format());
+        let (calls_f, x_f) = read_in_random_blocks(&mut file, block_max, seed).expect("file");
+        let (calls_s, x_s) = read_in_random_blocks(&mut stream, block_max, seed).expect("stream");
+        assert!(!x_f.is_empty(), "{what}");
+        assert_eq!(calls_s, calls_f, "{what}: indices");
+        assert!(bits(&x_s) == bits(&x_f), "{what}: samples differ");
+        if cfg.duration_s.is_some() {
+            assert_eq!(stream.total_samples(), file.total_samples(), "{what}");
+        } else {
+            assert_eq!(stream.total_samples(), None, "{what}");
+            assert_eq!(stream.warnings(), file.warnings(), "{what}: warnings");
+        }
+    }
+
+    #[test]
+    fn stream_matches_file_source_bit_for_bit() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let cases: [(SampleFormat, f64, bool); 9] = [
+            (SampleFormat::Ci8, 0.0, false),
+            (SampleFormat::cu8(), 0.0, false),
+            (SampleFormat::Ci16Le, -0.7e6, true),
+            (SampleFormat::Cf32Le, 0.0, true),
+            (SampleFormat::Ri8, 1.1e6, false),
+            (SampleFormat::ci2(), 0.0, false),
+            (SampleFormat::ci2(), 0.3e6, true),
+            (SampleFormat::ri2(), 1.25e6, false),
+            (SampleFormat::Packed1Complex, 0.0, false),
+        ];
+        let spans = [
+            (0u64, None),
+            (37, Some(5000u64)),
+            (1001, None),
+            (3, Some(1)),
+        ];
+        for (k, (format, if_hz, invert_q)) in cases.into_iter().enumerate() {
+            // Random bytes: every code, NaN and infinity for floats, a trailing partial
+            // sample for the multi-byte formats.
+            let bytes = random_bytes(40_003, k as u64);
+            for (j, &(skip, dur)) in spans.iter().enumerate() {
+                let cfg = SourceConfig {
+                    if_hz,
+                    invert_q,
+                    skip_s: skip as f64 / FS,
+                    duration_s: dur.map(|d| d as f64 / FS),
+                    ..SourceConfig::new(dir.path().join(format!("rec{k}")))
+                        .with_format(format.clone())
+                        .with_fs_hz(FS)
+                };
+                compare(&bytes, &cfg, 7, 2000, (k * 10 + j) as u64);
+            }
+        }
+    }
+
+    #[test]
+    fn stream_crosses_the_1_mib_buffer_like_a_file() {
+        // 3 MiB of ci2 (6.3 M samples): reads larger than the buffer, pieces of up to 300 kB.
+        let dir = tempfile::tempdir().expect("tempdir");
+        let bytes = random_bytes(3 << 20, 99);
+        for format in [SampleFormat::ci2(), SampleFormat::Ci16Le] {
+            let cfg = SourceConfig {
+                skip_s: 12_345.0 / FS,
+                ..SourceConfig::new(dir.path().join(format.name()))
+                    .with_format(format.clone())
+                    .with_fs_hz(FS)
+            };
+            compare(&bytes, &cfg, 300_000, 3_000_000, 7);
+        }
+    }
+
+    fn ci8_ramp(n: usize) -> Vec<u8> {
+        (0..n)
+            .flat_map(|k| [(k % 100) as u8, (k / 100) as u8])
+            .collect()
+    }
+
+    fn ci8_cfg() -> SourceConfig {
+        SourceConfig::new("-")
+            .with_format(SampleFormat::Ci8)
+            .with_fs_hz(FS)
+    }
+
+    #[test]
+    fn stream_skip_and_duration() {
+        let bytes = ci8_ramp(1000);
+        let cfg = SourceConfig {
+            skip_s: 100.0 / FS,
+            duration_s: Some(50.0 / FS),
+            ..ci8_cfg()
+        };
+        let mut src = ReaderSource::new(Trickle::new(bytes.clone(), 7, 1), &cfg).expect("new");
+        assert_eq!(src.total_samples(), Some(50));
+        let mut buf = vec![Complex32::default(); 64];
+        let (first, n) = src.read(&mut buf).expect("read");
+        assert_eq!((first, n), (100, 50));
+        for (k, s) in buf[..n].iter().enumerate() {
+            let idx = 100 + k;
+            assert_eq!(*s, c((idx % 100) as f32, (idx / 100) as f32));
+        }
+        assert_eq!(src.read(&mut buf).expect("read"), (150, 0));
+        assert!(src.warnings().is_empty(), "{:?}", src.warnings());
+
+        // No duration: to the end, length unknown.
+        let cfg = SourceConfig {
+            skip_s: 990.0 / FS,
+            ..ci8_cfg()
+        };
+        let mut src = ReaderSource::new(Trickle::new(bytes.clone(), 7, 2), &cfg).expect("new");
+        assert_eq!(src.total_samples(), None);
+        let y = read_all(&mut src).expect("read");
+        assert_eq!(y.len(), 10);
+        assert_eq!(y[0], c(90.0, 9.0));
+
+        // A duration past the end: what is there, with a warning.
+        let cfg = SourceConfig {
+            skip_s: 900.0 / FS,
+            duration_s: Some(500.0 / FS),
+            ..ci8_cfg()
+        };
+        let mut src = ReaderSource::new(Trickle::new(bytes.clone(), 7, 3), &cfg).expect("new");
+        assert_eq!(src.total_samples(), Some(500));
+        assert_eq!(read_all(&mut src).expect("read").len(), 100);
+        assert_eq!(src.total_samples(), Some(100));
+        let w = src.warnings();
+        assert!(
+            w.iter()
+                .any(|w| w.contains("standard input") && w.contains("read 100 samples")),
+            "{w:?}"
+        );
+
+        // A skip beyond the end, and an empty stream, fail at the first read.
+        let cfg = SourceConfig {
+            skip_s: 1000.0 / FS,
+            ..ci8_cfg()
+        };
+        let mut src = ReaderSource::new(Trickle::new(bytes, 7, 4), &cfg).expect("new");
+        let e = src.read(&mut buf).expect_err("skip beyond the end");
+        assert!(matches!(e, SampleError::SkipBeyondEnd { .. }), "{e}");
+        assert!(e.to_string().contains("1000 samples"), "{e}");
+        let mut src = ReaderSource::new(Trickle::new(vec![7], 7, 5), &ci8_cfg()).expect("new");
+        let e = src.read(&mut buf).expect_err("empty");
+        assert!(matches!(e, SampleError::EmptyFile { .. }), "{e}");
+        assert!(e.to_string().contains("standard input is empty"), "{e}");
+
+        // Bad times are refused up front, like for a file.
+        let e = ReaderSource::new(
+            std::io::empty(),
+            &SourceConfig {
+                skip_s: -1.0,
+                ..ci8_cfg()
+            },
+        )
+        .expect_err("negative skip");
+        assert!(e.to_string().contains("skip = -1"), "{e}");
+    }
+
+    #[test]
+    fn stream_needs_format_and_rate() {
+        let err = |cfg: &SourceConfig| match open_source(cfg) {
+            Ok(_) => panic!("expected an error for {cfg:?}"),
+            Err(e) => e,
+        };
+        let e = err(&SourceConfig::new("-"));
+        assert!(matches!(e, SampleError::StreamNeedsFormatAndRate { .. }));
+        let msg = e.to_string();
+        assert!(
+            msg.contains("reading from standard input needs --format and --fs")
+                && msg.contains("give --format and --fs"),
+            "{msg}"
+        );
+        let msg = err(&SourceConfig::new("-").with_format(SampleFormat::Ci8)).to_string();
+        assert!(msg.ends_with("give --fs"), "{msg}");
+        let msg = err(&SourceConfig::new("-").with_fs_hz(FS)).to_string();
+        assert!(msg.ends_with("give --format"), "{msg}");
+
+        // Rate and IF are checked as for a file.
+        let msg = err(&SourceConfig {
+            fs_hz: Some(1.0e6),
+            ..ci8_cfg()
+        })
+        .to_string();
+        assert!(
+            msg.contains("too low for GPS L1 C/A") && msg.contains("standard input"),
+            "{msg}"
+        );
+        let ri8 = ci8_cfg().with_format(SampleFormat::Ri8);
+        let e = err(&ri8);
+        assert!(matches!(e, SampleError::IfOutOfRange { .. }), "{e}");
+        assert!(e.to_string().contains("0 < IF < fs/2"), "{e}");
+
+        // Opening standard input reads nothing yet.
+        let src = open_source(&ci8_cfg()).expect("stdin");
+        assert_eq!((src.fs_hz(), src.total_samples()), (FS, None));
+    }
+
+    #[test]
+    fn stream_trailing_partial_sample_is_dropped_with_a_warning() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("odd.ci16");
+        let bytes = vec![1, 0, 2, 0, 3, 0, 4, 0, 9, 9, 9];
+        std::fs::write(&path, &bytes).expect("write");
+        let cfg = SourceConfig::new(&path)
+            .with_format(SampleFormat::Ci16Le)
+            .with_fs_hz(FS);
+        let mut src = ReaderSource::new(Trickle::new(bytes, 7, 11), &cfg).expect("new");
+        assert!(src.warnings().is_empty());
+        assert_eq!(
+            read_all(&mut src).expect("read"),
+            vec![c(1.0, 2.0), c(3.0, 4.0)]
+        );
+        let w = src.warnings();
+        assert!(w.iter().any(|w| w.contains("last 3 byte(s)")), "{w:?}");
+        let file = FileSource::open(&cfg).expect("file");
+        assert_eq!(w, file.warnings());
+    }
+
+    fn mkfifo(path: &Path) -> bool {
+        match std::process::Command::new("mkfifo").arg(path).status() {
+            Ok(s) if s.success() => true,
+            other => {
+                eprintln!("skip: cannot run mkfifo ({other:?})");
+                false
+            }
+        }
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn fifo_streams_through_open_source() {
+        use std::io::Write;
+
+        let dir = tempfile::tempdir().expect("tempdir");
+        let fifo = dir.path().join("live.ci2");
+        if !mkfifo(&fifo) {
+            return;
+        }
+        let bytes = random_bytes(300_001, 21);
+        let cfg = SourceConfig {
+            skip_s: 5.0 / FS,
+            if_hz: 0.25e6,
+            ..SourceConfig::new(&fifo)
+                .with_format(SampleFormat::ci2())
+                .with_fs_hz(FS)
+        };
+
+        // Configuration errors come before the pipe is opened (which would wait for a writer).
+        let e = match open_source(&SourceConfig::new(&fifo)) {
+            Ok(_) => panic!("a pipe without --format must fail"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("live.ci2") && e.contains("needs --format and --fs"),
+            "{e}"
+        );
+        let meta = dir.path().join("live.sigmf-meta");
+        if !mkfifo(&meta) {
+            return;
+        }
+        let e = match open_source(&SourceConfig {
+            path: meta,
+            ..cfg.clone()
+        }) {
+            Ok(_) => panic!("SigMF metadata is file-only"),
+            Err(e) => e,
+        };
+        assert!(matches!(e, SampleError::NotStreamable { .. }), "{e}");
+
+        let writer = {
+            let (fifo, bytes) = (fifo.clone(), bytes.clone());
+            std::thread::spawn(move || -> std::io::Result<()> {
+                let mut f = std::fs::OpenOptions::new().write(true).open(&fifo)?;
+                for piece in bytes.chunks(70_001) {
+                    f.write_all(piece)?;
+                    f.flush()?;
+                    std::thread::sleep(std::time::Duration::from_millis(5));
+                }
+                Ok(())
+            })
+        };
+        let mut src = open_source(&cfg).expect("open the pipe");
+        assert_eq!(src.total_samples(), None);
+        let streamed = read_all(src.as_mut());
+        writer
+            .join()
+            .expect("writer thread")
+            .expect("write the pipe");
+        let streamed = streamed.expect("read the pipe");
+
+        let plain = dir.path().join("plain.ci2");
+        std::fs::write(&plain, &bytes).expect("write");
+        let mut file = open_source(&SourceConfig {
+            path: plain,
+            ..cfg.clone()
+        })
+        .expect("open the file");
+        let expected = read_all(file.as_mut()).expect("read the file");
+        assert_eq!(streamed.len(), 600_002 - 5);
+        assert!(bits(&streamed) == bits(&expected), "pipe and file differ");
+    }
+}

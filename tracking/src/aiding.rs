@@ -9,6 +9,7 @@
 //! Doppler / 1540) plus the DLL correction, so the feed-forward reaches the code NCO too.
 
 use gpsrx_dsp::constants::{CARRIER_CYCLES_PER_CHIP, CA_CHIP_RATE_HZ, LAMBDA_L1_M};
+use gpsrx_dsp::Prn;
 
 /// An external Doppler estimate for one integration interval.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -32,6 +33,30 @@ impl DopplerAid {
         } else {
             0.0
         }
+    }
+}
+
+/// The aiding port of the tracking channels: where an external Doppler estimate comes from.
+///
+/// The receiver asks it for every channel at the start of every code period (seed 004 Fig. 4:
+/// the INS Doppler is fed forward beside the loop filter); an implementation turns an INS
+/// velocity, an ephemeris and a position into the line-of-sight Doppler of each satellite.
+/// `None` means no aid for that satellite at that time (the loop runs unaided).
+///
+/// Closures `Fn(Prn, f64) -> Option<DopplerAid>` implement it, for tests and studies that know
+/// the truth.
+pub trait AidingPort: Sync {
+    /// The aid for satellite `prn` at receive time `t_s` (seconds from the first sample of the
+    /// recording).
+    fn doppler_aid(&self, prn: Prn, t_s: f64) -> Option<DopplerAid>;
+}
+
+impl<F> AidingPort for F
+where
+    F: Fn(Prn, f64) -> Option<DopplerAid> + Sync,
+{
+    fn doppler_aid(&self, prn: Prn, t_s: f64) -> Option<DopplerAid> {
+        self(prn, t_s)
     }
 }
 

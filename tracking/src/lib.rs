@@ -34,7 +34,7 @@ pub mod loop_analysis;
 pub mod loop_filter;
 pub mod phase_sim;
 
-pub use aiding::DopplerAid;
+pub use aiding::{AidingPort, DopplerAid};
 pub use bit_sync::{Bit, BitSync, BitSyncConfig, BitSyncState};
 pub use carrier_loop::{CarrierLoop, CarrierOutput};
 pub use channel::{Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState};

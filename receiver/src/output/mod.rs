@@ -13,6 +13,7 @@
 //! [`OutputError`]. Bad values (NaN, out-of-range numbers) never panic: they are written as
 //! empty fields where the format allows it and reported as errors where it does not.
 
+pub mod file_sink;
 pub mod geojson;
 pub mod kml;
 pub mod nmea;
@@ -25,6 +26,7 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
+pub use file_sink::FileSink;
 pub use geojson::write_geojson;
 pub use kml::write_kml;
 pub use nmea::{NmeaOptions, NmeaWriter};

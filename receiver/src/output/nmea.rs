@@ -280,6 +280,11 @@ impl<W: Write> NmeaWriter<W> {
             .map_err(OutputError::io(&self.file))
     }
 
+    /// Pushes what was written so far to the destination (a live stream, line by line).
+    pub fn flush(&mut self) -> Result<(), OutputError> {
+        self.out.flush().map_err(OutputError::io(&self.file))
+    }
+
     /// Flushes and returns the destination.
     pub fn finish(mut self) -> Result<W, OutputError> {
         self.out.flush().map_err(OutputError::io(&self.file))?;

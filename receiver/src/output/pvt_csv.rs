@@ -122,6 +122,11 @@ impl<W: Write> PvtCsvWriter<W> {
         self.out.write_record(&row).map_err(csv_err(&self.file))
     }
 
+    /// Pushes the rows written so far to the destination.
+    pub fn flush(&mut self) -> Result<(), OutputError> {
+        self.out.flush().map_err(OutputError::io(&self.file))
+    }
+
     /// Flushes and returns the destination.
     pub fn finish(self) -> Result<W, OutputError> {
         let file = self.file;
@@ -174,6 +179,11 @@ impl<W: Write> ChannelCsvWriter<W> {
             flag(row.frame_sync),
         ];
         self.out.write_record(&record).map_err(csv_err(&self.file))
+    }
+
+    /// Pushes the rows written so far to the destination.
+    pub fn flush(&mut self) -> Result<(), OutputError> {
+        self.out.flush().map_err(OutputError::io(&self.file))
     }
 
     /// Flushes and returns the destination.

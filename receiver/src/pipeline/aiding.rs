@@ -329,3 +329,9 @@ impl Knowledge {
         }
     }
 }
+
+impl gpsrx_tracking::AidingPort for InsFeedForward {
+    fn doppler_aid(&self, prn: gpsrx_dsp::Prn, t_s: f64) -> Option<DopplerAid> {
+        self.aid(prn.get(), t_s)
+    }
+}

@@ -41,6 +41,15 @@ impl<'a> SampleView<'a> {
         self.start + self.data.len() as u64
     }
 
+    /// The samples before `limit` only (none when `limit` is at or before the start).
+    pub fn until(self, limit: u64) -> SampleView<'a> {
+        let n = limit.saturating_sub(self.start).min(self.data.len() as u64) as usize;
+        SampleView {
+            start: self.start,
+            data: &self.data[..n],
+        }
+    }
+
     /// Samples `[from, from + len)` if all are held.
     pub fn get(&self, from: u64, len: usize) -> Option<&'a [Complex32]> {
         if from < self.start || from + len as u64 > self.end() {
@@ -101,6 +110,16 @@ impl SampleWindow {
             self.tail -= self.head;
             self.head = 0;
         }
+    }
+
+    /// Appends samples that follow the ones held (a stream pushed block by block).
+    pub fn push(&mut self, samples: &[Complex32]) {
+        if self.data.len() < self.tail + samples.len() {
+            self.data
+                .resize(self.tail + samples.len(), Complex32::new(0.0, 0.0));
+        }
+        self.data[self.tail..self.tail + samples.len()].copy_from_slice(samples);
+        self.tail += samples.len();
     }
 
     /// Reads up to `n` more samples from `src`; returns how many arrived (0 at the end).

@@ -4,7 +4,7 @@
 //!
 //! - static: a fixed ECEF point;
 //! - CSV: natural cubic splines through the given positions (C2 by construction);
-//! - built-in motions ([`motion`]): vehicle manoeuvres (cruise, accelerate, jerk, turn, stop) on
+//! - built-in motions (`motion`): vehicle manoeuvres (cruise, accelerate, jerk, turn, stop) on
 //!   roads of given grade in the local level (ENU) frame of the start point, integrated with RK4
 //!   at 1 ms and evaluated between steps by quintic Hermite interpolation of position, velocity
 //!   and acceleration (C2). The local frame is a plane tangent at the start, so the height above

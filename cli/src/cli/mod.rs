@@ -1,0 +1,267 @@
+//! Command-line arguments of `gpsrx`.
+
+mod acquire;
+mod bench;
+mod run;
+mod track;
+
+pub use acquire::AcquireArgs;
+pub use bench::BenchArgs;
+pub use run::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
+pub use track::TrackArgs;
+
+use clap::{Args, Parser, Subcommand};
+use gpsrx_receiver::ReceiverConfig;
+use gpsrx_samples::{SampleFormat, SourceConfig};
+use std::path::PathBuf;
+
+/// gpsrx: a GPS L1 C/A software receiver with INS-aided tracking loops.
+#[derive(Debug, Parser)]
+#[command(name = "gpsrx", version)]
+pub struct Cli {
+    /// More log output (or set GPSRX_LOG=debug).
+    #[arg(short, long, global = true)]
+    pub verbose: bool,
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate GPS L1 C/A IF samples (and truth files) from a scenario file.
+    Simulate(SimulateArgs),
+    /// Describe a recording: size, duration, statistics, histogram and spectrum.
+    Info(InfoArgs),
+    /// Simulate the built-in demo scenario and show what was made.
+    Demo(DemoArgs),
+    /// Search a recording for satellites (FFT parallel code-phase search).
+    Acquire(AcquireArgs),
+    /// Acquire and track satellites; write every integration interval to CSV.
+    Track(TrackArgs),
+    /// Process a recording into position fixes and standard files (RINEX, NMEA, GeoJSON, KML, CSV).
+    Run(RunArgs),
+    /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
+    Config(ConfigArgs),
+    /// Loop studies: steady-state errors, bandwidth vs noise, high dynamics (seed 004).
+    Study(gpsrx_studies::StudyArgs),
+    /// Measure this machine: correlator kernels, acquisition, end-to-end real-time factor.
+    Bench(BenchArgs),
+}
+
+/// `gpsrx config`.
+#[derive(Debug, Args)]
+pub struct ConfigArgs {
+    /// Print the default, commented gpsrx.toml.
+    #[arg(long)]
+    pub default: bool,
+}
+
+/// Options that say how to read a recording; shared by every subcommand that reads one.
+#[derive(Debug, Clone, Args)]
+pub struct SourceArgs {
+    /// The recording (raw samples, .wav, or SigMF .sigmf-meta/.sigmf-data).
+    pub file: PathBuf,
+    /// Sample format: ci8, cu8, ci16_le, cf32_le, cf64_le, ri8, ri16_le, rf32_le, ci2, ri2, ci1
+    /// (default: from SigMF or WAV metadata).
+    #[arg(long)]
+    pub format: Option<String>,
+    /// Sampling rate, Hz (default: from SigMF or WAV metadata).
+    #[arg(long, value_name = "HZ")]
+    pub fs: Option<f64>,
+    /// Intermediate frequency, Hz (real IF is mixed down to baseband).
+    #[arg(
+        long = "if",
+        value_name = "HZ",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub if_hz: f64,
+    /// Read the samples as I - jQ (some front ends invert Q).
+    #[arg(long)]
+    pub invert_q: bool,
+    /// Skip this many seconds from the start of the file.
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub skip: f64,
+    /// Read at most this many seconds.
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+}
+
+impl SourceArgs {
+    /// The sample-source configuration these options describe.
+    pub fn to_config(&self) -> anyhow::Result<SourceConfig> {
+        let format = match &self.format {
+            Some(f) => Some(f.parse::<SampleFormat>()?),
+            None => None,
+        };
+        Ok(SourceConfig {
+            path: self.file.clone(),
+            format,
+            fs_hz: self.fs,
+            if_hz: self.if_hz,
+            invert_q: self.invert_q,
+            skip_s: self.skip,
+            duration_s: self.duration,
+        })
+    }
+}
+
+/// `gpsrx simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Scenario file (TOML); see samples/scenarios/README.md. Omit with --default.
+    pub scenario: Option<PathBuf>,
+    /// Use the built-in default scenario.
+    #[arg(long, conflicts_with = "scenario")]
+    pub default: bool,
+    /// Output directory: the recording, its .sigmf-meta, truth.csv and truth_sv.csv go there
+    /// (and ins.csv when the scenario has an `[ins]` table).
+    #[arg(short, long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Override the scenario's duration, s.
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Override the scenario's noise seed.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Override the output format.
+    #[arg(long)]
+    pub format: Option<String>,
+    /// Override the sampling rate, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub fs: Option<f64>,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `gpsrx info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// The recording and how to read it.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// Samples read for statistics (the size and duration always cover the whole file).
+    #[arg(long, default_value_t = 4_000_000)]
+    pub max_samples: u64,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `gpsrx demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Keep the simulated files in this directory (default: a temporary directory, removed).
+    #[arg(long, value_name = "DIR")]
+    pub keep: Option<PathBuf>,
+    /// Shorten the demo recording, s (default: the scenario's 40 s).
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+}
+
+/// Tracking-loop options, shared by `track` and (later) `run`; each overrides the config file.
+#[derive(Debug, Clone, Default, Args)]
+pub struct LoopArgs {
+    /// Configuration file (TOML) with a `[tracking]` table: `pull_in` and `track` loop settings,
+    /// `min_pull_in_s`, `fll_assist_s`, `cn0_lost_dbhz`, `cn0_window_s`, `lost_estimates`.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// PLL order after pull-in: 1, 2 or 3 (0: FLL only).
+    #[arg(long, value_name = "N")]
+    pub pll_order: Option<u8>,
+    /// PLL noise bandwidth after pull-in, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub pll_bw: Option<f64>,
+    /// FLL order after pull-in: 0 (none), 1 or 2.
+    #[arg(long, value_name = "N")]
+    pub fll_order: Option<u8>,
+    /// FLL noise bandwidth after pull-in, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub fll_bw: Option<f64>,
+    /// DLL order: 1 or 2.
+    #[arg(long, value_name = "N")]
+    pub dll_order: Option<u8>,
+    /// DLL noise bandwidth, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub dll_bw: Option<f64>,
+    /// Coherent integration after bit sync, ms: 1, 2, 4, 5, 10 or 20.
+    #[arg(long, value_name = "MS")]
+    pub t_coh: Option<f64>,
+    /// Early-late spacing, chips (0.1 to 1).
+    #[arg(long, value_name = "CHIPS")]
+    pub el_spacing: Option<f64>,
+    /// PLL noise bandwidth while the loop is aided by an INS feed-forward (`run --ins`), Hz:
+    /// the aid removes the dynamics, so a narrower loop lets through less noise
+    /// (default: the same loops aided or not).
+    #[arg(long, value_name = "HZ")]
+    pub aided_pll_bw: Option<f64>,
+    /// PLL order while aided: 1, 2 or 3 (default: as unaided). Seed 004: use 2 or more, a
+    /// 1st-order aided loop drifts with the INS bias.
+    #[arg(long, value_name = "N")]
+    pub aided_pll_order: Option<u8>,
+}
+
+impl LoopArgs {
+    /// The configuration: defaults, then the config file (`--config`), then these options.
+    pub fn receiver_config(&self) -> anyhow::Result<ReceiverConfig> {
+        let mut config = match &self.config {
+            Some(path) => ReceiverConfig::load(path)?,
+            None => ReceiverConfig::default(),
+        };
+        config.tracking = self.apply(config.tracking)?;
+        Ok(config)
+    }
+
+    /// The channel configuration: defaults, then the config file, then these options.
+    pub fn channel_config(&self) -> anyhow::Result<gpsrx_tracking::ChannelConfig> {
+        Ok(self.receiver_config()?.tracking)
+    }
+
+    /// `cfg` with these options applied, validated.
+    fn apply(
+        &self,
+        mut cfg: gpsrx_tracking::ChannelConfig,
+    ) -> anyhow::Result<gpsrx_tracking::ChannelConfig> {
+        let t = &mut cfg.track;
+        if let Some(v) = self.pll_order {
+            t.pll_order = v;
+        }
+        if let Some(v) = self.pll_bw {
+            t.pll_bw_hz = v;
+        }
+        if let Some(v) = self.fll_order {
+            t.fll_order = v;
+        }
+        if let Some(v) = self.fll_bw {
+            t.fll_bw_hz = v;
+        }
+        if let Some(v) = self.dll_order {
+            t.dll_order = v;
+        }
+        if let Some(v) = self.dll_bw {
+            t.dll_bw_hz = v;
+        }
+        if let Some(v) = self.t_coh {
+            t.t_coh_s = v * 1e-3;
+        }
+        if let Some(v) = self.el_spacing {
+            t.el_spacing_chips = v;
+        }
+        if self.aided_pll_bw.is_some() || self.aided_pll_order.is_some() {
+            let mut a = cfg.aided_track.unwrap_or(cfg.track);
+            if let Some(v) = self.aided_pll_bw {
+                a.pll_bw_hz = v;
+            }
+            if let Some(v) = self.aided_pll_order {
+                a.pll_order = v;
+            }
+            cfg.aided_track = Some(a);
+        }
+        cfg.validate()
+            .map_err(|e| anyhow::anyhow!("tracking configuration: {e}"))?;
+        Ok(cfg)
+    }
+}

@@ -1,0 +1,181 @@
+//! The command line of `gpsrx run`.
+
+use super::{LoopArgs, SourceArgs};
+use gpsrx_receiver::config::{self, ReceiverConfig};
+use std::path::PathBuf;
+
+/// Ionosphere model switch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum IonoModel {
+    /// Broadcast Klobuchar (decoded from subframe 4 page 18, or from --nav).
+    Klobuchar,
+    /// No correction.
+    None,
+}
+
+/// Troposphere model switch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TropoModel {
+    /// Saastamoinen, standard atmosphere.
+    Saastamoinen,
+    /// No correction.
+    None,
+}
+
+/// `gpsrx run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// The recording and how to read it.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// Loop settings.
+    #[command(flatten)]
+    pub loops: LoopArgs,
+    /// Output directory (created if needed).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
+    #[arg(long, value_name = "FILE")]
+    pub nav: Option<PathBuf>,
+    /// Ionosphere correction [default: klobuchar].
+    #[arg(long, value_enum)]
+    pub iono: Option<IonoModel>,
+    /// Troposphere correction (`none` for simulated files without troposphere)
+    /// [default: saastamoinen].
+    #[arg(long, value_enum)]
+    pub tropo: Option<TropoModel>,
+    /// Elevation mask, degrees [default: 5].
+    #[arg(long, value_name = "DEG")]
+    pub elevation_mask: Option<f64>,
+    /// Observable and fix rate, Hz, 1 to 50 [default: 10].
+    #[arg(long, value_name = "HZ")]
+    pub rate: Option<f64>,
+    /// Full GPS week near the recording, to resolve the broadcast 10-bit week (default: from
+    /// SigMF metadata, else the current week).
+    #[arg(long, value_name = "WEEK")]
+    pub week: Option<u32>,
+    /// Doppler search half-width of the acquisition, Hz [default: 5000; 15000 or more for a
+    /// front end with a large LO offset, or --doppler-center].
+    #[arg(long, value_name = "HZ")]
+    pub doppler_max: Option<f64>,
+    /// Centre of the acquisition's Doppler search, Hz: a known front-end frequency offset
+    /// [default: 0].
+    #[arg(long, value_name = "HZ", allow_hyphen_values = true)]
+    pub doppler_center: Option<f64>,
+    /// Acquisition coherent integration, ms, 1 to 10 [default: 1]. Weak signals (below about
+    /// 35 dB-Hz): 10, with --acq-noncoherent 10 or more.
+    #[arg(long, value_name = "MS")]
+    pub acq_coherent_ms: Option<u32>,
+    /// Acquisition non-coherent sum of this many coherent blocks [default: 10].
+    #[arg(long, value_name = "N")]
+    pub acq_noncoherent: Option<u32>,
+    /// RAIM false-alarm probability [default: 0.001].
+    #[arg(long, value_name = "P")]
+    pub raim_pfa: Option<f64>,
+    /// Landmark range observations, CSV `tow_s,x_m,y_m,z_m,range_m,sigma_m` (seed 001): added to
+    /// the fixes without a clock term, so 3 satellites and 1 landmark give a fix.
+    #[arg(long, value_name = "FILE")]
+    pub landmarks: Option<PathBuf>,
+    /// Use satellites whose ephemeris says they are unhealthy (some simulators copy a health
+    /// flag that the real satellite had at the time).
+    #[arg(long)]
+    pub allow_unhealthy: bool,
+    /// INS output, CSV `t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps[,gps_tow_s]` (ECEF; `t_s` from
+    /// the first IF sample; >= 10 Hz): its velocity is fed forward into every carrier and code
+    /// loop (seed 004). Give `--nav` too for aiding before the ephemerides are decoded.
+    #[arg(long, value_name = "FILE")]
+    pub ins: Option<PathBuf>,
+    /// Read `--ins` but do not aid the loops (to compare aided and unaided runs).
+    #[arg(long, requires = "ins")]
+    pub no_aiding: bool,
+    /// First-order band limiter alpha/(s+alpha) on the feed-forward, rad/s (seed 004 eq. 8):
+    /// reproduces an INS of limited dynamic range.
+    #[arg(long, value_name = "RAD_S", requires = "ins")]
+    pub ins_band_limit: Option<f64>,
+    /// Longest gap allowed between INS rows, s.
+    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    pub ins_max_gap: f64,
+    /// Dead-reckoning log, CSV `t_s,gyro_v,odo_pulses` (raw, seed 000) or
+    /// `t_s,yaw_rate_dps,speed_mps` (`t_s` from the first IF sample): fused with the fixes into
+    /// `fused.csv`, `fused.nmea`, `fused.geojson`, `fused.kml`; the calibrated sensor parameters
+    /// go to `dr_params.toml`. Nominal parameters from the config file's `[dr]` table.
+    #[arg(long, value_name = "FILE")]
+    pub dr: Option<PathBuf>,
+    /// Longitudinal accelerometer log, CSV `t_s,a_long_mps2`: seed 002's speed filter, column
+    /// `speed_filter_mps` of `fused.csv`.
+    #[arg(long, value_name = "FILE")]
+    pub accel: Option<PathBuf>,
+    /// DR filter: seed 000's proposed 8-state filter (position and carrier velocity) or the
+    /// conventional 4-state one (position only) [default: proposed].
+    #[arg(long, value_enum, requires = "dr")]
+    pub dr_filter: Option<DrFilterChoice>,
+    /// Initial DR sensor parameters: a `dr_params.toml` written by a previous run (seed 000:
+    /// saves the ~900 s calibration); overrides the config file's `[dr]` values.
+    #[arg(long, value_name = "FILE", requires = "dr")]
+    pub dr_params: Option<PathBuf>,
+}
+
+/// `--dr-filter`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DrFilterChoice {
+    /// Seed 000's 8-state filter: position and carrier-velocity updates, gyro and odometer
+    /// calibration.
+    Proposed,
+    /// The conventional 4-state filter (seed 000 eq. 7): position updates only.
+    Conventional,
+}
+
+impl From<IonoModel> for config::IonoModel {
+    fn from(m: IonoModel) -> Self {
+        match m {
+            IonoModel::Klobuchar => config::IonoModel::Klobuchar,
+            IonoModel::None => config::IonoModel::None,
+        }
+    }
+}
+
+impl From<TropoModel> for config::TropoModel {
+    fn from(m: TropoModel) -> Self {
+        match m {
+            TropoModel::Saastamoinen => config::TropoModel::Saastamoinen,
+            TropoModel::None => config::TropoModel::None,
+        }
+    }
+}
+
+impl RunArgs {
+    /// The receiver configuration: defaults, then the config file, then these options;
+    /// validated.
+    pub fn receiver_config(&self) -> anyhow::Result<ReceiverConfig> {
+        let mut c = self.loops.receiver_config()?;
+        let r = &mut c.run;
+        let set = |field: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *field = v;
+            }
+        };
+        set(&mut r.rate_hz, self.rate);
+        set(&mut r.elevation_mask_deg, self.elevation_mask);
+        set(&mut r.raim_pfa, self.raim_pfa);
+        set(&mut r.doppler_max_hz, self.doppler_max);
+        set(&mut r.doppler_center_hz, self.doppler_center);
+        if let Some(v) = self.acq_coherent_ms {
+            r.acq_coherent_ms = v;
+        }
+        if let Some(v) = self.acq_noncoherent {
+            r.acq_noncoherent = v;
+        }
+        if let Some(v) = self.iono {
+            r.iono = v.into();
+        }
+        if let Some(v) = self.tropo {
+            r.tropo = v.into();
+        }
+        if self.week.is_some() {
+            r.week = self.week;
+        }
+        r.allow_unhealthy |= self.allow_unhealthy;
+        c.validate()?;
+        Ok(c)
+    }
+}

@@ -1,0 +1,129 @@
+//! `gpsrx config --default`: print the default configuration file, commented.
+
+use crate::cli::ConfigArgs;
+use gpsrx_tracking::ChannelConfig;
+
+/// Runs `gpsrx config`.
+pub fn run(args: &ConfigArgs) -> anyhow::Result<()> {
+    if !args.default {
+        anyhow::bail!("say what to print: `gpsrx config --default` prints the default gpsrx.toml");
+    }
+    print!("{}", default_toml()?);
+    Ok(())
+}
+
+/// The default configuration as commented TOML (valid input to `--config`).
+pub fn default_toml() -> anyhow::Result<String> {
+    let c = ChannelConfig::default();
+    let loops = |name: &str, l: &gpsrx_tracking::LoopConfig| -> anyhow::Result<String> {
+        Ok(format!(
+            "[tracking.{name}]\n\
+             pll_order = {}            # PLL order 1, 2 or 3 (0: FLL only)\n\
+             pll_bw_hz = {:?}          # PLL noise bandwidth, Hz\n\
+             fll_order = {}            # FLL assist order 0 (none), 1 or 2\n\
+             fll_bw_hz = {:?}          # FLL noise bandwidth, Hz\n\
+             dll_order = {}            # DLL order 1 or 2 (carrier-aided)\n\
+             dll_bw_hz = {:?}          # DLL noise bandwidth, Hz\n\
+             t_coh_s = {:?}            # integration time, s: 0.001 .. 0.020, a divisor of 20 ms\n\
+             el_spacing_chips = {:?}   # early-late spacing, 0.1 .. 1 chip\n\
+             pll_discriminator = \"{}\"  # costas (data) or atan2 (pilot)\n\
+             fll_discriminator = \"{}\"  # data_insensitive or atan2\n\
+             dll_discriminator = \"{}\"  # normalized_envelope or dot_product\n",
+            l.pll_order,
+            l.pll_bw_hz,
+            l.fll_order,
+            l.fll_bw_hz,
+            l.dll_order,
+            l.dll_bw_hz,
+            l.t_coh_s,
+            l.el_spacing_chips,
+            enum_name(&l.pll_discriminator)?,
+            enum_name(&l.fll_discriminator)?,
+            enum_name(&l.dll_discriminator)?,
+        ))
+    };
+    let text = format!(
+        "# gpsrx configuration (gpsrx run/track --config gpsrx.toml).\n\
+         # Every value here can be overridden on the command line (--pll-order, --pll-bw, ...).\n\
+         # Unknown keys are errors.\n\
+         \n\
+         [tracking]\n\
+         min_pull_in_s = {:?}      # minimum pull-in time before the hand-over to [tracking.track], s\n\
+         fll_assist_s = {:?}       # the pull-in FLL assist is switched off after this, s\n\
+         cn0_lost_dbhz = {:?}      # C/N0 below which a channel counts as lost, dB-Hz\n\
+         cn0_window_s = {:?}       # length of one C/N0 estimate (bit-aligned NWPR), s\n\
+         lost_estimates = {}       # consecutive low estimates that release the channel\n\
+         weak_enter_dbhz = {:?}    # below this C/N0 a channel takes [tracking.weak_track], dB-Hz (0: never)\n\
+         weak_leave_dbhz = {:?}    # above this it goes back to [tracking.track], dB-Hz\n\
+         \n\
+         # Pull-in loops: 1 ms, wide, FLL-assisted.\n{}\n\
+         # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n\
+         # 3rd order at 18 Hz follows 10 g manoeuvres.\n{}\n\
+         # Tracking loops for weak signals (C/N0 below weak_enter_dbhz): 20 ms, narrow.\n{}\n\
+         # Tracking loops while an INS feed-forward aids the channel (gpsrx run --ins; optional,\n\
+         # default: the same as [tracking.track]; --aided-pll-bw, --aided-pll-order):\n\
+         # [tracking.aided_track]\n\
+         # pll_order = 2\n\
+         # pll_bw_hz = 3.0\n\
+         # ... (give every key of [tracking.track]: missing ones take the pull-in defaults)\n\
+         \n\
+         [run]                     # gpsrx run (command-line options override these)\n\
+         rate_hz = 10.0            # observable and fix rate, 1 .. 50 Hz (--rate)\n\
+         elevation_mask_deg = 5.0  # elevation mask, deg (--elevation-mask)\n\
+         iono = \"klobuchar\"        # klobuchar or none (--iono)\n\
+         tropo = \"saastamoinen\"    # saastamoinen or none (--tropo)\n\
+         raim_pfa = 0.001          # RAIM false-alarm probability (--raim-pfa)\n\
+         doppler_max_hz = 5000.0   # acquisition Doppler half-width, Hz (--doppler-max)\n\
+         doppler_center_hz = 0.0   # acquisition Doppler centre: front-end LO offset, Hz (--doppler-center)\n\
+         acq_coherent_ms = 1       # acquisition coherent integration, 1 .. 10 ms (--acq-coherent-ms)\n\
+         acq_noncoherent = 10      # acquisition non-coherent blocks (--acq-noncoherent)\n\
+         # (weak signals, below about 35 dB-Hz: acq_coherent_ms = 10, acq_noncoherent = 10 or more)\n\
+         allow_unhealthy = false   # use satellites flagged unhealthy (--allow-unhealthy)\n\
+         \n\
+         [dr]                      # gpsrx run --dr / --accel (seed 000 sensor model)\n\
+         sf_g_dps_per_v = 45.045   # nominal gyro scale factor Sf_G, deg/s/V\n\
+         v_nom_v = 2.5             # nominal gyro zero-rate voltage V_nom, V\n\
+         sf_n_m_per_pulse = 0.1    # nominal odometer scale factor Sf_N, m/pulse\n\
+         filter = \"proposed\"       # proposed (8 states, carrier velocity) or conventional (--dr-filter)\n\
+         update_interval_s = 1.0   # least interval between GNSS updates of the filters, s\n",
+        c.min_pull_in_s,
+        c.fll_assist_s,
+        c.cn0_lost_dbhz,
+        c.cn0_window_s,
+        c.lost_estimates,
+        c.weak_enter_dbhz,
+        c.weak_leave_dbhz,
+        loops("pull_in", &c.pull_in)?,
+        loops("track", &c.track)?,
+        loops("weak_track", &c.weak_track.unwrap_or(c.track))?,
+    );
+    Ok(text)
+}
+
+fn enum_name<T: serde::Serialize>(v: &T) -> anyhow::Result<String> {
+    Ok(serde_json::to_value(v)?
+        .as_str()
+        .unwrap_or_default()
+        .to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_file_parses_back_to_the_defaults() {
+        let text = default_toml().unwrap_or_else(|e| panic!("{e}"));
+        let f = gpsrx_receiver::ReceiverConfig::from_toml(&text, "default")
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
+        // Every value the file writes is the library's default.
+        let defaults = gpsrx_receiver::ReceiverConfig::default();
+        assert_eq!(f.tracking, ChannelConfig::default());
+        assert_eq!(f.run, defaults.run);
+        let nominal = gpsrx_ins_aiding::DrParams::default();
+        assert_eq!(f.dr.sf_g_dps_per_v, Some(nominal.sf_g_dps_per_v));
+        assert_eq!(f.dr.v_nom_v, Some(nominal.v_nom_v));
+        assert_eq!(f.dr.sf_n_m_per_pulse, Some(nominal.sf_n_m_per_pulse));
+        assert_eq!(f.dr.filter.as_deref(), Some("proposed"));
+    }
+}

@@ -1,0 +1,185 @@
+//! `gpsrx run`: a recording (or standard input) in, position fixes and standard files out.
+//!
+//! A thin layer over [`gpsrx_receiver::Receiver`]: the command line and configuration file
+//! become a [`gpsrx_receiver::ReceiverConfig`], the recording a sample source read once, and
+//! the outputs a [`FileSink`] in `--out DIR` (`pvt.csv`, `pvt.nmea`, `observables.rnx`,
+//! `ephemeris.rnx`, `track.geojson`, `track.kml`, `channels.csv`); with `--dr`/`--accel` the
+//! fixes are then fused with the DR logs (`dr_inputs`).
+
+use crate::commands::source::open_interruptible;
+use anyhow::Context;
+use gpsrx_ins_aiding::{read_ins_csv, DrParams};
+use gpsrx_nav::rinex_nav::read_rinex_nav;
+use gpsrx_receiver::fusion::gnss::GnssFix;
+use gpsrx_receiver::output::{FileSink, Fix};
+use gpsrx_receiver::pipeline::{FixReport, Progress, Sink, SinkError, Tee};
+use gpsrx_receiver::{Assistance, Receiver, RunSummary};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::Write;
+
+mod dr_inputs;
+
+pub use crate::cli::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
+use dr_inputs::{write_fused_outputs, DrInputs};
+
+/// What `gpsrx run` produced: the receiver's summary and, with `--dr`/`--accel`, the fusion's.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct RunReport {
+    /// The receiver's summary.
+    #[serde(flatten)]
+    pub receiver: RunSummary,
+    /// With `--dr`/`--accel`: rows of `fused.csv` by source (gnss, fused, dr).
+    pub fused_rows: Option<[usize; 3]>,
+    /// With `--dr`: the calibrated sensor parameters at the end.
+    pub dr_params: Option<DrParams>,
+}
+
+/// The command's own sink beside the files: the progress bar and the fixes for DR fusion.
+struct CommandSink {
+    bar: ProgressBar,
+    gnss_fixes: Option<Vec<GnssFix>>,
+}
+
+impl Sink for CommandSink {
+    fn fix(&mut self, report: &FixReport) -> Result<(), SinkError> {
+        if let Some(f) = &mut self.gnss_fixes {
+            f.push(GnssFix::from_solution(report.t_stream_s, &report.solution));
+        }
+        Ok(())
+    }
+
+    fn progress(&mut self, p: &Progress) -> Result<(), SinkError> {
+        self.bar.set_position(p.sample_index);
+        self.bar.set_message(format!(
+            "{} satellites, {} frame-synced, {} with ephemeris",
+            p.satellites, p.frame_synced, p.with_ephemeris
+        ));
+        Ok(())
+    }
+}
+
+/// The assistance inputs named on the command line.
+fn assistance(args: &RunArgs) -> anyhow::Result<Assistance> {
+    let nav = match &args.nav {
+        Some(p) => Some(
+            read_rinex_nav(p)
+                .with_context(|| format!("cannot read the navigation file {}", p.display()))?,
+        ),
+        None => None,
+    };
+    let landmarks = match &args.landmarks {
+        Some(p) => gpsrx_receiver::landmarks::read_landmarks(p)?,
+        None => Vec::new(),
+    };
+    let ins = match &args.ins {
+        Some(path) => {
+            let track = read_ins_csv(path, args.ins_max_gap)?;
+            let (a, b) = track.span_s();
+            let off = if args.no_aiding {
+                " (aiding off: --no-aiding)"
+            } else {
+                ""
+            };
+            tracing::info!(
+                "INS {}: {} rows from {a:.2} to {b:.2} s{off}",
+                path.display(),
+                track.samples().len()
+            );
+            (!args.no_aiding).then_some(gpsrx_receiver::pipeline::InsAiding {
+                track,
+                band_limit_rad_s: args.ins_band_limit,
+            })
+        }
+        None => None,
+    };
+    Ok(Assistance {
+        nav,
+        ins,
+        landmarks,
+    })
+}
+
+/// Runs the receiver on the recording of `args`; returns the report and the fixes.
+pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunReport, Vec<Fix>)> {
+    let config = args.receiver_config()?;
+    let src_cfg = args.source.to_config()?;
+    let mut src = open_interruptible(&src_cfg)?;
+    let dr_inputs = DrInputs::load(args, &config)?;
+    let mut receiver = Receiver::new(&config, src.fs_hz(), assistance(args)?)?;
+    let bar = if show_progress {
+        src.total_samples()
+            .map(ProgressBar::new)
+            .unwrap_or_else(ProgressBar::no_length)
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {percent:>3}% {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let files = FileSink::create(&args.out, config.run.rate_hz)?;
+    let extra = CommandSink {
+        bar: bar.clone(),
+        gnss_fixes: dr_inputs.as_ref().map(|_| Vec::new()),
+    };
+    let mut sink = Tee(files, extra);
+    let summary = receiver.run(src.as_mut(), &mut sink)?;
+    bar.finish_and_clear();
+    let Tee(files, extra) = sink;
+    let mut report = RunReport {
+        receiver: summary,
+        ..RunReport::default()
+    };
+    if let (Some(inputs), Some(gnss)) = (&dr_inputs, &extra.gnss_fixes) {
+        let (rows, params) = write_fused_outputs(inputs, gnss, &args.out)?;
+        report.fused_rows = Some(rows);
+        report.dr_params = params;
+    }
+    Ok((report, files.into_fixes()))
+}
+
+/// Runs `gpsrx run`.
+pub fn run(args: &RunArgs) -> anyhow::Result<()> {
+    let (report, _) = run_file(args, true)?;
+    print_report(&mut std::io::stdout().lock(), &report, args)
+        .context("cannot write the summary to standard output")
+}
+
+/// The summary, for people.
+fn print_report(out: &mut dyn Write, report: &RunReport, args: &RunArgs) -> std::io::Result<()> {
+    let s = &report.receiver;
+    writeln!(
+        out,
+        "processed {:.1} s in {:.1} s ({:.1}x real time)",
+        s.duration_s,
+        s.wall_s,
+        s.duration_s / s.wall_s.max(1e-9)
+    )?;
+    writeln!(out, "satellites tracked: {:?}", s.tracked_prns)?;
+    match (s.first_fix_s, s.mean_llh) {
+        (Some(t), Some((lat, lon, h))) => {
+            writeln!(out, "first fix {t:.2} s after the start; {} fixes", s.fixes)?;
+            writeln!(out, "mean position {lat:.7} deg, {lon:.7} deg, {h:.2} m; mean PDOP {:.2}", s.mean_pdop.unwrap_or(f64::NAN))?;
+        }
+        _ if s.tracked_prns.is_empty() => writeln!(out,
+            "no fix: no satellite was tracked. Check the format, rate, IF and Q sign (gpsrx info FILE), widen the search (--doppler-max, --doppler-center for a front-end LO offset) or integrate longer (--acq-coherent-ms 10 --acq-noncoherent 20)"
+        )?,
+        _ => writeln!(out,
+            "no fix: the recording ended before 4 satellites had their ephemeris (subframes 1-3 take 18-30 s; give --nav FILE to start sooner)"
+        )?,
+    }
+    if let Some([g, f, d]) = report.fused_rows {
+        writeln!(
+            out,
+            "fused.csv: {f} fused rows, {d} dead-reckoning only, {g} GNSS only"
+        )?;
+    }
+    if let Some(p) = &report.dr_params {
+        writeln!(
+            out,
+            "DR calibration: Sf_G {:.3} deg/s/V, V_nom {:.4} V, Sf_N {:.5} m/pulse (dr_params.toml)",
+            p.sf_g_dps_per_v, p.v_nom_v, p.sf_n_m_per_pulse
+        )?;
+    }
+    writeln!(out, "outputs in {}", args.out.display())
+}

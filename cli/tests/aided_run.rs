@@ -1,0 +1,342 @@
+//! INS aiding end to end: the feed-forward Doppler against the simulator's truth, and
+//! `gpsrx run --ins` through a 5 g turn with narrow loops, aided and unaided.
+
+use crate::common::{run, truth};
+use gpsrx_cli::commands::simulate::write_ins_for;
+use gpsrx_ins_aiding::error_model::InsErrorConfig;
+use gpsrx_ins_aiding::read_ins_csv;
+use gpsrx_nav::rinex_nav::parse_rinex_nav;
+use gpsrx_receiver::output::Fix;
+use gpsrx_receiver::pipeline::aiding::InsFeedForward;
+use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
+use gpsrx_samples::sim::{Scenario, Simulator};
+use std::path::{Path, PathBuf};
+
+/// A vehicle at 30 m/s that turns at 5 g (jerk-limited over 1 s) from `turn_at_s` for
+/// `turn_s`, 2.048 MHz ci8, receiver clock drifting at 4e-8 (63 Hz on every Doppler).
+fn turn_scenario(duration_s: f64, turn_at_s: f64, turn_s: f64) -> Scenario {
+    let text = format!(
+        r#"
+duration_s = {duration_s}
+seed = 5
+nav = "builtin:brdc0010.22n"
+[start]
+week = 2190
+tow_s = 538194.0
+[output]
+format = "ci8"
+fs_hz = 2.048e6
+[clock]
+bias_s = 2.0e-4
+drift_s_s = 4.0e-8
+[truth]
+rate_hz = 10.0
+[receiver]
+kind = "motion"
+start_llh_deg = [37.5665, 126.9780, 40.0]
+heading_deg = 30.0
+speed_mps = 30.0
+transition_s = 1.0
+segments = [
+  {{ type = "cruise", duration_s = {turn_at_s} }},
+  {{ type = "turn", duration_s = {turn_s}, accel_g = 5.0, direction = "left" }},
+  {{ type = "cruise", duration_s = 60.0 }},
+]
+"#
+    );
+    Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Seed 004 eq. 6 with a perfect INS: the feed-forward equals the Doppler of the simulated
+/// signal (carrier-phase rate in receiver time, `truth_sv.csv`'s definition) within 0.1 Hz,
+/// through a 5 g turn, for every satellite. The receiver clock drift at the first fix is not
+/// in it (the loops hold it already; see `pipeline::aiding`), so the comparison adds it back;
+/// a later change of the drift is fed forward.
+#[test]
+fn feedforward_doppler_matches_truth_for_a_perfect_ins() {
+    let dir = tmp();
+    let sc = turn_scenario(12.0, 4.0, 6.0);
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let ins_path = dir.path().join("ins.csv");
+    write_ins_for(&sim, &InsErrorConfig::default(), &ins_path).unwrap_or_else(|e| panic!("{e}"));
+    let ins = read_ins_csv(&ins_path, 0.5).unwrap_or_else(|e| panic!("{e}"));
+    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let ff = InsFeedForward::new(ins, Some(nav), 2190, None).allow_unhealthy(true);
+    // The clock drift, as a fix's velocity solution would give it (m/s).
+    let drift_mps = 4.0e-8 * 299_792_458.0;
+    let (_, rx0) = sim.receiver_truth(0.5);
+    ff.set_fix(0.5, rx0.pos_m, Some(drift_mps));
+    let drift_hz = 4.0e-8 * 1575.42e6;
+    let h = 0.5e-3;
+    let (mut worst, mut n, mut max_abs) = (0.0f64, 0, 0.0f64);
+    for k in 1..=20 {
+        let t = 0.55 * f64::from(k);
+        for sat in &sim.satellites {
+            let (a, _) = sim.observe(sat, t - h);
+            let (b, _) = sim.observe(sat, t + h);
+            let truth_hz = (b.carrier_cycles - a.carrier_cycles) / (2.0 * h);
+            let aid = ff
+                .aid(sat.prn.get(), t)
+                .unwrap_or_else(|| panic!("no aid for {} at {t}", sat.prn));
+            worst = worst.max((aid.doppler_hz - drift_hz - truth_hz).abs());
+            max_abs = max_abs.max(truth_hz.abs());
+            n += 1;
+            // The rate: 10 ms ahead.
+            let (c, _) = sim.observe(sat, t + 0.01 - h);
+            let (d, _) = sim.observe(sat, t + 0.01 + h);
+            let truth_next = (d.carrier_cycles - c.carrier_cycles) / (2.0 * h);
+            let rate_truth = (truth_next - truth_hz) / 0.01;
+            assert!(
+                (aid.doppler_rate_hz_s - rate_truth).abs() < 2.0,
+                "{} at {t}: rate {} vs {rate_truth} Hz/s",
+                sat.prn,
+                aid.doppler_rate_hz_s
+            );
+        }
+    }
+    assert!(n >= 100, "{n} comparisons");
+    assert!(max_abs > 1000.0, "Dopplers of real size ({max_abs} Hz)");
+    assert!(worst < 0.1, "worst feed-forward error {worst} Hz");
+    eprintln!("worst feed-forward error {worst:.4} Hz over {n} comparisons");
+
+    // The drift rises by 1e-9 (1.58 Hz): after 5 s of 10 Hz fixes (5 smoothing time constants)
+    // every feed-forward is 1.58 Hz lower (to 1 %).
+    let before = ff
+        .aid(sim.satellites[0].prn.get(), 6.0)
+        .map(|a| a.doppler_hz);
+    for k in 1..=50 {
+        let t = 0.5 + 0.1 * f64::from(k);
+        let (_, rx) = sim.receiver_truth(t);
+        ff.set_fix(t, rx.pos_m, Some(drift_mps + 1e-9 * 299_792_458.0));
+    }
+    let after = ff
+        .aid(sim.satellites[0].prn.get(), 6.0)
+        .map(|a| a.doppler_hz);
+    let step = after.unwrap_or(f64::NAN) - before.unwrap_or(f64::NAN);
+    assert!(
+        (step + 1.57542).abs() < 0.02,
+        "drift change fed forward: {step} Hz"
+    );
+}
+
+/// Without the GPS time or the ephemeris there is no feed-forward (never a made-up one).
+#[test]
+fn no_feedforward_without_time_or_ephemeris() {
+    let dir = tmp();
+    let text = "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps\n0,-3.0e6,4.0e6,3.9e6,1,2,3\n0.1,-3.0e6,4.0e6,3.9e6,1,2,3\n";
+    let p = dir.path().join("ins.csv");
+    std::fs::write(&p, text).unwrap_or_else(|e| panic!("{e}"));
+    let ins = read_ins_csv(&p, 0.5).unwrap_or_else(|e| panic!("{e}"));
+    let ff = InsFeedForward::new(ins, None, 2190, None);
+    assert!(ff.aid(5, 0.05).is_none(), "no GPS time yet");
+    ff.set_time_origin(gpsrx_nav::time::GpsTime::new(2190, 538194.0));
+    assert!(ff.aid(5, 0.05).is_none(), "no ephemeris for G05");
+}
+
+/// (state, carrier_lock) of every channels.csv row within [t0, t1] s of receive time.
+fn channel_rows(out: &Path, t0_tow: f64, t1_tow: f64) -> Vec<(String, bool)> {
+    let mut rdr =
+        csv::Reader::from_path(out.join("channels.csv")).unwrap_or_else(|e| panic!("{e}"));
+    let headers = rdr.headers().unwrap_or_else(|e| panic!("{e}")).clone();
+    let col = |name: &str| {
+        headers
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name}"))
+    };
+    let (ct, cs, cl) = (col("tow_s"), col("state"), col("carrier_lock"));
+    rdr.records()
+        .map(|r| r.unwrap_or_else(|e| panic!("{e}")))
+        .filter(|r| {
+            let t: f64 = r[ct].parse().unwrap_or(f64::NAN);
+            (t0_tow..=t1_tow).contains(&t)
+        })
+        .map(|r| (r[cs].to_string(), &r[cl] == "1" || &r[cl] == "true"))
+        .collect()
+}
+
+/// 3D error of a fix against truth interpolated at its time.
+fn error_3d_m(f: &Fix, truth: &[(f64, [f64; 3], [f64; 3])]) -> f64 {
+    let t = f.time.tow_s;
+    let i = truth
+        .partition_point(|r| r.0 <= t)
+        .clamp(1, truth.len() - 1);
+    let (a, b) = (&truth[i - 1], &truth[i]);
+    let u = (t - a.0) / (b.0 - a.0);
+    (0..3)
+        .map(|k| (f.ecef_m[k] - (a.1[k] + u * (b.1[k] - a.1[k]))).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Seed 004 end to end: a 3 Hz 2nd-order PLL cannot follow a 5 g turn (dynamic stress
+/// 0.2809 a / Bn^2 = 2900 deg for the full 5 g on the line of sight); fed forward with the INS
+/// velocity (biased accelerometers, 0.01 m/s^2) it keeps phase lock on every satellite and the
+/// receiver keeps giving fixes through the turn.
+#[test]
+fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
+    let dir = tmp();
+    let (turn_at, turn_s) = (16.0, 8.0);
+    let mut sc = turn_scenario(30.0, turn_at, turn_s);
+    sc.ins = Some(
+        toml::from_str("accel_bias_enu_mps2 = [0.01, 0.01, 0.0]\nrate_hz = 100.0")
+            .unwrap_or_else(|e| panic!("{e}")),
+    );
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let report = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    let ins_path: PathBuf = dir.path().join("ins.csv");
+    let cfg: InsErrorConfig = toml::Value::Table(sc.ins.clone().unwrap_or_default())
+        .try_into()
+        .unwrap_or_else(|e| panic!("{e}"));
+    write_ins_for(&sim, &cfg, &ins_path).unwrap_or_else(|e| panic!("{e}"));
+    let nav = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data/brdc0010.22n");
+    let nav = nav.to_str().unwrap_or_default();
+    let ins = ins_path.to_str().unwrap_or_default();
+    let common = [
+        "--nav",
+        nav,
+        "--pll-order",
+        "2",
+        "--pll-bw",
+        "3",
+        "--allow-unhealthy",
+    ];
+    let aided_out = dir.path().join("aided");
+    let unaided_out = dir.path().join("unaided");
+    let mut aided_args = common.to_vec();
+    aided_args.extend_from_slice(&["--ins", ins]);
+    let aided = run(&report.data_path, &aided_out, &aided_args);
+    let mut unaided_args = common.to_vec();
+    unaided_args.extend_from_slice(&["--ins", ins, "--no-aiding"]);
+    let unaided = run(&report.data_path, &unaided_out, &unaided_args);
+
+    // The turn in GPS time (plus the 1 s ramps).
+    let t0 = 538194.0 + turn_at;
+    let t1 = t0 + turn_s;
+    let locked_fraction = |out: &Path| {
+        let rows = channel_rows(out, t0, t1);
+        let locked = rows.iter().filter(|(s, l)| s == "track" && *l).count();
+        (locked as f64 / rows.len().max(1) as f64, rows.len())
+    };
+    let (fa, na) = locked_fraction(&aided_out);
+    let (fu, nu) = locked_fraction(&unaided_out);
+    eprintln!("phase-locked rows in the turn: aided {fa:.3} of {na}, unaided {fu:.3} of {nu}");
+    assert!(fa > 0.97, "aided channels keep phase lock ({fa})");
+    assert!(
+        fu < 0.7,
+        "unaided 3 Hz loops lose lock in a 5 g turn ({fu})"
+    );
+
+    let truth = truth(dir.path());
+    let in_turn = |f: &&Fix| (t0..=t1).contains(&f.time.tow_s);
+    let aided_turn: Vec<&Fix> = aided.iter().filter(in_turn).collect();
+    let unaided_turn: Vec<&Fix> = unaided.iter().filter(in_turn).collect();
+    let errs: Vec<f64> = aided_turn.iter().map(|f| error_3d_m(f, &truth)).collect();
+    let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len().max(1) as f64).sqrt();
+    eprintln!(
+        "fixes in the turn: aided {} (3D RMS {rms:.2} m, max {:.2} m), unaided {}",
+        aided_turn.len(),
+        errs.iter().copied().fold(0.0, f64::max),
+        unaided_turn.len()
+    );
+    // 10 Hz fixes over the 8 s turn.
+    assert!(
+        aided_turn.len() >= 75,
+        "aided fixes through the turn: {}",
+        aided_turn.len()
+    );
+    assert!(rms < 2.0, "aided fix error in the turn {rms} m RMS");
+}
+
+/// `aided_track`: while the aid is on, the channel runs the narrower aided loops (Doppler noise
+/// of a 2 Hz loop), and when the aid goes it returns to its unaided 15 Hz loops, in lock.
+#[test]
+fn aided_loops_are_used_while_the_aid_is_on() {
+    use gpsrx_receiver::pipeline::tracker::track;
+    use gpsrx_samples::{open_source, SourceConfig};
+    use gpsrx_tracking::{Channel, ChannelConfig, ChannelStart, ChannelState, DopplerAid};
+
+    let dir = tmp();
+    let mut sc = turn_scenario(8.0, 60.0, 1.0); // straight at 30 m/s throughout
+    sc.satellites.cn0_all_dbhz = Some(45.0);
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let report = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    let fs = 2.048e6;
+    let truth_doppler = |prn: u8, t: f64| -> Option<f64> {
+        let sat = sim.satellites.iter().find(|s| s.prn.get() == prn)?;
+        let (a, _) = sim.observe(sat, t - 0.5e-3);
+        let (b, _) = sim.observe(sat, t + 0.5e-3);
+        Some((b.carrier_cycles - a.carrier_cycles) / 1e-3)
+    };
+    let mut cfg = ChannelConfig::default();
+    cfg.track.pll_order = 2;
+    cfg.track.pll_bw_hz = 15.0;
+    let mut aided = cfg.track;
+    aided.pll_bw_hz = 2.0;
+    cfg.aided_track = Some(aided);
+    let sat = &sim.satellites[0];
+    let (o, _) = sim.observe(sat, 0.0);
+    let (o2, _) = sim.observe(sat, 1e-3);
+    let to_start = (1023.0 - o.chips.rem_euclid(1023.0)) / ((o2.chips - o.chips) / 1e-3) * fs;
+    let start = ChannelStart {
+        prn: sat.prn,
+        code_start_sample: to_start.round() as u64,
+        doppler_hz: truth_doppler(sat.prn.get(), 0.0).unwrap_or(0.0),
+        cn0_dbhz: f64::NAN,
+    };
+    let ch = Channel::new(&start, fs, &cfg).unwrap_or_else(|e| panic!("{e}"));
+    let aid = |prn: gpsrx_dsp::Prn, t: f64| {
+        (t < 5.0).then(|| DopplerAid {
+            doppler_hz: truth_doppler(prn.get(), t).unwrap_or(0.0),
+            doppler_rate_hz_s: 0.0,
+        })
+    };
+    let mut src =
+        open_source(&SourceConfig::new(report.data_path.clone())).unwrap_or_else(|e| panic!("{e}"));
+    let mut err_aided = Vec::new();
+    let mut err_unaided = Vec::new();
+    let out = track(src.as_mut(), vec![ch], Some(&aid), |_, e| {
+        if e.state != ChannelState::Track {
+            return;
+        }
+        let Some(truth) = truth_doppler(e.prn, e.t_rx_s + 0.5e-3) else {
+            return;
+        };
+        // The hand-over (bit sync) comes at about 2 s; the 2 Hz loop settles within 1 s.
+        if (3.5..4.9).contains(&e.t_rx_s) {
+            err_aided.push(e.doppler_hz - truth);
+        } else if e.t_rx_s > 6.0 {
+            err_unaided.push(e.doppler_hz - truth);
+        }
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    let std = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / v.len().max(1) as f64;
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len().max(1) as f64).sqrt()
+    };
+    let (sa, su) = (std(&err_aided), std(&err_unaided));
+    eprintln!(
+        "NCO Doppler noise: aided 2 Hz loop {sa:.3} Hz ({} epochs), unaided 15 Hz loop {su:.3} Hz ({} epochs)",
+        err_aided.len(),
+        err_unaided.len()
+    );
+    assert!(err_aided.len() > 1000 && err_unaided.len() > 1000);
+    assert!(
+        su > 4.0 * sa,
+        "the aided loop is the narrow one ({sa} vs {su} Hz)"
+    );
+    assert_eq!(
+        out[0].state(),
+        ChannelState::Track,
+        "in lock after the aid went"
+    );
+    assert!(!out[0].aided_loops(), "back on the unaided loops");
+}

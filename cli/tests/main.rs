@@ -1,0 +1,13 @@
+//! Integration tests of the `gpsrx` command-line tool and its commands: one test binary
+//! (one link) for the crate.
+
+mod common;
+
+mod acquisition;
+mod aided_run;
+mod bench;
+mod dr_run;
+mod ins_simulate;
+mod outputs;
+mod run;
+mod tracking;

@@ -1,0 +1,169 @@
+//! [`FileSink`]: the receiver's standard output files in a directory.
+//!
+//! `pvt.csv` and `pvt.nmea` (flushed at every fix, so a live stream can be followed),
+//! `channels.csv`, `observables.rnx` (RINEX 3; held back until the first fix gives the
+//! header's approximate position, or 300 s of observables with the week decoded, or the end),
+//! `ephemeris.rnx` (the decoded ephemerides, at the end), `track.geojson` and `track.kml` (the
+//! fixes, at the end).
+
+use crate::output::{
+    create_file, rinex_nav::write_rinex_nav_file, write_geojson, write_kml, ChannelCsvWriter,
+    ChannelRow, Fix, NavHeader, NavRecord, NmeaOptions, NmeaWriter, ObsEpoch, ObsHeader,
+    OutputError, PvtCsvWriter, RinexObsWriter,
+};
+use crate::pipeline::sink::{FixReport, NavigationEnd, ObservablesReport, Sink, SinkError};
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// Seconds of observables held back waiting for the first fix (whose position goes into the
+/// RINEX header) before they are written without one.
+const OBS_BACKLOG_MAX_S: f64 = 300.0;
+
+/// Writes the standard files into a directory.
+#[derive(Debug)]
+pub struct FileSink {
+    dir: PathBuf,
+    rate_hz: f64,
+    pvt_csv: PvtCsvWriter<BufWriter<File>>,
+    nmea: NmeaWriter<BufWriter<File>>,
+    channels_csv: ChannelCsvWriter<BufWriter<File>>,
+    obs_writer: Option<RinexObsWriter<BufWriter<File>>>,
+    obs_backlog: Vec<ObsEpoch>,
+    fixes: Vec<Fix>,
+}
+
+impl FileSink {
+    /// Creates `dir` if needed and the streaming files in it; `rate_hz` is the observable rate
+    /// (the RINEX interval).
+    pub fn create(dir: &Path, rate_hz: f64) -> Result<Self, OutputError> {
+        std::fs::create_dir_all(dir).map_err(OutputError::io(&dir.display().to_string()))?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            rate_hz,
+            pvt_csv: PvtCsvWriter::create(&dir.join("pvt.csv"))?,
+            nmea: NmeaWriter::create(&dir.join("pvt.nmea"), NmeaOptions::default())?,
+            channels_csv: ChannelCsvWriter::create(&dir.join("channels.csv"))?,
+            obs_writer: None,
+            obs_backlog: Vec::new(),
+            fixes: Vec::new(),
+        })
+    }
+
+    /// The fixes written.
+    pub fn fixes(&self) -> &[Fix] {
+        &self.fixes
+    }
+
+    /// The fixes written, consumed.
+    pub fn into_fixes(self) -> Vec<Fix> {
+        self.fixes
+    }
+
+    /// Creates `observables.rnx` (header position `approx_position_m`, if known) and writes
+    /// the epochs held back for it, in increasing time. They all get `week`: epochs before the
+    /// first subframe 1 carried the reference week, which can be 1024 weeks (or more) off.
+    fn open_observables(
+        &mut self,
+        approx_position_m: Option<[f64; 3]>,
+        week: u32,
+    ) -> Result<(), OutputError> {
+        let header = ObsHeader {
+            approx_position_m: approx_position_m.unwrap_or_default(),
+            interval_s: Some(1.0 / self.rate_hz),
+            ..ObsHeader::default()
+        };
+        let mut w = RinexObsWriter::create(&self.dir.join("observables.rnx"), header)?;
+        let mut last_tow_s = f64::NEG_INFINITY;
+        for mut o in self.obs_backlog.drain(..) {
+            o.time.week = week;
+            if o.time.tow_s > last_tow_s {
+                last_tow_s = o.time.tow_s;
+                w.write_epoch(&o)?;
+            }
+        }
+        self.obs_writer = Some(w);
+        Ok(())
+    }
+}
+
+impl Sink for FileSink {
+    fn fix(&mut self, report: &FixReport) -> Result<(), SinkError> {
+        self.pvt_csv.write_fix(&report.fix)?;
+        self.nmea.write_fix(&report.fix)?;
+        self.pvt_csv.flush()?;
+        self.nmea.flush()?;
+        self.fixes.push(report.fix.clone());
+        Ok(())
+    }
+
+    fn observables(&mut self, report: &ObservablesReport) -> Result<(), SinkError> {
+        let week = report.epoch.time.week;
+        match (&mut self.obs_writer, report.fix_position_m) {
+            (Some(w), _) => w.write_epoch(&report.epoch)?,
+            (None, Some(position)) => {
+                self.open_observables(Some(position), week)?;
+                if let Some(w) = &mut self.obs_writer {
+                    w.write_epoch(&report.epoch)?;
+                }
+            }
+            (None, None) => {
+                self.obs_backlog.push(report.epoch.clone());
+                // Bounded memory: without a fix for this long (but with the week decoded, so
+                // the labels will not change), the observables go out with an unknown position.
+                if report.week_decoded
+                    && self.obs_backlog.len() as f64 > OBS_BACKLOG_MAX_S * self.rate_hz
+                {
+                    self.open_observables(None, week)?;
+                    tracing::warn!(
+                        "no fix after {OBS_BACKLOG_MAX_S} s of observables: observables.rnx has no approximate position"
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn channel(&mut self, row: &ChannelRow) -> Result<(), SinkError> {
+        Ok(self.channels_csv.write_row(row)?)
+    }
+
+    fn finish(&mut self, end: &NavigationEnd) -> Result<(), SinkError> {
+        self.pvt_csv.flush()?;
+        self.nmea.flush()?;
+        self.channels_csv.flush()?;
+        match self.obs_writer.take() {
+            Some(w) => {
+                w.finish()?;
+            }
+            None if !self.obs_backlog.is_empty() => {
+                // No fix: the observables still go out, with an unknown approximate position,
+                // all labelled with the best week known (the last epoch's: decoded, or the
+                // reference).
+                let week = self.obs_backlog.last().map_or(0, |o| o.time.week);
+                self.open_observables(None, week)?;
+                if let Some(w) = self.obs_writer.take() {
+                    w.finish()?;
+                }
+            }
+            None => {}
+        }
+        let records: Vec<NavRecord> = end
+            .ephemerides
+            .iter()
+            .cloned()
+            .map(NavRecord::from)
+            .collect();
+        let header = NavHeader {
+            iono: end.iono,
+            utc: end.utc,
+            ..NavHeader::default()
+        };
+        write_rinex_nav_file(&self.dir.join("ephemeris.rnx"), &header, &records)?;
+        let mut f = create_file(&self.dir.join("track.geojson"))?;
+        write_geojson(&mut f, "track.geojson", &self.fixes)?;
+        let mut f = create_file(&self.dir.join("track.kml"))?;
+        write_kml(&mut f, "track.kml", "gpsrx track", &self.fixes)?;
+        Ok(())
+    }
+}

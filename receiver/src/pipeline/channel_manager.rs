@@ -1,0 +1,517 @@
+//! The channel manager: which satellites have a tracking channel, and the searches that start
+//! new ones.
+//!
+//! - Cold start: the first samples of the stream are searched for every PRN; when fewer than 4
+//!   are found and the configured search is less sensitive than 10 ms x 10, the rest are
+//!   searched again with 10 ms x 10 (about 8 dB more sensitive), and that engine is kept for
+//!   re-acquisition.
+//! - Re-acquisition: every `interval_s` of signal, the PRNs without a live channel are searched
+//!   in the latest samples; a PRN that has been tracked (and lost) at every interval, one never
+//!   found less and less often (1, 2, 4, then every 8 intervals), since most of the 32 are
+//!   below the horizon.
+//! - Work: every channel processes the code periods the sample window holds, in parallel
+//!   (rayon), concurrently with a due search (rayon `join`), so a search never stalls tracking.
+
+use crate::pipeline::ring::SampleView;
+use gpsrx_dsp::acquisition::{AcqConfig, AcqResult, AcquisitionEngine, SearchTarget};
+use gpsrx_dsp::Prn;
+use gpsrx_tracking::{
+    AidingPort, Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState,
+};
+use num_complex::Complex32;
+use rayon::prelude::*;
+
+/// Coherent integration (ms) and non-coherent blocks of the weak-signal search that follows a
+/// cold start finding fewer than [`WEAK_SEARCH_BELOW`] satellites.
+const WEAK_ACQ: (u32, u32) = (10, 10);
+
+/// A cold start finding fewer satellites than this runs the weak-signal search.
+const WEAK_SEARCH_BELOW: usize = 4;
+
+/// Longest wait between two searches of a PRN that was never found, in search intervals:
+/// a PRN searched and not found waits 1, 2, 4, then 8 intervals before the next search.
+const MAX_BACKOFF_INTERVALS: u32 = 8;
+
+/// How the manager searches.
+#[derive(Debug, Clone)]
+pub struct SearchSettings {
+    /// The acquisition engine's settings (integration, Doppler range).
+    pub acq: AcqConfig,
+    /// Search again with 10 ms x 10 when the first search finds fewer than 4 satellites and is
+    /// less sensitive than that.
+    pub weak_fallback: bool,
+    /// Seconds of signal between re-acquisition searches; `None`: no re-acquisition.
+    pub reacquisition_interval_s: Option<f64>,
+    /// PRNs to look for (empty: all 32).
+    pub prns: Vec<Prn>,
+    /// The cold start's targets, when known better than "every wanted PRN, full Doppler
+    /// range" (an assisted search with predicted Doppler windows).
+    pub cold_targets: Option<Vec<SearchTarget>>,
+}
+
+/// A search due in this block: its first sample and its targets.
+#[derive(Debug)]
+pub struct DueSearch {
+    first: u64,
+    targets: Vec<SearchTarget>,
+}
+
+/// What a search found: its first sample, targets and results.
+#[derive(Debug)]
+pub struct SearchOutcome {
+    first: u64,
+    targets: Vec<SearchTarget>,
+    results: Vec<AcqResult>,
+}
+
+impl SearchOutcome {
+    /// Index of the first sample searched.
+    pub fn first(&self) -> u64 {
+        self.first
+    }
+}
+
+/// The tracking channels and the searches that start them.
+#[derive(Debug)]
+pub struct ChannelManager {
+    fs_hz: f64,
+    channel_config: ChannelConfig,
+    /// The re-acquisition engine (the cold start's, or the weak one); `None` before the cold
+    /// start and when there is no search at all.
+    engine: Option<AcquisitionEngine>,
+    cold: Option<ColdStart>,
+    settings: Option<SearchSettings>,
+    channels: Vec<Channel>,
+    /// Per channel, the reports of the last round (kept: no allocation per block).
+    reports: Vec<Vec<ChannelEpoch>>,
+    schedule: Option<SearchSchedule>,
+}
+
+/// The engines of the cold start, made once.
+#[derive(Debug)]
+struct ColdStart {
+    engine: AcquisitionEngine,
+    weak: Option<AcquisitionEngine>,
+}
+
+impl ChannelManager {
+    /// A manager that searches with `settings` and starts channels with `channel_config`.
+    pub fn new(
+        fs_hz: f64,
+        channel_config: ChannelConfig,
+        settings: SearchSettings,
+    ) -> Result<Self, gpsrx_dsp::acquisition::AcqError> {
+        let engine = AcquisitionEngine::new(fs_hz, settings.acq.clone())?;
+        let (coh, nc) = WEAK_ACQ;
+        let less_sensitive = settings.acq.coherent_ms < coh
+            || settings.acq.coherent_ms * settings.acq.noncoherent < coh * nc;
+        let weak = if settings.weak_fallback && less_sensitive {
+            let cfg = AcqConfig {
+                coherent_ms: coh,
+                noncoherent: nc,
+                ..settings.acq.clone()
+            };
+            Some(AcquisitionEngine::new(fs_hz, cfg)?)
+        } else {
+            None
+        };
+        Ok(Self {
+            fs_hz,
+            channel_config,
+            engine: None,
+            cold: Some(ColdStart { engine, weak }),
+            settings: Some(settings),
+            channels: Vec::new(),
+            reports: Vec::new(),
+            schedule: None,
+        })
+    }
+
+    /// A manager for channels started elsewhere, with no search (loop studies, tests).
+    pub fn with_channels(fs_hz: f64, channels: Vec<Channel>) -> Self {
+        Self {
+            fs_hz,
+            channel_config: ChannelConfig::default(),
+            engine: None,
+            cold: None,
+            settings: None,
+            channels,
+            reports: Vec::new(),
+            schedule: None,
+        }
+    }
+
+    /// Samples the cold start wants before it searches (0 when it is done or there is none).
+    pub fn cold_start_samples(&self) -> usize {
+        self.cold.as_ref().map_or(0, |c| {
+            c.weak
+                .as_ref()
+                .map_or(0, AcquisitionEngine::samples_wanted)
+                .max(c.engine.samples_wanted())
+        })
+    }
+
+    /// Whether the cold start is still to come.
+    pub fn cold_start_pending(&self) -> bool {
+        self.cold.is_some()
+    }
+
+    /// Samples the cold start cannot do without.
+    pub fn cold_start_minimum(&self) -> usize {
+        self.cold.as_ref().map_or(0, |c| c.engine.samples_needed())
+    }
+
+    /// Searches `samples` (whose first sample has index `first_index`) for every wanted PRN,
+    /// starts a channel per satellite found, and returns the detections.
+    pub fn cold_start(
+        &mut self,
+        samples: &[Complex32],
+        first_index: u64,
+    ) -> Result<Vec<AcqResult>, ColdStartError> {
+        let Some(cold) = self.cold.take() else {
+            return Ok(Vec::new());
+        };
+        let n = samples.len();
+        if n < cold.engine.samples_needed() {
+            return Err(ColdStartError::TooShort {
+                samples: n,
+                needed: cold.engine.samples_needed(),
+            });
+        }
+        let targets: Vec<SearchTarget> = match &self.settings {
+            Some(SearchSettings {
+                cold_targets: Some(t),
+                ..
+            }) => t.clone(),
+            s => {
+                let prns = s.as_ref().map(|s| s.prns.as_slice()).unwrap_or(&[]);
+                wanted_prns(prns).map(SearchTarget::full).collect()
+            }
+        };
+        let mut found = cold
+            .engine
+            .search(&samples[..n.min(cold.engine.samples_wanted())], &targets)?;
+        let detected = found.iter().filter(|d| d.detected).count();
+        let engine = match cold.weak {
+            Some(weak) if detected < WEAK_SEARCH_BELOW && n >= weak.samples_needed() => {
+                let acq = cold.engine.config();
+                tracing::warn!(
+                    "{detected} satellite(s) found with {} ms x {}: searching again with {} ms x {} for weak signals (--acq-coherent-ms chooses)",
+                    acq.coherent_ms,
+                    acq.noncoherent,
+                    WEAK_ACQ.0,
+                    WEAK_ACQ.1
+                );
+                let missing: Vec<SearchTarget> = found
+                    .iter()
+                    .filter(|d| !d.detected)
+                    .map(|d| SearchTarget::full(d.prn))
+                    .collect();
+                let again = weak.search(&samples[..n.min(weak.samples_wanted())], &missing)?;
+                for r in again {
+                    if let Some(slot) = found.iter_mut().find(|d| d.prn == r.prn) {
+                        *slot = r;
+                    }
+                }
+                weak
+            }
+            _ => cold.engine,
+        };
+        for d in found.iter().filter(|d| d.detected) {
+            let start = ChannelStart::from_acquisition(d, first_index);
+            self.channels
+                .push(Channel::new(&start, self.fs_hz, &self.channel_config)?);
+            tracing::info!(
+                "{}: acquired, Doppler {:.0} Hz, C/N0 {:.1} dB-Hz",
+                d.prn,
+                d.doppler_hz,
+                d.cn0_dbhz.unwrap_or(f64::NAN)
+            );
+        }
+        if let Some(interval_s) = self
+            .settings
+            .as_ref()
+            .and_then(|s| s.reacquisition_interval_s)
+        {
+            self.schedule = Some(SearchSchedule::new(interval_s, &self.channels, self.fs_hz));
+        }
+        self.engine = Some(engine);
+        Ok(found.into_iter().filter(|d| d.detected).collect())
+    }
+
+    /// Samples a re-acquisition search reads (0 without one).
+    fn search_samples(&self) -> usize {
+        match (&self.engine, &self.schedule) {
+            (Some(e), Some(_)) => e.samples_wanted(),
+            _ => 0,
+        }
+    }
+
+    /// The search due now that the window is `window`, if one is.
+    pub fn due_search(&mut self, window: SampleView<'_>) -> Option<DueSearch> {
+        let keep = self.search_samples();
+        let prns = self
+            .settings
+            .as_ref()
+            .map(|s| s.prns.as_slice())
+            .unwrap_or(&[]);
+        let schedule = self.schedule.as_mut()?;
+        schedule.due(prns, window, keep, &self.channels)
+    }
+
+    /// Every channel processes the code periods `window` holds (in parallel), while `search`
+    /// (if any) runs beside them. With `aid`, each channel's NCOs get the fed-forward Doppler
+    /// of its satellite at the start of every code period.
+    pub fn work(
+        &mut self,
+        window: SampleView<'_>,
+        search: Option<DueSearch>,
+        aid: Option<&dyn AidingPort>,
+    ) -> Option<SearchOutcome> {
+        self.reports.resize_with(self.channels.len(), Vec::new);
+        let channels = &mut self.channels;
+        let reports = &mut self.reports;
+        let mut run_all = || {
+            channels
+                .par_iter_mut()
+                .zip(reports.par_iter_mut())
+                .for_each(|(ch, out)| run_channel(ch, window, aid, out));
+        };
+        match (self.engine.as_ref(), search) {
+            (Some(engine), Some(s)) => {
+                let samples = window.get(s.first, engine.samples_wanted()).unwrap_or(&[]);
+                let (results, ()) = rayon::join(|| engine.search(samples, &s.targets), run_all);
+                results.ok().map(|results| SearchOutcome {
+                    first: s.first,
+                    targets: s.targets,
+                    results,
+                })
+            }
+            _ => {
+                run_all();
+                None
+            }
+        }
+    }
+
+    /// Hands the reports of the last [`ChannelManager::work`] to `f` as `(channel index,
+    /// report)`, channel by channel, each in time order.
+    pub fn drain_reports<E>(
+        &mut self,
+        mut f: impl FnMut(usize, &ChannelEpoch) -> Result<(), E>,
+    ) -> Result<(), E> {
+        for (i, r) in self.reports.iter_mut().enumerate() {
+            let mut result = Ok(());
+            for e in r.iter() {
+                result = f(i, e);
+                if result.is_err() {
+                    break;
+                }
+            }
+            r.clear();
+            result?;
+        }
+        Ok(())
+    }
+
+    /// Starts channels for what a search found; returns the detections.
+    pub fn start_found(&mut self, outcome: SearchOutcome) -> Vec<AcqResult> {
+        let keep = self.search_samples() as u64;
+        if let Some(s) = self.schedule.as_mut() {
+            s.record(&outcome.targets, &outcome.results, outcome.first + keep);
+        }
+        let mut started = Vec::new();
+        for d in outcome.results.into_iter().filter(|d| d.detected) {
+            let start = ChannelStart::from_acquisition(&d, outcome.first);
+            match Channel::new(&start, self.fs_hz, &self.channel_config) {
+                Ok(ch) => {
+                    tracing::info!(
+                        "{}: acquired at {:.2} s, Doppler {:.0} Hz",
+                        d.prn,
+                        outcome.first as f64 / self.fs_hz,
+                        d.doppler_hz
+                    );
+                    self.channels.push(ch);
+                    started.push(d);
+                }
+                Err(e) => tracing::warn!("{}: cannot start a channel: {e}", d.prn),
+            }
+        }
+        started
+    }
+
+    /// The oldest sample still needed: the slowest live channel's next code period, and the
+    /// samples the next search will read. `end` is the window's end.
+    pub fn oldest_needed(&self, end: u64) -> u64 {
+        let live = self
+            .channels
+            .iter()
+            .filter(|c| c.state() != ChannelState::Lost);
+        let oldest = live.map(|c| c.next_span().0).min().unwrap_or(end);
+        let keep = self.search_samples() as u64;
+        let search_from = self
+            .schedule
+            .as_ref()
+            .map_or(u64::MAX, |s| s.next_tick.saturating_sub(keep));
+        oldest.min(search_from)
+    }
+
+    /// Whether nothing more can happen: every channel lost and no search to start new ones.
+    pub fn finished(&self) -> bool {
+        self.schedule.is_none()
+            && self.cold.is_none()
+            && self
+                .channels
+                .iter()
+                .all(|c| c.state() == ChannelState::Lost)
+    }
+
+    /// The channels, in the order they were started.
+    pub fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+
+    /// The channels, consumed.
+    pub fn into_channels(self) -> Vec<Channel> {
+        self.channels
+    }
+}
+
+/// The cold start could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum ColdStartError {
+    /// Fewer samples than one search needs.
+    #[error(
+        "the recording is too short for acquisition ({samples} samples; at least {needed} needed)"
+    )]
+    TooShort {
+        /// Samples available.
+        samples: usize,
+        /// Samples one search needs.
+        needed: usize,
+    },
+    /// The search failed.
+    #[error(transparent)]
+    Acquisition(#[from] gpsrx_dsp::acquisition::AcqError),
+    /// A channel could not be started.
+    #[error("cannot start a tracking channel: {0}")]
+    Channel(#[from] gpsrx_tracking::ConfigError),
+}
+
+/// The PRNs in `prns`, or all 32 when it is empty.
+fn wanted_prns(prns: &[Prn]) -> Box<dyn Iterator<Item = Prn> + '_> {
+    if prns.is_empty() {
+        Box::new(Prn::all())
+    } else {
+        Box::new(prns.iter().copied())
+    }
+}
+
+/// When each PRN is searched next (see the module documentation).
+#[derive(Debug)]
+struct SearchSchedule {
+    /// Sample index of the next search tick.
+    next_tick: u64,
+    /// Samples between ticks.
+    interval: u64,
+    /// Per PRN (index 0 = PRN 1): sample index before which it is not searched again.
+    not_before: [u64; 32],
+    /// Per PRN: the current wait after a fruitless search, in intervals.
+    backoff: [u32; 32],
+    /// Per PRN: whether it has ever had a channel (then it is searched at every tick).
+    tracked: [bool; 32],
+}
+
+impl SearchSchedule {
+    fn new(interval_s: f64, channels: &[Channel], fs: f64) -> Self {
+        let interval = ((interval_s * fs) as u64).max(1);
+        let mut s = Self {
+            next_tick: interval,
+            interval,
+            not_before: [0; 32],
+            backoff: [1; 32],
+            tracked: [false; 32],
+        };
+        for c in channels {
+            s.tracked[c.prn().index()] = true;
+        }
+        s
+    }
+
+    /// The first sample and the targets of the search due in this block, if one is: the wanted
+    /// PRNs without a live channel whose back-off has run out.
+    fn due(
+        &mut self,
+        prns: &[Prn],
+        window: SampleView<'_>,
+        keep: usize,
+        channels: &[Channel],
+    ) -> Option<DueSearch> {
+        let now = window.end();
+        if now < self.next_tick || now - window.start() < keep as u64 {
+            return None;
+        }
+        self.next_tick = now + self.interval;
+        let live = |p: Prn| {
+            channels
+                .iter()
+                .any(|c| c.prn() == p && c.state() != ChannelState::Lost)
+        };
+        let targets: Vec<SearchTarget> = wanted_prns(prns)
+            .filter(|&p| !live(p) && (self.tracked[p.index()] || now >= self.not_before[p.index()]))
+            .map(SearchTarget::full)
+            .collect();
+        tracing::debug!(
+            "re-acquisition at sample {now}: {} PRN(s) searched",
+            targets.len()
+        );
+        (!targets.is_empty()).then(|| DueSearch {
+            first: now - keep as u64,
+            targets,
+        })
+    }
+
+    /// Updates the back-off of the PRNs just searched at sample `now`.
+    fn record(&mut self, targets: &[SearchTarget], results: &[AcqResult], now: u64) {
+        for (t, d) in targets.iter().zip(results) {
+            let i = t.prn.index();
+            if d.detected {
+                self.tracked[i] = true;
+                self.backoff[i] = 1;
+            } else if !self.tracked[i] {
+                // Due again `backoff` intervals after this tick (slightly early, so that it
+                // falls on a tick).
+                self.not_before[i] = now + (u64::from(self.backoff[i]) - 1) * self.interval + 1;
+                self.backoff[i] = (self.backoff[i] * 2).min(MAX_BACKOFF_INTERVALS);
+            }
+        }
+    }
+}
+
+/// Processes every code period of `ch` that `window` holds, appending the reports to `out`.
+fn run_channel(
+    ch: &mut Channel,
+    window: SampleView<'_>,
+    aid: Option<&dyn AidingPort>,
+    out: &mut Vec<ChannelEpoch>,
+) {
+    while ch.state() != ChannelState::Lost {
+        let (start, n) = ch.next_span();
+        if start < window.start() {
+            ch.skip_to(window.start());
+            continue;
+        }
+        match window.get(start, n) {
+            Some(x) => {
+                if let Some(aid) = aid {
+                    let t = start as f64 / ch.fs_hz();
+                    ch.set_aid(aid.doppler_aid(ch.prn(), t), t);
+                }
+                if let Some(e) = ch.process_code_period(x) {
+                    out.push(e);
+                }
+            }
+            None => break,
+        }
+    }
+}

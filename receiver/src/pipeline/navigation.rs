@@ -1,0 +1,471 @@
+//! The navigation processor: from channel reports to observables and fixes.
+//!
+//! Per satellite an LNAV decoder (frame sync, subframes, ephemeris); across satellites the
+//! observable builder (pseudoranges, carrier phase, Doppler at common receiver epochs); per
+//! epoch the WLS PVT with RAIM (`gpsrx_nav::pvt::solve`) with the decoded or assisted
+//! ephemerides, the receiver clock kept within 0.5 ms of GPS time by whole-millisecond steps,
+//! and the aiding feedback (ephemerides, fixes and the time origin to the INS feed-forward).
+
+use crate::config::{IonoModel, RunSettings, TropoModel};
+use crate::landmarks::LandmarkObservation;
+use crate::output::{ChannelRow, Fix, FixQuality, ObsEpoch, SatObs, SatView};
+use crate::pipeline::aiding::InsFeedForward;
+use crate::pipeline::navdata::{NavDecoder, NavEvent};
+use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
+use crate::pipeline::sink::{
+    FixReport, NavigationEnd, ObservablesReport, Progress, ReceiverEvent, Sink, SinkError,
+};
+use gpsrx_nav::atmosphere::KlobucharParams;
+use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
+use gpsrx_nav::ephemeris::Ephemeris;
+use gpsrx_nav::frames::azimuth_elevation;
+use gpsrx_nav::pvt::{solve, Landmark, PvtOptions, PvtSolution, RaimStatus, SatMeasurement};
+use gpsrx_nav::rinex_nav::NavData;
+use gpsrx_nav::time::GpsTime;
+use gpsrx_tracking::{ChannelEpoch, ChannelState};
+use std::collections::BTreeMap;
+
+/// Running statistics of the fixes (bounded memory for any stream length).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FixStats {
+    /// Stream time of the first fix, s.
+    pub first_fix_s: Option<f64>,
+    /// Number of fixes.
+    pub fixes: usize,
+    sum_lat_deg: f64,
+    sum_lon_deg: f64,
+    sum_h_m: f64,
+    sum_pdop: f64,
+}
+
+impl FixStats {
+    fn add(&mut self, t_s: f64, fix: &Fix) {
+        self.first_fix_s.get_or_insert(t_s);
+        self.fixes += 1;
+        self.sum_lat_deg += fix.llh.lat_rad.to_degrees();
+        self.sum_lon_deg += fix.llh.lon_rad.to_degrees();
+        self.sum_h_m += fix.llh.h_m;
+        self.sum_pdop += fix.pdop;
+    }
+
+    /// Mean latitude, longitude (degrees) and height (m) of the fixes.
+    pub fn mean_llh(&self) -> Option<(f64, f64, f64)> {
+        let n = self.fixes as f64;
+        (self.fixes > 0).then(|| (self.sum_lat_deg / n, self.sum_lon_deg / n, self.sum_h_m / n))
+    }
+
+    /// Mean PDOP of the fixes.
+    pub fn mean_pdop(&self) -> Option<f64> {
+        (self.fixes > 0).then(|| self.sum_pdop / self.fixes as f64)
+    }
+}
+
+/// Decoders, observables and PVT.
+#[derive(Debug)]
+pub struct NavigationProcessor {
+    fs_hz: f64,
+    settings: RunSettings,
+    reference_week: u32,
+    nav_assist: Option<NavData>,
+    landmarks: Vec<LandmarkObservation>,
+    decoders: BTreeMap<u8, NavDecoder>,
+    builder: ObservableBuilder,
+    prior: Option<PvtSolution>,
+    iono_fallback_said: bool,
+    /// Per channel: receive time of its last channel row.
+    last_row_t: BTreeMap<usize, f64>,
+    /// Latest sample index a progress report was made for.
+    progress_at: u64,
+    stats: FixStats,
+}
+
+impl NavigationProcessor {
+    /// A processor for samples at `fs_hz`. `cn0_lost_dbhz`: reports below it give no
+    /// observables. `reference_week` resolves the broadcast 10-bit week.
+    pub fn new(
+        fs_hz: f64,
+        settings: RunSettings,
+        cn0_lost_dbhz: f64,
+        reference_week: u32,
+        nav_assist: Option<NavData>,
+        landmarks: Vec<LandmarkObservation>,
+    ) -> Self {
+        let builder =
+            ObservableBuilder::new(fs_hz, settings.rate_hz).with_min_cn0_dbhz(cn0_lost_dbhz);
+        Self {
+            fs_hz,
+            settings,
+            reference_week,
+            nav_assist,
+            landmarks,
+            decoders: BTreeMap::new(),
+            builder,
+            prior: None,
+            iono_fallback_said: false,
+            last_row_t: BTreeMap::new(),
+            progress_at: 0,
+            stats: FixStats::default(),
+        }
+    }
+
+    /// The fixes so far, summarised.
+    pub fn stats(&self) -> &FixStats {
+        &self.stats
+    }
+
+    /// The satellites tracked at some point.
+    pub fn tracked_prns(&self) -> Vec<u8> {
+        self.decoders.keys().copied().collect()
+    }
+
+    /// What was decoded: ephemerides, ionosphere and UTC parameters.
+    pub fn end(&self) -> NavigationEnd {
+        NavigationEnd {
+            ephemerides: self
+                .decoders
+                .values()
+                .filter_map(|d| d.ephemeris.clone())
+                .collect(),
+            iono: self.decoders.values().find_map(|d| d.iono),
+            utc: self.decoders.values().find_map(|d| d.utc),
+        }
+    }
+
+    /// Takes one channel report: decodes its bit, writes the channel row, builds observables
+    /// and solves every epoch that is complete.
+    pub fn on_report(
+        &mut self,
+        channel: usize,
+        e: &ChannelEpoch,
+        aiding: Option<&InsFeedForward>,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        sink.channel_epoch(channel, e)?;
+        self.decode(e, aiding, sink)?;
+        self.channel_row(channel, e, sink)?;
+        let ready = match self.decoders.get(&e.prn) {
+            Some(d) => self.builder.push(e, d),
+            None => Vec::new(),
+        };
+        if let (Some(ff), Some(t0)) = (aiding, self.builder.rx_time_origin()) {
+            ff.set_time_origin(t0);
+        }
+        for epoch in ready {
+            self.solve_epoch(epoch, aiding, sink)?;
+        }
+        let s = e.sample_index;
+        if s > self.progress_at + (self.fs_hz * 0.2) as u64 {
+            self.progress_at = s;
+            sink.progress(&Progress {
+                sample_index: s,
+                satellites: self.decoders.len(),
+                frame_synced: self.decoders.values().filter(|d| d.synced()).count(),
+                with_ephemeris: self
+                    .decoders
+                    .values()
+                    .filter(|d| d.ephemeris.is_some())
+                    .count(),
+                fixes: self.stats.fixes,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Feeds the report's data bit to its satellite's decoder.
+    fn decode(
+        &mut self,
+        e: &ChannelEpoch,
+        aiding: Option<&InsFeedForward>,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        let week = self.reference_week;
+        let dec = self
+            .decoders
+            .entry(e.prn)
+            .or_insert_with(|| NavDecoder::new(e.prn, week));
+        if let (Some(b), Some(ms)) = (e.bit, e.bit_start_ms) {
+            for ev in dec.push_bit(b.value, ms) {
+                match ev {
+                    NavEvent::FrameSync { tow_s } => {
+                        tracing::info!("G{:02}: frame sync, TOW {tow_s} s", e.prn);
+                        sink.event(&ReceiverEvent::FrameSync {
+                            prn: e.prn,
+                            tow_s: f64::from(tow_s),
+                        })?;
+                    }
+                    NavEvent::Ephemeris(eph) => {
+                        tracing::info!("G{:02}: ephemeris decoded (IODE {})", e.prn, eph.iode);
+                        if let Some(ff) = aiding {
+                            ff.set_ephemeris(&eph);
+                        }
+                        sink.event(&ReceiverEvent::EphemerisDecoded {
+                            prn: e.prn,
+                            iode: eph.iode,
+                        })?;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        if e.state == ChannelState::Lost {
+            dec.reset_sync();
+            sink.event(&ReceiverEvent::Lost {
+                prn: e.prn,
+                t_s: e.t_rx_s,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The channel's row, at most once per fix interval.
+    fn channel_row(
+        &mut self,
+        channel: usize,
+        e: &ChannelEpoch,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        let due = self
+            .last_row_t
+            .get(&channel)
+            .is_none_or(|&t| e.t_rx_s - t >= 1.0 / self.settings.rate_hz - 1e-9);
+        if !due {
+            return Ok(());
+        }
+        self.last_row_t.insert(channel, e.t_rx_s);
+        let synced = self.decoders.get(&e.prn).is_some_and(NavDecoder::synced);
+        let row = ChannelRow {
+            time: self
+                .builder
+                .rx_time_origin()
+                .map(|t0| t0.add_seconds(e.t_rx_s))
+                .unwrap_or(GpsTime {
+                    week: 0,
+                    tow_s: e.t_rx_s,
+                }),
+            channel: channel as u32,
+            prn: e.prn,
+            state: format!("{:?}", e.state).to_lowercase(),
+            cn0_dbhz: e.cn0_dbhz.is_finite().then_some(e.cn0_dbhz),
+            doppler_hz: Some(e.doppler_hz),
+            code_phase_chips: Some(e.code_phase_chips),
+            pll_lock_indicator: Some(e.pll_lock_metric),
+            code_lock: e.code_lock,
+            carrier_lock: e.pll_lock,
+            bit_sync: e.bit_edge || synced,
+            frame_sync: synced,
+        };
+        sink.channel(&row)
+    }
+
+    /// The ionosphere parameters for the next solution: decoded, assisted, else a typical set.
+    fn iono(&mut self) -> Option<KlobucharParams> {
+        if self.settings.iono != IonoModel::Klobuchar {
+            return None;
+        }
+        let known = self
+            .decoders
+            .values()
+            .find_map(|d| d.iono)
+            .or_else(|| self.nav_assist.as_ref().and_then(|n| n.iono));
+        if known.is_none() && !self.iono_fallback_said {
+            tracing::info!(
+                "ionosphere: typical Klobuchar coefficients until subframe 4 page 18 is decoded (or give --nav)"
+            );
+            self.iono_fallback_said = true;
+        }
+        Some(known.unwrap_or(KlobucharParams::FALLBACK))
+    }
+
+    /// The ephemeris for each satellite of the epoch: decoded, else from the navigation file.
+    fn ephemerides(&self, epoch: &ObservableEpoch) -> Vec<(u8, Ephemeris)> {
+        epoch
+            .sats
+            .iter()
+            .filter_map(|s| {
+                let decoded = self.decoders.get(&s.prn).and_then(|d| d.ephemeris.clone());
+                decoded
+                    .or_else(|| {
+                        self.nav_assist
+                            .as_ref()
+                            .and_then(|n| n.select(s.prn, epoch.rx_time).cloned())
+                    })
+                    .map(|e| (s.prn, e))
+            })
+            .collect()
+    }
+
+    /// The WLS solution of one epoch, if there are enough measurements.
+    fn solution(
+        &mut self,
+        epoch: &ObservableEpoch,
+        ephs: &[(u8, Ephemeris)],
+    ) -> Option<PvtSolution> {
+        let meas: Vec<SatMeasurement<'_>> = epoch
+            .sats
+            .iter()
+            .filter_map(|s| {
+                let (_, eph) = ephs.iter().find(|(p, _)| *p == s.prn)?;
+                (eph.sv_health == 0 || self.settings.allow_unhealthy).then_some(SatMeasurement {
+                    prn: s.prn,
+                    pseudorange_m: s.smoothed_pseudorange_m,
+                    doppler_hz: Some(s.doppler_hz),
+                    cn0_dbhz: s.cn0_dbhz,
+                    tx_time: None,
+                    ephemeris: eph,
+                })
+            })
+            .collect();
+        let opts = PvtOptions {
+            tropo: self.settings.tropo == TropoModel::Saastamoinen,
+            elevation_mask_deg: self.settings.elevation_mask_deg,
+            raim_pfa: self.settings.raim_pfa,
+            iono: self.iono(),
+            ..PvtOptions::default()
+        };
+        // Landmark observations of this epoch (receiver time within half an interval; the clock
+        // bias is kept below 0.5 ms, far less than that).
+        let landmarks: Vec<Landmark> = self
+            .landmarks
+            .iter()
+            .filter(|l| (l.tow_s - epoch.rx_time.tow_s).abs() <= 0.5 / self.settings.rate_hz)
+            .map(|l| l.landmark)
+            .collect();
+        if meas.len() + landmarks.len() < 4 || meas.is_empty() {
+            tracing::trace!(
+                "{} satellites with ephemeris at {:.3}",
+                meas.len(),
+                epoch.rx_time.tow_s
+            );
+            return None;
+        }
+        match solve(epoch.rx_time, &meas, &landmarks, &opts, self.prior.as_ref()) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                tracing::debug!("no fix at {:.3}: {e}", epoch.rx_time.tow_s);
+                None
+            }
+        }
+    }
+
+    /// Solves one epoch and hands its observables and fix to the sink.
+    fn solve_epoch(
+        &mut self,
+        epoch: ObservableEpoch,
+        aiding: Option<&InsFeedForward>,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        let ephs = self.ephemerides(&epoch);
+        let solution = self.solution(&epoch, &ephs);
+        sink.observables(&ObservablesReport {
+            epoch: obs_epoch(&epoch),
+            fix_position_m: solution
+                .as_ref()
+                .map(|s| [s.pos_ecef_m.x, s.pos_ecef_m.y, s.pos_ecef_m.z]),
+            week_decoded: self.decoders.values().any(|d| d.decoded_week().is_some()),
+        })?;
+        let Some(sol) = solution else {
+            return Ok(());
+        };
+        // Keep the receiver clock within +-0.5 ms of GPS time by whole-millisecond steps.
+        let bias_ms = sol.clock_bias_m / SPEED_OF_LIGHT_MPS * 1e3;
+        if bias_ms.abs() > 0.5 {
+            let step = -bias_ms.round() as i64;
+            self.builder.step_clock_ms(step);
+            tracing::debug!("receiver clock stepped by {step} ms");
+            sink.event(&ReceiverEvent::ClockStep { ms: step })?;
+        }
+        let t_stream_s = epoch.sample / self.fs_hz;
+        if self.stats.first_fix_s.is_none() {
+            tracing::info!(
+                "first fix at {:.2} s: {:.7} {:.7} {:.1} m, {} satellites, PDOP {:.1}",
+                t_stream_s,
+                sol.llh.lat_rad.to_degrees(),
+                sol.llh.lon_rad.to_degrees(),
+                sol.llh.h_m,
+                sol.n_sv,
+                sol.dop.pdop
+            );
+        }
+        let fix = fix_of(&sol, &epoch, &ephs);
+        if let Some(ff) = aiding {
+            ff.set_fix(t_stream_s, sol.pos_ecef_m, sol.clock_drift_mps);
+        }
+        self.stats.add(t_stream_s, &fix);
+        sink.fix(&FixReport {
+            fix,
+            solution: sol.clone(),
+            t_stream_s,
+        })?;
+        self.prior = Some(sol);
+        Ok(())
+    }
+}
+
+/// The observables of an epoch as RINEX writes them.
+fn obs_epoch(epoch: &ObservableEpoch) -> ObsEpoch {
+    ObsEpoch {
+        time: epoch.rx_time,
+        clock_offset_s: None,
+        sats: epoch
+            .sats
+            .iter()
+            .map(|s| SatObs {
+                prn: s.prn,
+                pseudorange_m: Some(s.pseudorange_m),
+                carrier_cycles: Some(s.carrier_cycles),
+                doppler_hz: Some(s.doppler_hz),
+                cn0_dbhz: s.cn0_dbhz.is_finite().then_some(s.cn0_dbhz),
+                loss_of_lock: s.loss_of_lock || epoch.clock_step_ms != 0,
+                half_cycle_ambiguous: s.half_cycle_ambiguous,
+            })
+            .collect(),
+    }
+}
+
+/// The fix of a solution, with the satellites in view (azimuth, elevation, C/N0).
+fn fix_of(sol: &PvtSolution, epoch: &ObservableEpoch, ephs: &[(u8, Ephemeris)]) -> Fix {
+    let sats_in_view = ephs
+        .iter()
+        .map(|(prn, eph)| {
+            let sv = eph.sv_state(sol.time);
+            let (az, el) = azimuth_elevation(&sol.pos_ecef_m, &sv.pos_m);
+            let cn0 = epoch
+                .sats
+                .iter()
+                .find(|s| s.prn == *prn)
+                .map(|s| s.cn0_dbhz)
+                .filter(|c| c.is_finite());
+            SatView {
+                prn: *prn,
+                el_deg: el.to_degrees(),
+                az_deg: az.to_degrees().rem_euclid(360.0),
+                cn0_dbhz: cn0,
+            }
+        })
+        .collect();
+    Fix {
+        time: sol.time,
+        ecef_m: [sol.pos_ecef_m.x, sol.pos_ecef_m.y, sol.pos_ecef_m.z],
+        llh: sol.llh,
+        vel_ecef_mps: sol.vel_ecef_mps.map(|v| [v.x, v.y, v.z]),
+        clock_bias_m: sol.clock_bias_m,
+        clock_drift_mps: sol.clock_drift_mps,
+        n_sv: sol.n_sv,
+        used_prns: sol.used_prns.clone(),
+        pdop: sol.dop.pdop,
+        hdop: sol.dop.hdop,
+        vdop: sol.dop.vdop,
+        raim: raim_text(&sol.raim),
+        quality: FixQuality::Gnss,
+        sats_in_view,
+    }
+}
+
+/// The RAIM status as the outputs write it.
+fn raim_text(r: &RaimStatus) -> String {
+    match r {
+        RaimStatus::Ok => "ok".into(),
+        RaimStatus::FaultExcluded { prn } => format!("excluded G{prn:02}"),
+        other => format!("{other:?}").to_lowercase(),
+    }
+}

@@ -1,0 +1,4 @@
+//! Integration tests of the receiver library: the pipeline driven in memory against the
+//! simulator's truth (one test binary for the crate).
+
+mod pipeline;

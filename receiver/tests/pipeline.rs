@@ -1,0 +1,364 @@
+//! The receiver pipeline in memory: samples from the simulator pushed block by block in any
+//! chunking, or read through a source, give the same fixes, and they land on the truth.
+
+use gpsrx_nav::rinex_nav::parse_rinex_nav;
+use gpsrx_receiver::pipeline::{MemorySink, ReceiverEvent, Sink};
+use gpsrx_receiver::{Assistance, Receiver, ReceiverConfig};
+use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
+use gpsrx_samples::sim::{Scenario, Simulator};
+use gpsrx_samples::{SampleError, SampleFormat, SampleSource};
+use num_complex::Complex32;
+use std::path::Path;
+
+/// A static receiver near Daejeon, 2.048 MHz, the built-in broadcast ephemerides.
+fn simulator(duration_s: f64) -> Simulator {
+    let text = format!(
+        r#"
+duration_s = {duration_s}
+seed = 7
+nav = "builtin:brdc0010.22n"
+[start]
+week = 2190
+tow_s = 538198.0
+[output]
+format = "cf32_le"
+fs_hz = 2.048e6
+[receiver]
+kind = "static"
+llh_deg = [36.3721, 127.3604, 80.0]
+[clock]
+bias_s = 3.0e-4
+drift_s_s = 4.0e-8
+"#
+    );
+    let sc = Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
+    Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The simulator's samples as a source, read in reads of any size.
+struct SimSource<'a> {
+    sim: &'a Simulator,
+    chunk: u64,
+    buf: Vec<Complex32>,
+    used: usize,
+    next: u64,
+    format: SampleFormat,
+}
+
+impl<'a> SimSource<'a> {
+    fn new(sim: &'a Simulator) -> Self {
+        Self {
+            sim,
+            chunk: 0,
+            buf: Vec::new(),
+            used: 0,
+            next: 0,
+            format: SampleFormat::Cf32Le,
+        }
+    }
+}
+
+impl SampleSource for SimSource<'_> {
+    fn fs_hz(&self) -> f64 {
+        2.048e6
+    }
+    fn format(&self) -> &SampleFormat {
+        &self.format
+    }
+    fn total_samples(&self) -> Option<u64> {
+        Some(self.sim.total_samples())
+    }
+    fn read(&mut self, out: &mut [Complex32]) -> Result<(u64, usize), SampleError> {
+        let first = self.next;
+        let mut n = 0;
+        while n < out.len() {
+            if self.used == self.buf.len() {
+                if self.chunk >= self.sim.chunk_count() {
+                    break;
+                }
+                self.sim.generate_chunk(self.chunk, &mut self.buf);
+                self.chunk += 1;
+                self.used = 0;
+            }
+            let k = (out.len() - n).min(self.buf.len() - self.used);
+            out[n..n + k].copy_from_slice(&self.buf[self.used..self.used + k]);
+            self.used += k;
+            n += k;
+        }
+        self.next += n as u64;
+        Ok((first, n))
+    }
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+fn receiver(fs_hz: f64) -> Receiver {
+    let mut config = ReceiverConfig::default();
+    config.run.tropo = gpsrx_receiver::config::TropoModel::None;
+    config.run.week = Some(2190);
+    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let assistance = Assistance {
+        nav: Some(nav),
+        ..Assistance::default()
+    };
+    Receiver::new(&config, fs_hz, assistance).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn pushed_blocks_of_any_size_give_the_fixes_of_a_source_run() {
+    let sim = simulator(14.0);
+    let fs = 2.048e6;
+    // Run from a source.
+    let mut by_run = MemorySink::new();
+    let summary = receiver(fs)
+        .run(&mut SimSource::new(&sim), &mut by_run)
+        .unwrap_or_else(|e| panic!("{e}"));
+    // Pushed in odd block sizes (a prime, and 1 ms + 1 sample).
+    let mut pushed = [MemorySink::new(), MemorySink::new()];
+    let mut rx = [receiver(fs), receiver(fs)];
+    let sizes = [7919usize, 2049];
+    let mut src = SimSource::new(&sim);
+    let mut block = vec![Complex32::new(0.0, 0.0); 50_000];
+    let mut pending: [Vec<Complex32>; 2] = [Vec::new(), Vec::new()];
+    loop {
+        let (_, n) = src.read(&mut block).unwrap_or_else(|e| panic!("{e}"));
+        for k in 0..2 {
+            pending[k].extend_from_slice(&block[..n]);
+            let whole = pending[k].len() / sizes[k] * sizes[k];
+            let take = if n == 0 { pending[k].len() } else { whole };
+            for part in pending[k][..take].chunks(sizes[k]) {
+                rx[k]
+                    .push(part, &mut pushed[k])
+                    .unwrap_or_else(|e| panic!("{e}"));
+            }
+            pending[k].drain(..take);
+        }
+        if n == 0 {
+            break;
+        }
+    }
+    for k in 0..2 {
+        let s = rx[k]
+            .finish(&mut pushed[k])
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.fixes, summary.fixes, "block size {}", sizes[k]);
+        assert_eq!(s.tracked_prns, summary.tracked_prns);
+        for (a, b) in pushed[k].fixes.iter().zip(&by_run.fixes) {
+            assert_eq!(a.fix.ecef_m, b.fix.ecef_m, "block size {}", sizes[k]);
+            assert_eq!(a.fix.time, b.fix.time);
+        }
+        assert_eq!(pushed[k].observables.len(), by_run.observables.len());
+        assert_eq!(pushed[k].events, by_run.events);
+    }
+    // The fixes land on the truth (static antenna): within 3 m horizontally and 6 m
+    // vertically, every one of them, and the first comes within 12 s (frame sync plus an
+    // ephemeris from the navigation file).
+    assert!(summary.fixes > 10, "{} fixes", summary.fixes);
+    let first = summary.first_fix_s.unwrap_or(f64::INFINITY);
+    assert!(first < 12.0, "first fix at {first:.1} s");
+    let (_, truth) = sim.receiver_truth(0.0);
+    for f in &by_run.fixes {
+        let r = gpsrx_nav::frames::enu_rotation(&f.fix.llh);
+        let d = gpsrx_nav::frames::Vector3::new(
+            f.fix.ecef_m[0] - truth.pos_m.x,
+            f.fix.ecef_m[1] - truth.pos_m.y,
+            f.fix.ecef_m[2] - truth.pos_m.z,
+        );
+        let enu = r * d;
+        assert!(
+            enu.x.hypot(enu.y) < 3.0 && enu.z.abs() < 6.0,
+            "fix at {:.1} s off by {:.2} m E, {:.2} m N, {:.2} m U",
+            f.t_stream_s,
+            enu.x,
+            enu.y,
+            enu.z
+        );
+    }
+    // Every simulated satellite above the mask was acquired, and each was announced once.
+    let acquired: Vec<u8> = by_run
+        .events
+        .iter()
+        .filter_map(|e| match e {
+            ReceiverEvent::Acquired { prn, .. } => Some(*prn),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(acquired.len(), summary.tracked_prns.len());
+    assert!(
+        summary.tracked_prns.len() >= 6,
+        "{:?}",
+        summary.tracked_prns
+    );
+    assert!(by_run.end.is_some(), "the sink was not finished");
+}
+
+#[test]
+fn a_source_at_another_rate_is_refused() {
+    let sim = simulator(1.0);
+    let mut rx = receiver(4.0e6);
+    let err = rx
+        .run(&mut SimSource::new(&sim), &mut MemorySink::new())
+        .err()
+        .unwrap_or_else(|| panic!("a 2.048 MHz source accepted by a 4 MHz receiver"));
+    assert!(err.to_string().contains("2048000 Hz"), "{err}");
+}
+
+#[test]
+fn a_stream_shorter_than_one_search_is_an_error_naming_it() {
+    let mut rx = receiver(2.048e6);
+    let mut sink = MemorySink::new();
+    rx.push(&[Complex32::new(1.0, 0.0); 1000], &mut sink)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let err = rx
+        .finish(&mut sink)
+        .err()
+        .unwrap_or_else(|| panic!("1000 samples accepted"));
+    assert!(err.to_string().contains("too short"), "{err}");
+}
+
+#[test]
+fn non_finite_samples_read_as_zero_and_samples_after_the_end_are_refused() {
+    let mut rx = receiver(2.048e6);
+    let mut sink = MemorySink::new();
+    let nan = Complex32::new(f32::NAN, f32::INFINITY);
+    // Half a second of NaN and infinity: no panic, no satellite, no fix.
+    for _ in 0..50 {
+        rx.push(&[nan; 20_480], &mut sink)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    let summary = rx.finish(&mut sink).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        summary.tracked_prns.is_empty(),
+        "{:?}",
+        summary.tracked_prns
+    );
+    assert_eq!(summary.fixes, 0);
+    let err = rx
+        .push(&[Complex32::new(1.0, 0.0); 10], &mut sink)
+        .err()
+        .unwrap_or_else(|| panic!("samples accepted after finish"));
+    assert!(err.to_string().contains("ended"), "{err}");
+}
+
+#[test]
+fn an_invalid_configuration_names_the_setting() {
+    let mut config = ReceiverConfig::default();
+    config.run.rate_hz = 100.0;
+    let err = Receiver::new(&config, 2.048e6, Assistance::default())
+        .err()
+        .unwrap_or_else(|| panic!("rate 100 Hz accepted"));
+    assert!(
+        err.to_string().contains("rate 100 Hz: use 1 to 50 Hz"),
+        "{err}"
+    );
+    let err = ReceiverConfig::from_toml("[run]\nrate = 5\n", "test.toml")
+        .err()
+        .unwrap_or_else(|| panic!("unknown key accepted"));
+    assert!(err.to_string().contains("rate"), "{err}");
+}
+
+#[test]
+fn the_channel_manager_alone_finds_the_simulated_satellites_at_their_doppler() {
+    use gpsrx_dsp::acquisition::AcqConfig;
+    use gpsrx_receiver::pipeline::channel_manager::{ChannelManager, SearchSettings};
+    let sim = simulator(0.5);
+    let fs = 2.048e6;
+    let settings = SearchSettings {
+        acq: AcqConfig::default(),
+        weak_fallback: true,
+        reacquisition_interval_s: Some(1.0),
+        prns: Vec::new(),
+        cold_targets: None,
+    };
+    let mut manager = ChannelManager::new(fs, gpsrx_tracking::ChannelConfig::default(), settings)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut samples = vec![Complex32::new(0.0, 0.0); manager.cold_start_samples()];
+    let (first, n) = SimSource::new(&sim)
+        .read(&mut samples)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let found = manager
+        .cold_start(&samples[..n], first)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(found.len() >= 6, "{} found", found.len());
+    assert_eq!(manager.channels().len(), found.len());
+    for d in &found {
+        // Truth Doppler: the rate of the simulated carrier phase at the middle of the search.
+        let sat = sim
+            .satellites
+            .iter()
+            .find(|s| s.prn == d.prn)
+            .unwrap_or_else(|| panic!("{}: not simulated (a false acquisition)", d.prn));
+        let t = n as f64 / fs / 2.0;
+        let (a, _) = sim.observe(sat, t - 0.5e-3);
+        let (b, _) = sim.observe(sat, t + 0.5e-3);
+        let truth_hz = (b.carrier_cycles - a.carrier_cycles) / 1e-3;
+        assert!(
+            (d.doppler_hz - truth_hz).abs() < 100.0,
+            "{}: Doppler {:.0} Hz, truth {truth_hz:.0} Hz",
+            d.prn,
+            d.doppler_hz
+        );
+    }
+}
+
+#[test]
+fn the_navigation_processor_alone_and_the_file_sink_alone_reproduce_a_run() {
+    use gpsrx_receiver::output::FileSink;
+    use gpsrx_receiver::pipeline::navigation::NavigationProcessor;
+    use gpsrx_receiver::pipeline::Tee;
+    let sim = simulator(13.0);
+    let fs = 2.048e6;
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    // A run writing files and keeping every channel report.
+    let mut sink = Tee(
+        FileSink::create(&dir.path().join("run"), 10.0).unwrap_or_else(|e| panic!("{e}")),
+        MemorySink::new().with_channel_epochs(),
+    );
+    let summary = receiver(fs)
+        .run(&mut SimSource::new(&sim), &mut sink)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let Tee(_, memory) = sink;
+    assert!(summary.fixes > 5, "{} fixes", summary.fixes);
+    // The navigation processor on the recorded reports alone (no samples, no tracking) into a
+    // second file sink: the same fixes and the same files.
+    let mut config = ReceiverConfig::default();
+    config.run.tropo = gpsrx_receiver::config::TropoModel::None;
+    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let mut alone = NavigationProcessor::new(
+        fs,
+        config.run.clone(),
+        config.tracking.cn0_lost_dbhz,
+        2190,
+        Some(nav),
+        Vec::new(),
+    );
+    let mut replay = Tee(
+        FileSink::create(&dir.path().join("replay"), 10.0).unwrap_or_else(|e| panic!("{e}")),
+        MemorySink::new(),
+    );
+    for (i, e) in &memory.channel_epochs {
+        alone
+            .on_report(*i, e, None, &mut replay)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    replay
+        .finish(&alone.end())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(replay.1.fixes.len(), memory.fixes.len());
+    for (a, b) in replay.1.fixes.iter().zip(&memory.fixes) {
+        assert_eq!(a.fix.ecef_m, b.fix.ecef_m);
+    }
+    for name in [
+        "pvt.csv",
+        "pvt.nmea",
+        "channels.csv",
+        "track.geojson",
+        "track.kml",
+    ] {
+        let read = |d: &str| {
+            std::fs::read(dir.path().join(d).join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+        };
+        assert_eq!(read("run"), read("replay"), "{name} differs");
+    }
+}
