@@ -6,7 +6,7 @@
 //! When `rnx2rtkp` is not installed the RTKLIB test prints a note and passes, except with
 //! CI=true, where it fails.
 
-use gpsrx_nav::constants::{L1_FREQ_HZ, SPEED_OF_LIGHT_MPS};
+use gpsrx_nav::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::{
     azimuth_elevation, read_rinex_nav, rotate_for_earth_rotation, Ephemeris, GpsTime, Llh, NavData,
     Vector3,
@@ -418,7 +418,7 @@ fn forward(eph: &Ephemeris, rx: &Vector3<f64>, t: GpsTime) -> (f64, f64, f64, Ve
 /// Ten 1 s epochs from 2022-01-01 05:30:00 GPST, satellites above 10 degrees.
 fn synthetic_epochs(nav: &NavData) -> Vec<ObsEpoch> {
     let rx = truth().to_ecef();
-    let lambda = SPEED_OF_LIGHT_MPS / L1_FREQ_HZ;
+    let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
     let t0 = GpsTime::from_calendar(2022, 1, 1, 5, 30, 0.0);
     (0..10)
         .map(|k| {

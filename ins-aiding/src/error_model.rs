@@ -38,6 +38,7 @@
 
 use crate::band_limiter::BandLimiter;
 use crate::ins_file::{InsError, InsSample};
+use gpsrx_core::frames::{enu_rotation, Llh};
 use nalgebra::{Matrix3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
@@ -158,53 +159,11 @@ pub struct TruthState {
     pub vel_mps: Vector3<f64>,
 }
 
-/// WGS-84 semi-major axis, m.
-const WGS84_A_M: f64 = 6_378_137.0;
-/// WGS-84 first eccentricity squared.
-const WGS84_E2: f64 = 6.694_379_990_14e-3;
-
-/// Geodetic (WGS-84) latitude and longitude (rad) of an ECEF point, by fixed-point iteration of
-/// `phi = atan2(z, p (1 - e^2 N / (N + h)))`, `N = a / sqrt(1 - e^2 sin^2 phi)`,
-/// `h = p / cos phi - N` (converges to 1e-15 rad in a few steps anywhere outside the Earth's core).
-fn geodetic_lat_lon_rad(pos_m: &Vector3<f64>) -> (f64, f64) {
-    let lon = pos_m.y.atan2(pos_m.x);
-    let p = pos_m.x.hypot(pos_m.y);
-    let mut lat = pos_m.z.atan2(p * (1.0 - WGS84_E2));
-    for _ in 0..10 {
-        let (s, c) = lat.sin_cos();
-        let n = WGS84_A_M / (1.0 - WGS84_E2 * s * s).sqrt();
-        // Use the form that stays accurate near the poles (p -> 0).
-        let h = if c.abs() > 1e-3 {
-            p / c - n
-        } else {
-            pos_m.z / s - n * (1.0 - WGS84_E2)
-        };
-        let next = pos_m.z.atan2(p * (1.0 - WGS84_E2 * n / (n + h)));
-        if (next - lat).abs() < 1e-15 {
-            return (next, lon);
-        }
-        lat = next;
-    }
-    (lat, lon)
-}
-
 /// The rotation from the local level frame (east, north, up) at `pos_m` to ECEF: its columns are
-/// `e`, `n`, `u` of the module documentation (geodetic latitude).
+/// `e`, `n`, `u` of the module documentation (geodetic WGS-84 latitude and longitude from
+/// [`Llh::from_ecef`]; the transpose of the ECEF -> ENU [`enu_rotation`]).
 fn enu_to_ecef(pos_m: &Vector3<f64>) -> Matrix3<f64> {
-    let (lat, lon) = geodetic_lat_lon_rad(pos_m);
-    let (sp, cp) = lat.sin_cos();
-    let (sl, cl) = lon.sin_cos();
-    Matrix3::new(
-        -sl,
-        -sp * cl,
-        cp * cl, //
-        cl,
-        -sp * sl,
-        cp * sl, //
-        0.0,
-        cp,
-        sp,
-    )
+    enu_rotation(&Llh::from_ecef(pos_m)).transpose()
 }
 
 fn finite(v: &Vector3<f64>) -> bool {
@@ -311,18 +270,9 @@ pub fn simulate_ins(
 mod tests {
     use super::*;
 
-    /// WGS-84 geodetic -> ECEF, closed form: `N = a / sqrt(1 - e^2 sin^2 phi)`,
-    /// `x = (N + h) cos phi cos lambda`, `y = (N + h) cos phi sin lambda`,
-    /// `z = (N (1 - e^2) + h) sin phi`.
+    /// WGS-84 geodetic (degrees, m) -> ECEF.
     fn ecef(lat_deg: f64, lon_deg: f64, h_m: f64) -> Vector3<f64> {
-        let (sp, cp) = lat_deg.to_radians().sin_cos();
-        let (sl, cl) = lon_deg.to_radians().sin_cos();
-        let n = WGS84_A_M / (1.0 - WGS84_E2 * sp * sp).sqrt();
-        Vector3::new(
-            (n + h_m) * cp * cl,
-            (n + h_m) * cp * sl,
-            (n * (1.0 - WGS84_E2) + h_m) * sp,
-        )
+        Llh::from_degrees(lat_deg, lon_deg, h_m).to_ecef()
     }
 
     fn seoul() -> Vector3<f64> {
@@ -378,9 +328,9 @@ mod tests {
             let up = (ecef(lat, lon, 1000.0) - ecef(lat, lon, 0.0)) / 1000.0;
             let r = enu_to_ecef(&ecef(lat, lon, 250.0));
             assert!((r * Vector3::z() - up).norm() < 1e-9, "lat {lat} lon {lon}");
-            let (glat, glon) = geodetic_lat_lon_rad(&ecef(lat, lon, 250.0));
-            assert!((glat - lat.to_radians()).abs() < 1e-12, "lat {lat}");
-            assert!((glon - lon.to_radians()).abs() < 1e-12, "lon {lon}");
+            let g = Llh::from_ecef(&ecef(lat, lon, 250.0));
+            assert!((g.lat_rad - lat.to_radians()).abs() < 1e-12, "lat {lat}");
+            assert!((g.lon_rad - lon.to_radians()).abs() < 1e-12, "lon {lon}");
             // A rotation: orthonormal and right-handed.
             assert!((r.transpose() * r - Matrix3::identity()).norm() < 1e-12);
             assert!((r.determinant() - 1.0).abs() < 1e-12);

@@ -7,7 +7,8 @@
 //! - [`error_model`]: INS error models (accelerometer bias, velocity random walk, scale factor,
 //!   latency, band limit) that turn a truth trajectory into a simulated INS output;
 //! - [`band_limiter`]: the first-order band limiter `alpha / (s + alpha)` of seed 004 eq. 8;
-//! - [`feedforward`]: the line-of-sight Doppler `((v_sv - v_rx) . l) / lambda` of seed 004 eq. 6.
+//! - the line-of-sight Doppler `((v_sv - v_rx) . l) / lambda` of seed 004 eq. 6 is
+//!   [`gpsrx_core::los_doppler_hz`].
 //!
 //! Dead reckoning (seed 000) and the speed filter (seed 002):
 //! - [`dr_log`]: the `--dr FILE.csv` input: [`DrSample`] `{ t_s, reading: DrReading }` with
@@ -51,7 +52,6 @@ pub mod dr_log;
 pub mod dr_mechanization;
 pub mod dr_sensors;
 pub mod error_model;
-pub mod feedforward;
 pub mod ins_file;
 pub mod speed_filter;
 pub mod vehicle;
@@ -70,7 +70,6 @@ pub use dr_sensors::{
     SEED000_SF_G_DPS_PER_V,
 };
 pub use error_model::{simulate_ins, InsErrorConfig, TruthState};
-pub use feedforward::{los_doppler_hz, LAMBDA_L1_M};
 pub use ins_file::{read_ins_csv, write_ins_csv, InsError, InsSample, InsTrack};
 pub use speed_filter::{AccelSmoother, HoldLastSpeed, SpeedFilter, SpeedFilterConfig};
 pub use vehicle::{interpolate_truth, validate_truth, wrap_pi, VehicleTruth};

@@ -4,28 +4,9 @@
 use crate::dr_error::DrError;
 use std::f64::consts::PI;
 
-/// Truth of a land vehicle at one instant.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct VehicleTruth {
-    /// Seconds from the first IF sample.
-    pub t_s: f64,
-    /// East position, m.
-    pub east_m: f64,
-    /// North position, m.
-    pub north_m: f64,
-    /// Up position, m.
-    pub up_m: f64,
-    /// Speed along the path (what an odometer measures), m/s, `>= 0`.
-    pub speed_mps: f64,
-    /// Heading, clockwise from north, rad (any branch).
-    pub heading_rad: f64,
-    /// Heading rate, clockwise positive, rad/s.
-    pub yaw_rate_rad_s: f64,
-    /// Longitudinal acceleration (rate of change of `speed_mps`), m/s^2.
-    pub a_long_mps2: f64,
-    /// Road slope (nose up positive), rad.
-    pub pitch_rad: f64,
-}
+/// Truth of a land vehicle at one instant: the shared [`gpsrx_core::VehicleState`] (also what
+/// the simulator's motion tables give), under the name the sensor models use.
+pub use gpsrx_core::vehicle::VehicleState as VehicleTruth;
 
 /// Checks a truth trajectory: at least 2 states, finite values, speeds `>= 0` (to 1e-6 m/s), strictly
 /// increasing time.

@@ -4,7 +4,7 @@
 //! gives for the same model (derivatives of the position equations, not finite differences).
 
 use crate::constants::{F_REL_S_PER_SQRT_M, MU_M3_S2, OMEGA_E_DOT_RAD_S, SECONDS_PER_WEEK};
-use crate::frames::Vector3;
+use crate::frames::{light_time, SvAtReception, Vector3};
 use crate::time::GpsTime;
 
 /// One GPS LNAV broadcast ephemeris + clock set (subframes 1-3, IS-GPS-200 Table 20-I/20-III),
@@ -255,6 +255,80 @@ impl Ephemeris {
     pub fn is_within_s(&self, t: GpsTime, max_age_s: f64) -> bool {
         t.diff_s(self.toe).abs() <= max_age_s
     }
+
+    /// The longest |t - toe| for which gpsrx uses this ephemeris, s:
+    /// [`MAX_EPHEMERIS_AGE_S`] (4 h), or half the curve-fit interval
+    /// ([`Self::fit_interval_s`], IS-GPS-200 20.3.4.4) when that is longer.
+    pub fn max_age_s(&self) -> f64 {
+        MAX_EPHEMERIS_AGE_S.max(self.fit_interval_s() / 2.0)
+    }
+
+    /// Whether the ephemeris may be used at `t`: |t - toe| <= [`Self::max_age_s`].
+    pub fn is_valid_at(&self, t: GpsTime) -> bool {
+        self.is_within_s(t, self.max_age_s())
+    }
+
+    /// The satellite seen at reception time `t_rx` from `rx_pos_m`: [`crate::frames::light_time`]
+    /// with the state at transmit time `t_rx - tau` from this ephemeris, `iterations` passes from
+    /// the flight-time guess `tau_guess_s` (0.075 s when nothing better is known).
+    pub fn at_reception(
+        &self,
+        t_rx: GpsTime,
+        rx_pos_m: &Vector3<f64>,
+        tau_guess_s: f64,
+        iterations: usize,
+    ) -> SvAtReception {
+        light_time(
+            |tau| self.sv_state(t_rx.add_seconds(-tau)),
+            rx_pos_m,
+            tau_guess_s,
+            iterations,
+        )
+    }
+}
+
+/// The standard validity limit of a broadcast ephemeris, |t - toe| in seconds: 4 h.
+///
+/// IS-GPS-200 20.3.4.4: with the fit interval flag 0 the ephemeris is a 4-hour curve fit (and
+/// the control segment uploads a new one every 2 h, so a current one is never more than ~2 h
+/// from toe). gpsrx accepts any |t - toe| up to the whole 4 h so that a RINEX file with gaps
+/// still serves; the orbit error grows beyond the fit interval's ±2 h. An ephemeris with the fit
+/// interval flag set is used up to half its longer fit interval ([`Ephemeris::max_age_s`]).
+/// This is the one limit all of gpsrx uses ([`select_ephemeris`], [`Ephemeris::is_valid_at`]).
+pub const MAX_EPHEMERIS_AGE_S: f64 = 4.0 * 3600.0;
+
+/// How [`select_ephemeris`] treats the health word (IS-GPS-200 20.3.3.3.1.4, `sv_health`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HealthPolicy {
+    /// Only ephemerides with `sv_health == 0` (for positioning).
+    HealthyOnly,
+    /// Healthy ones first; an unhealthy one only when no healthy one is valid (for searching
+    /// and aiding: an unhealthy satellite usually still transmits).
+    PreferHealthy,
+    /// The health word does not matter (what the satellite transmits, for simulation).
+    Ignore,
+}
+
+/// The ephemeris of `prn` among `candidates` to use at `t`: those valid at `t`
+/// ([`Ephemeris::is_valid_at`]: |t - toe| <= 4 h or half the fit interval) and allowed by
+/// `health`, the one with the toe nearest to `t` (healthy first under
+/// [`HealthPolicy::PreferHealthy`]). Ties go to the first in `candidates`' order.
+pub fn select_ephemeris<'a>(
+    candidates: impl IntoIterator<Item = &'a Ephemeris>,
+    prn: u8,
+    t: GpsTime,
+    health: HealthPolicy,
+) -> Option<&'a Ephemeris> {
+    candidates
+        .into_iter()
+        .filter(|e| e.prn == prn && e.is_valid_at(t))
+        .filter(|e| health != HealthPolicy::HealthyOnly || e.sv_health == 0)
+        .map(|e| {
+            let rank = health == HealthPolicy::PreferHealthy && e.sv_health != 0;
+            (e, rank, t.diff_s(e.toe).abs())
+        })
+        .min_by(|a, b| a.1.cmp(&b.1).then(a.2.total_cmp(&b.2)))
+        .map(|(e, _, _)| e)
 }
 
 /// Half a GPS week, s: the IS-GPS-200 Table 20-IV limit on |t_k|.

@@ -1,141 +1,67 @@
-//! WGS-84 geodetic coordinates, ECEF and local East-North-Up frames.
-//!
-//! Ellipsoid parameters from NIMA TR8350.2 (WGS-84) Table 3.1, the frame IS-GPS-200 20.3.3.4.3
-//! expresses satellite positions in.
+//! WGS-84 geodetic coordinates, ECEF and local East-North-Up frames and the Earth-rotation
+//! correction, defined in [`gpsrx_core::frames`] and re-exported here, plus the light-time
+//! solution that finds where a satellite was when it sent the signal received now.
 
-use crate::constants::{WGS84_A_M, WGS84_F};
-use nalgebra::Matrix3;
+use crate::constants::SPEED_OF_LIGHT_MPS;
+use crate::ephemeris::SvState;
+pub use gpsrx_core::frames::{
+    azimuth_elevation, enu_rotation, rotate_for_earth_rotation, rotation_rate_times, Llh,
+};
 pub use nalgebra::Vector3;
 
-/// First eccentricity squared e^2 = f (2 - f).
-const E2: f64 = WGS84_F * (2.0 - WGS84_F);
-/// Semi-minor axis b = a (1 - f), m.
-const B_M: f64 = WGS84_A_M * (1.0 - WGS84_F);
-/// Second eccentricity squared e'^2 = e^2 / (1 - e^2).
-const EP2: f64 = E2 / (1.0 - E2);
-
-/// Geodetic latitude, longitude (radians, east positive) and height above the WGS-84 ellipsoid.
+/// A satellite as seen at reception (the result of [`light_time`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Llh {
-    /// Geodetic latitude, rad, north positive.
-    pub lat_rad: f64,
-    /// Longitude, rad, east positive.
-    pub lon_rad: f64,
-    /// Height above the WGS-84 ellipsoid, m.
-    pub h_m: f64,
+pub struct SvAtReception {
+    /// The satellite state at transmit time `t_rx - tau_k` (`tau_k` the last flight time the
+    /// iteration evaluated the satellite at), with `pos_m` and `vel_mps` rotated by
+    /// `R3(OmegaE tau_k)` into the ECEF frame of reception; the clock terms are unchanged.
+    pub sv: SvState,
+    /// Geometric range `|R3(OmegaE tau_k) r_sv(t_rx - tau_k) - r_rx|`, m.
+    pub range_m: f64,
+    /// The next flight-time estimate `range_m / c`, s.
+    pub flight_time_s: f64,
 }
 
-impl Llh {
-    /// Builds a position from degrees (latitude, longitude) and metres (ellipsoidal height).
-    pub fn from_degrees(lat_deg: f64, lon_deg: f64, h_m: f64) -> Llh {
-        Llh {
-            lat_rad: lat_deg.to_radians(),
-            lon_rad: lon_deg.to_radians(),
-            h_m,
-        }
-    }
-
-    /// Geodetic to ECEF (closed form): x = (N + h) cos(lat) cos(lon), y = (N + h) cos(lat)
-    /// sin(lon), z = (N (1 - e^2) + h) sin(lat), with N = a / sqrt(1 - e^2 sin^2(lat)).
-    pub fn to_ecef(&self) -> Vector3<f64> {
-        let (slat, clat) = self.lat_rad.sin_cos();
-        let (slon, clon) = self.lon_rad.sin_cos();
-        let n = WGS84_A_M / (1.0 - E2 * slat * slat).sqrt();
-        Vector3::new(
-            (n + self.h_m) * clat * clon,
-            (n + self.h_m) * clat * slon,
-            (n * (1.0 - E2) + self.h_m) * slat,
-        )
-    }
-
-    /// ECEF to geodetic by Bowring's parametric-latitude iteration (converges to < 1e-15 rad
-    /// in two or three steps for any point outside the Earth's core); the height uses
-    /// h = p cos(lat) + z sin(lat) - a sqrt(1 - e^2 sin^2(lat)), which is well conditioned at
-    /// the poles. The Earth's centre maps to lat = lon = 0, h = -a.
-    pub fn from_ecef(ecef: &Vector3<f64>) -> Llh {
-        let (x, y, z) = (ecef.x, ecef.y, ecef.z);
-        let p = x.hypot(y);
-        if p == 0.0 && z == 0.0 {
-            return Llh {
-                lat_rad: 0.0,
-                lon_rad: 0.0,
-                h_m: -WGS84_A_M,
-            };
-        }
-        let lon_rad = y.atan2(x);
-        let mut beta = z.atan2((1.0 - WGS84_F) * p);
-        let mut lat = 0.0_f64;
-        for _ in 0..10 {
-            let (sb, cb) = beta.sin_cos();
-            let new_lat = (z + EP2 * B_M * sb * sb * sb).atan2(p - E2 * WGS84_A_M * cb * cb * cb);
-            let converged = (new_lat - lat).abs() < 1e-15;
-            lat = new_lat;
-            beta = ((1.0 - WGS84_F) * lat.sin()).atan2(lat.cos());
-            if converged {
-                break;
-            }
-        }
-        let (slat, clat) = lat.sin_cos();
-        let h_m = p * clat + z * slat - WGS84_A_M * (1.0 - E2 * slat * slat).sqrt();
-        Llh {
-            lat_rad: lat,
-            lon_rad,
-            h_m,
-        }
-    }
-}
-
-/// Rotation from ECEF to the local East-North-Up frame at `origin`: the rows are the E, N and U
-/// unit vectors expressed in ECEF, so `enu = R * (ecef - origin_ecef)`.
-pub fn enu_rotation(origin: &Llh) -> Matrix3<f64> {
-    let (slat, clat) = origin.lat_rad.sin_cos();
-    let (slon, clon) = origin.lon_rad.sin_cos();
-    Matrix3::new(
-        -slon,
-        clon,
-        0.0,
-        -slat * clon,
-        -slat * slon,
-        clat,
-        clat * clon,
-        clat * slon,
-        slat,
-    )
-}
-
-/// Azimuth (rad, clockwise from north, in `[0, 2 pi)`) and elevation (rad, `[-pi/2, pi/2]`) of
-/// the satellite at `sv_ecef` seen from the receiver at `rx_ecef`, in the receiver's local
-/// geodetic ENU frame.
+/// Light-time solution with the Earth's rotation during the flight (IS-GPS-200 20.3.3.4.3.3.2):
+/// the flight time `tau` solves
 ///
-/// If the receiver position is unknown (within 1 m of the Earth's centre) the satellite is
-/// reported at the zenith (az = 0, el = pi/2), so that elevation masks and mapping functions
-/// stay neutral before the first fix. Coincident positions also give (0, pi/2).
-pub fn azimuth_elevation(rx_ecef: &Vector3<f64>, sv_ecef: &Vector3<f64>) -> (f64, f64) {
-    if rx_ecef.norm() < 1.0 {
-        return (0.0, std::f64::consts::FRAC_PI_2);
+/// ```text
+/// c tau = |R3(OmegaE tau) r_sv(t_rx - tau) - r_rx(t_rx)|
+/// ```
+///
+/// by fixed-point iteration from `tau_guess_s`, `iterations` passes (at least one) of
+/// `tau_{k+1} = |R3(OmegaE tau_k) r_sv(t_rx - tau_k) - r_rx| / c`. `state_at(tau)` is the
+/// satellite state at transmit time `t_rx - tau` in the ECEF frame of that instant (normally
+/// `eph.sv_state(t_rx.add_seconds(-tau))`, see [`crate::Ephemeris::at_reception`]; a constant
+/// state when the transmit time is already known from the pseudorange and only the rotation
+/// is wanted).
+///
+/// Each pass shrinks the error by about `|range rate| / c` (< 3e-6), so from a guess within
+/// 10 ms two passes leave < 1e-12 s; one pass from 75 ms is good to ~0.1 us.
+pub fn light_time(
+    mut state_at: impl FnMut(f64) -> SvState,
+    rx_pos_m: &Vector3<f64>,
+    tau_guess_s: f64,
+    iterations: usize,
+) -> SvAtReception {
+    let mut tau = tau_guess_s;
+    let mut tau_k = tau;
+    let mut sv = state_at(tau);
+    let mut range_m = 0.0;
+    for k in 0..iterations.max(1) {
+        if k > 0 {
+            sv = state_at(tau);
+        }
+        tau_k = tau;
+        let pos = rotate_for_earth_rotation(&sv.pos_m, tau_k);
+        range_m = (pos - rx_pos_m).norm();
+        sv.pos_m = pos;
+        tau = range_m / SPEED_OF_LIGHT_MPS;
     }
-    let los = sv_ecef - rx_ecef;
-    let range = los.norm();
-    if range == 0.0 || !range.is_finite() {
-        return (0.0, std::f64::consts::FRAC_PI_2);
+    sv.vel_mps = rotate_for_earth_rotation(&sv.vel_mps, tau_k);
+    SvAtReception {
+        sv,
+        range_m,
+        flight_time_s: tau,
     }
-    let enu = enu_rotation(&Llh::from_ecef(rx_ecef)) * los;
-    let mut az = enu.x.atan2(enu.y);
-    if az < 0.0 {
-        az += 2.0 * std::f64::consts::PI;
-    }
-    let el = (enu.z / range).clamp(-1.0, 1.0).asin();
-    (az, el)
-}
-
-/// Satellite ECEF position at transmission re-expressed in the ECEF frame of reception:
-/// rotation about z by OMEGA_E_DOT * `flight_time_s` (IS-GPS-200 20.3.3.4.3.3.2, Earth
-/// rotation correction). Use it with [`crate::SvState::pos_m`] computed at transmit time.
-pub fn rotate_for_earth_rotation(sv_ecef: &Vector3<f64>, flight_time_s: f64) -> Vector3<f64> {
-    let (s, c) = (crate::constants::OMEGA_E_DOT_RAD_S * flight_time_s).sin_cos();
-    Vector3::new(
-        c * sv_ecef.x + s * sv_ecef.y,
-        -s * sv_ecef.x + c * sv_ecef.y,
-        sv_ecef.z,
-    )
 }

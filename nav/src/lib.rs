@@ -15,7 +15,11 @@ pub mod time;
 pub mod utc;
 
 pub use atmosphere::{klobuchar_delay_s, saastamoinen_delay_m, KlobucharParams, UtcParams};
+pub use ephemeris::{select_ephemeris, HealthPolicy, MAX_EPHEMERIS_AGE_S};
 pub use ephemeris::{Ephemeris, SvState};
-pub use frames::{azimuth_elevation, enu_rotation, rotate_for_earth_rotation, Llh, Vector3};
+pub use frames::{
+    azimuth_elevation, enu_rotation, light_time, rotate_for_earth_rotation, Llh, SvAtReception,
+    Vector3,
+};
 pub use rinex_nav::{parse_rinex_nav, read_rinex_nav, NavData, RinexError};
 pub use time::GpsTime;

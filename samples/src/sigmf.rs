@@ -33,7 +33,7 @@ use crate::error::SampleError;
 use crate::format::SampleFormat;
 
 /// GPS L1 carrier frequency, the default `core:frequency` of a capture (IS-GPS-200 3.3.1.1).
-pub const GPS_L1_HZ: f64 = 1_575.42e6;
+pub use gpsrx_core::constants::F_L1_HZ as GPS_L1_HZ;
 
 /// Global keys that map to [`SigmfMeta`] fields; every other global key lands in `extra`.
 const KNOWN_GLOBAL_KEYS: &[&str] = &[

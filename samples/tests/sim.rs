@@ -8,7 +8,7 @@ use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
 use gpsrx_dsp::{CaCode, Prn};
 use gpsrx_nav::lnav::decode_subframe;
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
-use gpsrx_samples::sim::geometry::rotate_earth;
+use gpsrx_nav::rotate_for_earth_rotation as rotate_earth;
 use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
 use gpsrx_samples::sim::{Scenario, SimSatellite, Simulator};
 use gpsrx_samples::{open_source, SourceConfig};

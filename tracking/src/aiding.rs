@@ -83,17 +83,8 @@ pub fn code_rate_chips_s(carrier_doppler_hz: f64, dll_output_chips_s: f64) -> f6
     CA_CHIP_RATE_HZ + code_doppler_chips_s(carrier_doppler_hz) + dll_output_chips_s
 }
 
-/// Line-of-sight carrier Doppler (Hz) from satellite and receiver velocities (m/s, same frame)
-/// and the unit vector from the receiver to the satellite: `f_D = -((v_sv - v_rx) . u) / lambda`.
-///
-/// This is seed 004 eq. (6), `((V_sv - V_rx) . l)/lambda`, with `l = -u` pointing from the
-/// satellite to the receiver, so that the Doppler is positive when the range shrinks.
-pub fn los_doppler_hz(v_sv_mps: [f64; 3], v_rx_mps: [f64; 3], u_rx_to_sv: [f64; 3]) -> f64 {
-    let range_rate: f64 = (0..3)
-        .map(|i| (v_sv_mps[i] - v_rx_mps[i]) * u_rx_to_sv[i])
-        .sum();
-    -range_rate / LAMBDA_L1_M
-}
+// The line-of-sight Doppler `f_D = -((v_sv - v_rx) . u) / lambda` (seed 004 eq. 6) that feeds
+// this port is `gpsrx_core::los_doppler_hz`.
 
 /// Doppler rate (Hz/s) from a LOS range acceleration (m/s^2): `-a / lambda`. 1 g is 51.5 Hz/s
 /// (18,552 deg/s^2 of carrier phase).
@@ -116,9 +107,6 @@ mod tests {
 
     #[test]
     fn doppler_sign_and_units() {
-        // Receiver moving towards the satellite at 1 m/s: range shrinks, Doppler +1/lambda.
-        let f = los_doppler_hz([0.0; 3], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]);
-        assert!((f - 1.0 / LAMBDA_L1_M).abs() < 1e-9 && f > 5.25);
         // 1 g towards the satellite: range acceleration -g, Doppler rate +51.5 Hz/s,
         // i.e. 18,552 deg/s^2.
         let r = doppler_rate_hz_s(-9.80665);

@@ -17,6 +17,7 @@
 use crate::commands::simulate::simulate;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
 use gpsrx_dsp::ca_code::CaCode;
+use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ};
 use gpsrx_dsp::correlator::{
     correlate, Arithmetic, Correlator, Isa, PackedCode, ReplicaState, SampleSlice,
 };
@@ -257,7 +258,7 @@ fn bench_state() -> ReplicaState {
     let doppler_hz = 2000.0;
     ReplicaState {
         code_phase_chips: 517.25,
-        code_rate_chips_s: 1.023e6 * (1.0 + doppler_hz / 1575.42e6),
+        code_rate_chips_s: CA_CHIP_RATE_HZ * (1.0 + doppler_hz / F_L1_HZ),
         carrier_phase_cycles: 0.3,
         carrier_freq_hz: doppler_hz,
         carrier_rate_hz_s: 0.0,

@@ -17,9 +17,9 @@
 
 use super::PvtError;
 use crate::atmosphere::{klobuchar_delay_s, saastamoinen_delay_m, KlobucharParams};
-use crate::constants::{OMEGA_E_DOT_RAD_S, SPEED_OF_LIGHT_MPS};
+use crate::constants::SPEED_OF_LIGHT_MPS;
 use crate::ephemeris::{Ephemeris, SvState};
-use crate::frames::{azimuth_elevation, rotate_for_earth_rotation, Llh, Vector3};
+use crate::frames::{azimuth_elevation, light_time, Llh, Vector3};
 use crate::time::GpsTime;
 
 /// One satellite's observables at one epoch.
@@ -278,12 +278,10 @@ pub fn predict(
 ) -> Predicted {
     // Flight time from the geometry: two passes of tau = |R3(w tau) r_sv - r_rx| / c suffice
     // (the rotation moves the satellite by ~40 m, changing tau by < 1.4e-7 s, i.e. 1e-5 m).
-    let mut tau = (sat.sv.pos_m - rx).norm() / SPEED_OF_LIGHT_MPS;
-    let mut sv_pos = sat.sv.pos_m;
-    for _ in 0..3 {
-        sv_pos = rotate_for_earth_rotation(&sat.sv.pos_m, tau);
-        tau = (sv_pos - rx).norm() / SPEED_OF_LIGHT_MPS;
-    }
+    // The transmit time is known (prepare), so the state is fixed and only the rotation moves.
+    let tau0 = (sat.sv.pos_m - rx).norm() / SPEED_OF_LIGHT_MPS;
+    let seen = light_time(|_| sat.sv, rx, tau0, 3);
+    let (sv_pos, tau) = (seen.sv.pos_m, seen.flight_time_s);
     let d = sv_pos - rx;
     let rho = d.norm();
     let los = if rho > 0.0 { d / rho } else { Vector3::z() };
@@ -307,11 +305,4 @@ pub fn predict(
         range_model_m,
         el_rad,
     }
-}
-
-/// Time derivative of the Earth-rotation matrix applied to `v`: d/dtau [R3(w tau) v] =
-/// w * dR3/dtheta v, with R3 as in [`rotate_for_earth_rotation`].
-pub fn rotation_rate_times(v: &Vector3<f64>, tau_s: f64) -> Vector3<f64> {
-    let (s, c) = (OMEGA_E_DOT_RAD_S * tau_s).sin_cos();
-    OMEGA_E_DOT_RAD_S * Vector3::new(-s * v.x + c * v.y, -c * v.x - s * v.y, 0.0)
 }

@@ -17,10 +17,10 @@
 //! sigma = `doppler_sigma_mps` * sqrt([`super::Weighting::cn0_scale`]); covariance
 //! sigma0^2 N^-1 as for the position.
 
-use super::model::{rotation_rate_times, PreparedSat, PvtOptions};
+use super::model::{PreparedSat, PvtOptions};
 use super::wls::{Fix, N_UNKNOWNS};
-use crate::constants::{L1_FREQ_HZ, SPEED_OF_LIGHT_MPS};
-use crate::frames::{rotate_for_earth_rotation, Vector3};
+use crate::constants::{LAMBDA_L1_M, SPEED_OF_LIGHT_MPS};
+use crate::frames::{rotate_for_earth_rotation, rotation_rate_times, Vector3};
 use nalgebra::{Matrix4, Vector4};
 
 /// Velocity and clock-drift estimate.
@@ -45,7 +45,7 @@ pub fn solve_velocity(
     fix: &Fix,
     opts: &PvtOptions,
 ) -> Option<VelocitySolution> {
-    let lambda_m = SPEED_OF_LIGHT_MPS / L1_FREQ_HZ;
+    let lambda_m = LAMBDA_L1_M;
     let mut rows = Vec::new();
     let mut y = Vec::new();
     let mut sigmas = Vec::new();

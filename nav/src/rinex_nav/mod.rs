@@ -9,7 +9,7 @@ mod record;
 pub use error::RinexError;
 
 use crate::atmosphere::KlobucharParams;
-use crate::ephemeris::Ephemeris;
+use crate::ephemeris::{select_ephemeris, Ephemeris, HealthPolicy};
 use crate::time::GpsTime;
 use crate::utc::UtcParams;
 use header::Major;
@@ -40,27 +40,20 @@ pub struct RinexNavReport {
     pub skipped_records: BTreeMap<char, usize>,
 }
 
-/// Maximum |t - toe| for [`NavData::select`] when the fit interval flag is 0, s.
-pub const MAX_EPHEMERIS_AGE_S: f64 = 4.0 * 3600.0;
+pub use crate::ephemeris::MAX_EPHEMERIS_AGE_S;
 
 impl NavData {
     /// The healthy (`sv_health == 0`) ephemeris of `prn` whose toe is nearest to `t`, provided
     /// |t - toe| <= 4 h, or half the curve-fit interval when that is longer (fit interval
     /// flag set, IS-GPS-200 20.3.4.4). Ties go to the first in file order.
+    /// [`select_ephemeris`] with [`HealthPolicy::HealthyOnly`].
     pub fn select(&self, prn: u8, t: GpsTime) -> Option<&Ephemeris> {
-        self.ephemerides
-            .iter()
-            .filter(|e| e.prn == prn && e.sv_health == 0)
-            .map(|e| (e, t.diff_s(e.toe).abs()))
-            .filter(|(e, age)| *age <= MAX_EPHEMERIS_AGE_S.max(e.fit_interval_s() / 2.0))
-            .fold(
-                None,
-                |best: Option<(&Ephemeris, f64)>, (e, age)| match best {
-                    Some((_, best_age)) if best_age <= age => best,
-                    _ => Some((e, age)),
-                },
-            )
-            .map(|(e, _)| e)
+        self.select_with(prn, t, HealthPolicy::HealthyOnly)
+    }
+
+    /// [`select_ephemeris`] over this file's ephemerides with the given health policy.
+    pub fn select_with(&self, prn: u8, t: GpsTime, health: HealthPolicy) -> Option<&Ephemeris> {
+        select_ephemeris(&self.ephemerides, prn, t, health)
     }
 
     /// PRNs that have at least one ephemeris, ascending.

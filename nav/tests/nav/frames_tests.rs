@@ -151,3 +151,27 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn light_time_solves_the_rotated_range_equation() {
+    use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
+    use gpsrx_nav::{light_time, SvState};
+    // A satellite moving at 3.9 km/s; the transmit time is t_rx - tau.
+    let state_at = |tau: f64| SvState {
+        pos_m: Vector3::new(15_600e3, 7_540e3, 20_140e3) - Vector3::new(0.0, 3_900.0, 0.0) * tau,
+        vel_mps: Vector3::new(0.0, 3_900.0, 0.0),
+        clock_bias_s: 1e-4,
+        clock_drift_s_s: 1e-11,
+    };
+    let rx = Llh::from_degrees(37.5665, 126.978, 40.0).to_ecef();
+    let seen = light_time(state_at, &rx, 0.075, 3);
+    let tau = seen.flight_time_s;
+    let residual = (rotate_for_earth_rotation(&state_at(tau).pos_m, tau) - rx).norm()
+        - SPEED_OF_LIGHT_MPS * tau;
+    assert!(residual.abs() < 1e-6, "{residual}");
+    assert!((seen.range_m - SPEED_OF_LIGHT_MPS * tau).abs() < 1e-9);
+    assert!(
+        (seen.sv.vel_mps - rotate_for_earth_rotation(&state_at(tau).vel_mps, tau)).norm() < 1e-9
+    );
+    assert_eq!(seen.sv.clock_bias_s, 1e-4);
+}

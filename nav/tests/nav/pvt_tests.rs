@@ -6,7 +6,7 @@
 //! statistic below is reproducible.
 
 use crate::common::brdc;
-use gpsrx_nav::constants::{L1_FREQ_HZ, OMEGA_E_DOT_RAD_S, SPEED_OF_LIGHT_MPS};
+use gpsrx_nav::constants::{F_L1_HZ, OMEGA_E_DOT_RAD_S, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::pvt::{
     chi_square_quantile, solve, Landmark, PvtError, PvtOptions, PvtSolution, RaimStatus,
     SatMeasurement, Weighting,
@@ -146,7 +146,7 @@ fn simulate(nav: &NavData, truth: &Truth, atm: Atmos<'_>) -> Vec<Obs> {
         out.push(Obs {
             eph: eph.clone(),
             pr,
-            doppler: -rate * L1_FREQ_HZ / C,
+            doppler: -rate * F_L1_HZ / C,
             tx,
             el,
         });

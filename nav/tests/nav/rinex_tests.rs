@@ -311,3 +311,36 @@ fn select_nearest_healthy_within_four_hours() {
         .select(3, e.toe.add_seconds(-4.0 * 3600.0 - 1.0))
         .is_none());
 }
+
+#[test]
+fn health_policies_choose_among_valid_ephemerides() {
+    use gpsrx_nav::{select_ephemeris, HealthPolicy};
+    let nav = brdc();
+    let t = GpsTime::new(2190, 538_200.0); // 05:30: PRN 3's nearest toe is 06:00
+    let mut sick = nav.clone();
+    // The nearest one unhealthy, the others healthy.
+    for x in sick.ephemerides.iter_mut().filter(|x| x.prn == 3) {
+        x.sv_health = u8::from(x.toe.tow_s == 540_000.0);
+    }
+    let pick = |h| {
+        sick.select_with(3, t, h)
+            .map(|e| (e.toe.tow_s, e.sv_health))
+    };
+    assert_eq!(pick(HealthPolicy::Ignore), Some((540_000.0, 1)));
+    let healthy = pick(HealthPolicy::HealthyOnly).expect("a healthy one within 4 h");
+    assert_eq!(healthy.1, 0);
+    assert_eq!(pick(HealthPolicy::PreferHealthy), Some(healthy));
+    assert_eq!(
+        select_ephemeris(&sick.ephemerides, 3, t, HealthPolicy::HealthyOnly).map(|e| e.toe),
+        sick.select(3, t).map(|e| e.toe)
+    );
+    // Every selection is valid at t; nothing a week later.
+    assert!(sick
+        .ephemerides
+        .iter()
+        .filter(|e| e.prn == 3)
+        .all(|e| e.is_valid_at(t) == (t.diff_s(e.toe).abs() <= e.max_age_s())));
+    assert!(sick
+        .select_with(3, t.add_seconds(604_800.0), HealthPolicy::Ignore)
+        .is_none());
+}

@@ -2,6 +2,7 @@
 
 use super::fuse::FusedFix;
 use crate::output::{create_file, Fix, FixQuality, OutputError};
+use gpsrx_core::frames::{enu_rotation, Vector3};
 use gpsrx_ins_aiding::FixSource;
 use std::path::Path;
 
@@ -71,11 +72,10 @@ pub fn fused_as_fixes(fixes: &[FusedFix]) -> Vec<Fix> {
     fixes
         .iter()
         .map(|f| {
-            let (s, c) = f.llh.lat_rad.sin_cos();
-            let (so, co) = f.llh.lon_rad.sin_cos();
-            // East/north velocity to ECEF (no vertical component).
+            // East/north velocity to ECEF (no vertical component): R_enu^T v_enu.
             let [ve, vn] = f.vel_en_mps;
-            let vel = [-so * ve - s * co * vn, co * ve - s * so * vn, c * vn];
+            let v = enu_rotation(&f.llh).transpose() * Vector3::new(ve, vn, 0.0);
+            let vel = [v.x, v.y, v.z];
             Fix {
                 time: f.time,
                 ecef_m: [f.ecef_m.x, f.ecef_m.y, f.ecef_m.z],

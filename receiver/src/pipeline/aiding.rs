@@ -5,13 +5,17 @@
 //!
 //! 1. receive time in GPS time: `t_gps = t0 + t`, with `t0` the GPS time of the first sample
 //!    (from the first decoded time of week, or from the INS file's `gps_tow_s` column);
-//! 2. satellite position, velocity and clock drift from the ephemeris (decoded, or from
-//!    `--nav`) at the transmit time `t_gps - r/c`, rotated by the Earth's rotation during the
-//!    flight `OmegaE r / c` into the frame of reception (IS-GPS-200 20.3.3.4.3.3.2);
+//! 2. satellite position, velocity and clock drift from the ephemeris (the decoded one or one
+//!    from `--nav`, whichever valid one has the toe nearest to `t_gps`,
+//!    [`gpsrx_nav::select_ephemeris`]) at the transmit time `t_gps - tau`, rotated by the
+//!    Earth's rotation during the flight `OmegaE tau` into the frame of reception, with the
+//!    light time `tau` iterated twice from 75 ms ([`gpsrx_nav::light_time`], IS-GPS-200
+//!    20.3.3.4.3.3.2);
 //! 3. receiver position: the INS position before the first fix; after it, the fix propagated
 //!    by the INS displacement since the fix (the INS position may carry a bias, its velocity is
 //!    what matters); receiver velocity from the INS;
-//! 4. Doppler, seed 004 eq. 6 written with the unit vector `u` from receiver to satellite:
+//! 4. Doppler, seed 004 eq. 6 written with the unit vector `u` from receiver to satellite
+//!    ([`gpsrx_core::los_doppler_hz`]):
 //!    `f = -((v_sv - v_rx) . u) / lambda + f_L1 d_sv - f_L1 (d_rx - d_ref)`, with `d_sv` the
 //!    satellite clock drift and `d_rx` the receiver clock drift (s/s) from the fixes, smoothed
 //!    with a 1 s time constant (`pseudorange rate = range rate + c d_rx - c d_sv`,
@@ -30,10 +34,10 @@
 //! Until a satellite's ephemeris and the GPS time are known it gets no feed-forward (logged
 //! once per satellite), and outside the INS file's time span no satellite does.
 
-use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
-use gpsrx_ins_aiding::{los_doppler_hz, BandLimiter, InsTrack};
-use gpsrx_nav::constants::OMEGA_E_DOT_RAD_S;
-use gpsrx_nav::ephemeris::Ephemeris;
+use gpsrx_core::{los_doppler_hz, PosVel};
+use gpsrx_dsp::constants::SPEED_OF_LIGHT_MPS;
+use gpsrx_ins_aiding::{BandLimiter, InsTrack};
+use gpsrx_nav::ephemeris::{select_ephemeris, Ephemeris, HealthPolicy};
 use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::DopplerAid;
@@ -47,15 +51,13 @@ const RATE_STEP_S: f64 = 0.01;
 const LIMITER_RESTART_S: f64 = 1.0;
 /// Time constant of the receiver clock drift smoothing, s.
 pub const DRIFT_SMOOTHING_S: f64 = 1.0;
-/// Maximum age of a `--nav` ephemeris used for aiding, s (its fit interval is 4 h).
-const MAX_EPHEMERIS_AGE_S: f64 = 7200.0;
 
 /// What the receiver has learned that the feed-forward needs; updated as the run goes.
 #[derive(Debug, Clone, Default)]
 struct Knowledge {
     /// GPS time of the first IF sample.
     t0: Option<GpsTime>,
-    /// Ephemerides in use, per PRN.
+    /// Decoded ephemerides, per PRN.
     ephemerides: BTreeMap<u8, Ephemeris>,
     /// Latest fix: receive time (s from the first sample), ECEF position.
     fix: Option<(f64, Vector3<f64>)>,
@@ -70,7 +72,8 @@ struct Knowledge {
 #[derive(Debug)]
 pub struct InsFeedForward {
     ins: InsTrack,
-    nav: Option<NavData>,
+    /// The `--nav` ephemerides, per PRN, in file order.
+    nav: BTreeMap<u8, Vec<Ephemeris>>,
     band_limit_alpha_rad_s: Option<f64>,
     allow_unhealthy: bool,
     know: RwLock<Knowledge>,
@@ -102,9 +105,13 @@ impl InsFeedForward {
                 t.tow_s
             );
         }
+        let mut by_prn: BTreeMap<u8, Vec<Ephemeris>> = BTreeMap::new();
+        for e in nav.into_iter().flat_map(|n| n.ephemerides) {
+            by_prn.entry(e.prn).or_default().push(e);
+        }
         Self {
             ins,
-            nav,
+            nav: by_prn,
             band_limit_alpha_rad_s,
             allow_unhealthy: false,
             know: RwLock::new(Knowledge {
@@ -193,28 +200,19 @@ impl InsFeedForward {
         }
     }
 
-    /// The ephemeris for `prn` at `t`: the decoded one, else one from `--nav` (cached).
+    /// The ephemeris for `prn` at `t`: among the decoded one (whatever its health flag) and
+    /// those from `--nav` (healthy ones, or all with [`Self::allow_unhealthy`]), the valid one
+    /// with the toe nearest to `t` ([`select_ephemeris`]; the decoded one wins a tie).
     fn ephemeris(&self, prn: u8, t: GpsTime) -> Option<Ephemeris> {
-        if let Some(e) = self.know.read().ok()?.ephemerides.get(&prn) {
-            if e.is_within_s(t, MAX_EPHEMERIS_AGE_S) {
-                return Some(e.clone());
-            }
-        }
-        let nav = self.nav.as_ref()?;
-        let e = if self.allow_unhealthy {
-            // Nearest toe within the fit interval, whatever the health flag.
-            nav.ephemerides
-                .iter()
-                .filter(|e| e.prn == prn && e.is_within_s(t, MAX_EPHEMERIS_AGE_S))
-                .min_by(|a, b| t.diff_s(a.toe).abs().total_cmp(&t.diff_s(b.toe).abs()))?
-                .clone()
-        } else {
-            nav.select(prn, t)?.clone()
-        };
-        if let Ok(mut k) = self.know.write() {
-            k.ephemerides.insert(prn, e.clone());
-        }
-        Some(e)
+        let k = self.know.read().ok()?;
+        let nav = self
+            .nav
+            .get(&prn)
+            .into_iter()
+            .flatten()
+            .filter(|e| self.allow_unhealthy || e.sv_health == 0);
+        let candidates = k.ephemerides.get(&prn).into_iter().chain(nav);
+        select_ephemeris(candidates, prn, t, HealthPolicy::Ignore).cloned()
     }
 
     /// The INS state at receive time `t_s` (seconds from the first IF sample), through the GPS
@@ -237,25 +235,20 @@ impl InsFeedForward {
             }
             None => ins_pos,
         };
-        let t_rx = t0.add_seconds(t_s);
-        // Transmit time from the geometric range (one iteration: 1 m of range error is 3 ns).
-        let guess = eph.sv_state(t_rx.add_seconds(-0.075));
-        let tau = (guess.pos_m - rx_pos).norm() / SPEED_OF_LIGHT_MPS;
-        let sv = eph.sv_state(t_rx.add_seconds(-tau));
-        // Earth rotation during the flight, about z by OmegaE tau.
-        let th = OMEGA_E_DOT_RAD_S * tau;
-        let (s, c) = th.sin_cos();
-        let rot = |v: &Vector3<f64>| Vector3::new(c * v.x + s * v.y, -s * v.x + c * v.y, v.z);
-        let f = los_doppler_hz(
-            &rot(&sv.pos_m),
-            &rot(&sv.vel_mps),
-            &rx_pos,
-            &ins_vel,
-            match (k.rx_clock_drift_s_s, k.rx_clock_drift_ref) {
-                (Some(d), Some((d_ref, _))) => d - d_ref,
-                _ => 0.0,
-            },
-        ) + F_L1_HZ * sv.clock_drift_s_s;
+        let seen = eph.at_reception(t0.add_seconds(t_s), &rx_pos, 0.075, 2);
+        let sv = PosVel {
+            pos_m: seen.sv.pos_m,
+            vel_mps: seen.sv.vel_mps,
+        };
+        let rx = PosVel {
+            pos_m: rx_pos,
+            vel_mps: ins_vel,
+        };
+        let rx_drift = match (k.rx_clock_drift_s_s, k.rx_clock_drift_ref) {
+            (Some(d), Some((d_ref, _))) => d - d_ref,
+            _ => 0.0,
+        };
+        let f = los_doppler_hz(&sv, &rx, seen.sv.clock_drift_s_s, rx_drift)?;
         f.is_finite().then_some(f)
     }
 

@@ -16,9 +16,8 @@ use crate::sim::clock::ReceiverClock;
 use crate::sim::trajectory::{RxState, Trajectory};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, LAMBDA_L1_M, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::atmosphere::{klobuchar_delay_s, saastamoinen_delay_m, KlobucharParams};
-use gpsrx_nav::constants::OMEGA_E_DOT_RAD_S;
 use gpsrx_nav::ephemeris::Ephemeris;
-use gpsrx_nav::frames::{azimuth_elevation, Llh, Vector3};
+use gpsrx_nav::frames::{azimuth_elevation, light_time, Llh, Vector3};
 use gpsrx_nav::time::GpsTime;
 
 /// What is common to all satellites: time origin, receiver motion and clock, atmosphere.
@@ -97,9 +96,16 @@ impl Environment {
     pub fn slow_terms(&self, eph: &Ephemeris, t_rcv_s: f64) -> SlowTerms {
         let t = self.clock.true_time(t_rcv_s);
         let rx = self.trajectory.state(t);
-        let tx = self.start.add_seconds(t - 0.075);
-        let sv = eph.sv_state(tx);
-        let sv_pos = rotate_earth(&sv.pos_m, 0.075);
+        // One light-time pass from 75 ms: the satellite to ~0.1 km, ample for the elevation.
+        let start = self.start;
+        let sv_pos = light_time(
+            |tau| eph.sv_state(start.add_seconds(t - tau)),
+            &rx.pos_m,
+            0.075,
+            1,
+        )
+        .sv
+        .pos_m;
         let (az, el) = azimuth_elevation(&rx.pos_m, &sv_pos);
         let llh = Llh::from_ecef(&rx.pos_m);
         let iono_m = match &self.iono {
@@ -136,17 +142,15 @@ impl Environment {
         let b = self.clock.bias_s(self.clock.true_time(t_rcv_s));
         let t = t_rcv_s - b;
         let rx = self.trajectory.state(t);
-        let mut tau = tau_guess_s;
-        let mut sv_pos = Vector3::zeros();
-        let mut range = 0.0;
-        let mut sv_clock = 0.0;
-        for _ in 0..iterations.max(1) {
-            let sv = eph.sv_state(self.start.add_seconds(t - tau));
-            sv_pos = rotate_earth(&sv.pos_m, tau);
-            range = (sv_pos - rx.pos_m).norm();
-            sv_clock = sv.clock_bias_s;
-            tau = range / SPEED_OF_LIGHT_MPS;
-        }
+        let start = self.start;
+        let seen = light_time(
+            |tau| eph.sv_state(start.add_seconds(t - tau)),
+            &rx.pos_m,
+            tau_guess_s,
+            iterations,
+        );
+        let (sv_pos, range, tau) = (seen.sv.pos_m, seen.range_m, seen.flight_time_s);
+        let sv_clock = seen.sv.clock_bias_s;
         let clock_term = SPEED_OF_LIGHT_MPS * (b - sv_clock);
         let pseudorange_m = range + slow.iono_m + slow.tropo_m + clock_term;
         let phase_range_m = range - slow.iono_m + slow.tropo_m + clock_term;
@@ -166,12 +170,4 @@ impl Environment {
             carrier_cycles: -phase_range_m / LAMBDA_L1_M,
         }
     }
-}
-
-/// Rotates an ECEF position by the Earth's rotation during a flight of `tau_s` seconds
-/// (IS-GPS-200 20.3.3.4.3.3.2): the satellite's position expressed in the frame of the reception
-/// instant.
-pub fn rotate_earth(pos: &Vector3<f64>, tau_s: f64) -> Vector3<f64> {
-    let (s, c) = (OMEGA_E_DOT_RAD_S * tau_s).sin_cos();
-    Vector3::new(c * pos.x + s * pos.y, -s * pos.x + c * pos.y, pos.z)
 }

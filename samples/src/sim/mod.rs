@@ -23,7 +23,7 @@ use geometry::{Environment, Observation, SlowTerms};
 use gpsrx_dsp::constants::F_L1_HZ;
 use gpsrx_dsp::nco::SinCosTable;
 use gpsrx_dsp::{CaCode, Prn};
-use gpsrx_nav::ephemeris::Ephemeris;
+use gpsrx_nav::ephemeris::{Ephemeris, HealthPolicy};
 use gpsrx_nav::lnav::LnavEncoder;
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
 use gpsrx_nav::time::GpsTime;
@@ -177,7 +177,9 @@ impl Simulator {
                     continue;
                 }
             }
-            let Some(eph) = nearest_ephemeris(&nav, prn.get(), start) else {
+            // The nearest valid ephemeris, healthy or not: an unhealthy satellite still transmits,
+            // with its health bits set, and receivers must cope with that.
+            let Some(eph) = nav.select_with(prn.get(), start, HealthPolicy::Ignore) else {
                 if explicit.is_some() {
                     return Err(SimError::Scenario(format!(
                         "{prn} has no ephemeris within 4 h of {start:?} in {nav_source}"
@@ -516,22 +518,6 @@ impl Simulator {
             extra,
         }
     }
-}
-
-/// The ephemeris of `prn` with the toe nearest to `t` (within 4 h), healthy or not: an unhealthy
-/// satellite still transmits, with its health bits set, and receivers must cope with that.
-fn nearest_ephemeris(
-    nav: &gpsrx_nav::rinex_nav::NavData,
-    prn: u8,
-    t: GpsTime,
-) -> Option<&Ephemeris> {
-    nav.ephemerides
-        .iter()
-        .filter(|e| e.prn == prn)
-        .map(|e| (e, t.diff_s(e.toe).abs()))
-        .filter(|(_, age)| *age <= 4.0 * 3600.0)
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(e, _)| e)
 }
 
 /// Builds the transmitted LNAV bit stream (+1/-1, logic 0 -> +1) of one satellite from `sv_ref`

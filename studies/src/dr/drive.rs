@@ -37,20 +37,7 @@ impl Drive {
         let table = MotionTable::from_config(&sc.receiver, duration_s, TABLE_STEP_S)?;
         let n = (duration_s * TRUTH_RATE_HZ).round() as usize;
         let truth = (0..=n)
-            .map(|k| {
-                let s = table.vehicle_state(k as f64 / TRUTH_RATE_HZ);
-                VehicleTruth {
-                    t_s: s.t_s,
-                    east_m: s.east_m,
-                    north_m: s.north_m,
-                    up_m: s.up_m,
-                    speed_mps: s.speed_mps,
-                    heading_rad: s.heading_rad,
-                    yaw_rate_rad_s: s.yaw_rate_rad_s,
-                    a_long_mps2: s.a_long_mps2,
-                    pitch_rad: s.pitch_rad,
-                }
-            })
+            .map(|k| table.vehicle_state(k as f64 / TRUTH_RATE_HZ))
             .collect();
         Ok(Drive {
             truth,

@@ -2,10 +2,9 @@
 //! broadcast ephemerides, an approximate position and the time.
 
 use anyhow::{bail, Context};
-use gpsrx_dsp::constants::{LAMBDA_L1_M, SPEED_OF_LIGHT_MPS};
+use gpsrx_core::{los_doppler_hz, PosVel};
 use gpsrx_dsp::Prn;
-use gpsrx_nav::rinex_nav::MAX_EPHEMERIS_AGE_S;
-use gpsrx_nav::{azimuth_elevation, rotate_for_earth_rotation, Ephemeris, GpsTime, Llh, NavData};
+use gpsrx_nav::{azimuth_elevation, GpsTime, HealthPolicy, Llh, NavData, Vector3};
 
 /// What the ephemeris predicts for one satellite at the receiver.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -24,55 +23,34 @@ pub struct Prediction {
     pub healthy: bool,
 }
 
-/// The ephemeris of `prn` nearest to `t` in toe, within 4 h (or half its fit interval if
-/// longer), healthy ones first: [`NavData::select`] without dropping unhealthy satellites.
-fn ephemeris_for(nav: &NavData, prn: u8, t: GpsTime) -> Option<&Ephemeris> {
-    nav.ephemerides
-        .iter()
-        .filter(|e| e.prn == prn)
-        .map(|e| (e, t.diff_s(e.toe).abs()))
-        .filter(|(e, age)| *age <= MAX_EPHEMERIS_AGE_S.max(e.fit_interval_s() / 2.0))
-        .min_by(|a, b| {
-            (a.0.sv_health != 0)
-                .cmp(&(b.0.sv_health != 0))
-                .then(a.1.total_cmp(&b.1))
-        })
-        .map(|(e, _)| e)
-}
-
-/// Predicted Doppler and elevation of every PRN with an ephemeris valid at `t` (healthy or not)
-/// that is at least `mask_deg` above the horizon of a static receiver at `rx`.
+/// Predicted Doppler and elevation of every PRN with an ephemeris valid at `t` (healthy or not,
+/// healthy ones first: [`NavData::select_with`] with [`HealthPolicy::PreferHealthy`]) that is
+/// at least `mask_deg` above the horizon of a static receiver at `rx`.
 ///
-/// The satellite state is taken at transmit time `t - tau` (light time iterated from 75 ms)
-/// and rotated by the Earth's rotation during the flight (IS-GPS-200 20.3.3.4.3.3.2). With `u`
-/// the unit vector from the receiver to the satellite, the range rate is
-/// `rho_dot = (v_sv - v_rx) . u` (v_rx = 0 in ECEF), and the Doppler is positive when the range
-/// shrinks: `f_D = (-rho_dot + c * clock_drift_sv) / lambda_L1` (a satellite clock running fast
-/// transmits above 1575.42 MHz). The receiver's own clock drift is unknown here and adds
+/// The satellite state is taken at transmit time `t - tau` (light time iterated three times
+/// from 75 ms) and rotated by the Earth's rotation during the flight (IS-GPS-200
+/// 20.3.3.4.3.3.2; [`gpsrx_nav::Ephemeris::at_reception`]). With `u` the unit vector from the
+/// receiver to the satellite, the range rate is `rho_dot = (v_sv - v_rx) . u` (v_rx = 0 in
+/// ECEF), and the Doppler is positive when the range shrinks:
+/// `f_D = -rho_dot / lambda_L1 + f_L1 clock_drift_sv` ([`gpsrx_core::los_doppler_hz`]; a
+/// satellite clock running fast transmits above 1575.42 MHz). The receiver's own clock drift is unknown here and adds
 /// `-drift * f_L1` to every satellite (1e-6 s/s = -1575 Hz): cover it with the search window.
 pub fn predict(nav: &NavData, rx: &Llh, t: GpsTime, mask_deg: f64) -> Vec<Prediction> {
     let rx_ecef = rx.to_ecef();
     Prn::all()
         .filter_map(|prn| {
-            let eph = ephemeris_for(nav, prn.get(), t)?;
-            let mut tau = 0.075;
-            let mut state = eph.sv_state(t.add_seconds(-tau));
-            let mut pos = state.pos_m;
-            for _ in 0..3 {
-                state = eph.sv_state(t.add_seconds(-tau));
-                pos = rotate_for_earth_rotation(&state.pos_m, tau);
-                tau = (pos - rx_ecef).norm() / SPEED_OF_LIGHT_MPS;
-            }
-            let vel = rotate_for_earth_rotation(&state.vel_mps, tau);
-            let los = pos - rx_ecef;
-            let range = los.norm();
-            if !(range.is_finite() && range > 0.0) {
-                return None;
-            }
-            let range_rate = vel.dot(&(los / range));
-            let doppler_hz =
-                (-range_rate + SPEED_OF_LIGHT_MPS * state.clock_drift_s_s) / LAMBDA_L1_M;
-            let (az, el) = azimuth_elevation(&rx_ecef, &pos);
+            let eph = nav.select_with(prn.get(), t, HealthPolicy::PreferHealthy)?;
+            let seen = eph.at_reception(t, &rx_ecef, 0.075, 3);
+            let sv = PosVel {
+                pos_m: seen.sv.pos_m,
+                vel_mps: seen.sv.vel_mps,
+            };
+            let rx = PosVel {
+                pos_m: rx_ecef,
+                vel_mps: Vector3::zeros(),
+            };
+            let doppler_hz = los_doppler_hz(&sv, &rx, seen.sv.clock_drift_s_s, 0.0)?;
+            let (az, el) = azimuth_elevation(&rx_ecef, &seen.sv.pos_m);
             let elevation_deg = el.to_degrees();
             (elevation_deg >= mask_deg && doppler_hz.is_finite()).then_some(Prediction {
                 prn,

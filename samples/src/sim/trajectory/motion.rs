@@ -54,28 +54,8 @@ pub struct MotionTable {
 }
 
 /// What a vehicle's own sensors would see at one instant: the inputs of dead-reckoning and
-/// accelerometer models (seed 000 eqs. 1-3, seed 002).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VehicleState {
-    /// Seconds from the start.
-    pub t_s: f64,
-    /// East of the start point in its local level frame, m.
-    pub east_m: f64,
-    /// North, m.
-    pub north_m: f64,
-    /// Up, m.
-    pub up_m: f64,
-    /// Speed along the road (what an odometer measures), m/s, >= 0.
-    pub speed_mps: f64,
-    /// Heading, rad clockwise from north, in (-pi, pi].
-    pub heading_rad: f64,
-    /// Yaw rate (heading rate), rad/s, positive turning right.
-    pub yaw_rate_rad_s: f64,
-    /// Longitudinal acceleration (rate of `speed_mps`), m/s^2.
-    pub a_long_mps2: f64,
-    /// Road slope `atan(grade)`, rad, positive nose up.
-    pub pitch_rad: f64,
-}
+/// accelerometer models (seed 000 eqs. 1-3, seed 002); the shared [`gpsrx_core::VehicleState`].
+pub use gpsrx_core::vehicle::VehicleState;
 
 /// Motion state integrated in the level frame: east, north, up, speed, heading.
 type State = [f64; 5];
