@@ -52,17 +52,20 @@
 mod channel;
 mod conclusions;
 mod discriminator;
+mod doppler_code_md;
 mod formulas;
 mod grid;
 mod intro;
 mod loop_noise;
 mod measure;
 mod params;
+mod phase_md;
 mod plan;
 mod plots;
 mod ratios;
 mod result;
 mod table;
+mod table_two_md;
 mod theory;
 mod track;
 
