@@ -85,6 +85,11 @@ pub struct InsTrack {
 /// (default choice: 0.5 s, i.e. a 10 Hz file may lose four rows), finite values, positions
 /// within [`MIN_RADIUS_M`]..[`MAX_RADIUS_M`] of the Earth's centre, speeds up to
 /// [`MAX_SPEED_MPS`], `gps_tow_s` (if present) in `[0, 604800)` and increasing modulo the week.
+///
+/// The steps: the header (`InsColumns::from_header`), then per row the record
+/// (`read_record`), its numbers (`InsColumns::parse_row`), the row's own checks
+/// (`check_row`) and those against the previous row (`check_step`); at the end, at least 2
+/// rows.
 pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
     let p = path.display().to_string();
     if max_gap_s.is_nan() || max_gap_s <= 0.0 {
@@ -92,11 +97,6 @@ pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
             "the INS gap limit {max_gap_s} s must be positive (0.5 s suits a 10 Hz INS)"
         )));
     }
-    let row_err = |line: usize, message: String| InsError::Row {
-        path: p.clone(),
-        line,
-        message,
-    };
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
@@ -105,147 +105,19 @@ pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
             path: p.clone(),
             message: e.to_string(),
         })?;
-    let headers = rdr
-        .headers()
-        .map_err(|e| row_err(1, e.to_string()))?
-        .clone();
-    let header_line = headers
-        .position()
-        .map_or(1, |pos| usize::try_from(pos.line()).unwrap_or(1));
-    let col = |name: &str| headers.iter().position(|h| h == name);
-    let names = ["t_s", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps"];
-    let tow_col = col("gps_tow_s");
-    // `t_s` may be left out when `gps_tow_s` is given (the GPS time base): t_s then counts from
-    // the first row's time of week, and the receiver maps it once it knows the GPS time.
-    let gps_time_base = col("t_s").is_none() && tow_col.is_some();
-    let mut idx = [0usize; 7];
-    for (k, n) in names.iter().enumerate() {
-        if k == 0 && gps_time_base {
-            continue;
-        }
-        idx[k] = col(n).ok_or_else(|| {
-            row_err(
-                header_line,
-                format!(
-                    "no column `{n}`: the header must name t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps (ECEF, metres and m/s; gps_tow_s optional, or gps_tow_s instead of t_s)"
-                ),
-            )
-        })?;
-    }
+    let cols = InsColumns::from_header(&mut rdr, &p)?;
     let mut samples: Vec<InsSample> = Vec::new();
     let mut first_tow: Option<f64> = None;
-    let mut last_line = header_line;
+    let mut last_line = cols.header_line;
     for (i, rec) in rdr.records().enumerate() {
-        let rec = rec.map_err(|e| match e.kind() {
-            csv::ErrorKind::UnequalLengths {
-                pos,
-                expected_len,
-                len,
-            } => row_err(
-                pos.as_ref()
-                    .map_or(i + 2, |p| usize::try_from(p.line()).unwrap_or(i + 2)),
-                format!(
-                    "{len} values but the header has {expected_len} columns: every row needs one value per header column"
-                ),
-            ),
-            _ => row_err(i + 2, format!("{e}")),
-        })?;
-        let line = rec
-            .position()
-            .map_or(i + 2, |pos| usize::try_from(pos.line()).unwrap_or(i + 2));
+        let (rec, line) = read_record(rec, i, &p)?;
         last_line = line;
-        let num = |c: usize, name: &str| -> Result<f64, InsError> {
-            let f = rec.get(c).unwrap_or("");
-            f.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    if f.is_empty() {
-                        row_err(
-                            line,
-                            format!("`{name}` is missing: fill it in or delete the row"),
-                        )
-                    } else {
-                        row_err(
-                            line,
-                            format!("{name} = `{f}` is not a finite number: fix or delete the row"),
-                        )
-                    }
-                })
-        };
-        let mut v = [0.0; 7];
-        for k in usize::from(gps_time_base)..7 {
-            v[k] = num(idx[k], names[k])?;
-        }
-        let gps_tow_s = match tow_col {
-            Some(c) => Some(num(c, "gps_tow_s")?),
-            None => None,
-        };
-        if let (true, Some(tow)) = (gps_time_base, gps_tow_s) {
-            // Seconds since the first row, across a week rollover.
-            let t0 = *first_tow.get_or_insert(tow);
-            v[0] = (tow - t0).rem_euclid(WEEK_S);
-        }
-        let pos_m = Vector3::new(v[1], v[2], v[3]);
-        let vel_mps = Vector3::new(v[4], v[5], v[6]);
-        let r = pos_m.norm();
-        if !(MIN_RADIUS_M..=MAX_RADIUS_M).contains(&r) {
-            return Err(row_err(
-                line,
-                format!(
-                    "the position is {:.1} km from the Earth's centre, outside {:.0}-{:.0} km: x_m,y_m,z_m must be ECEF in metres (not km, not latitude/longitude)",
-                    r / 1e3,
-                    MIN_RADIUS_M / 1e3,
-                    MAX_RADIUS_M / 1e3
-                ),
-            ));
-        }
-        let speed = vel_mps.norm();
-        if speed > MAX_SPEED_MPS {
-            return Err(row_err(
-                line,
-                format!(
-                    "the speed {speed:.1} m/s is above {MAX_SPEED_MPS} m/s: vx_mps,vy_mps,vz_mps must be ECEF velocity in m/s"
-                ),
-            ));
-        }
-        if let Some(tow) = gps_tow_s {
-            if !(0.0..WEEK_S).contains(&tow) {
-                return Err(row_err(
-                    line,
-                    format!("gps_tow_s = {tow} is outside a GPS week [0, 604800) s: give the time of week in seconds"),
-                ));
-            }
-        }
+        let sample = cols.parse_row(&rec, line, &p, &mut first_tow)?;
+        check_row(&sample, line, &p)?;
         if let Some(last) = samples.last() {
-            if v[0] <= last.t_s {
-                return Err(row_err(
-                    line,
-                    format!(
-                        "t_s = {} does not increase (previous {}): sort the file by t_s and remove duplicate rows",
-                        v[0], last.t_s
-                    ),
-                ));
-            }
-            if v[0] - last.t_s > max_gap_s {
-                return Err(row_err(line, format!("gap of {:.3} s before this row (limit {max_gap_s} s): the INS must run at 10 Hz or faster without gaps", v[0] - last.t_s)));
-            }
-            if let (Some(a), Some(b)) = (last.gps_tow_s, gps_tow_s) {
-                // A decrease by more than half a week is a week rollover, not a step back.
-                if b <= a && a - b < WEEK_S / 2.0 {
-                    return Err(row_err(
-                        line,
-                        format!("gps_tow_s = {b} does not increase (previous {a}): the GPS time of week must advance with t_s"),
-                    ));
-                }
-            }
+            check_step(last, &sample, max_gap_s, line, &p)?;
         }
-        samples.push(InsSample {
-            t_s: v[0],
-            gps_tow_s,
-            pos_m,
-            vel_mps,
-        });
+        samples.push(sample);
     }
     if samples.len() < 2 {
         return Err(InsError::Row {
@@ -261,6 +133,237 @@ pub fn read_ins_csv(path: &Path, max_gap_s: f64) -> Result<InsTrack, InsError> {
         samples,
         gps_time_base_tow_s: first_tow,
     })
+}
+
+/// The required columns of an INS file, in the order of [`InsColumns::idx`].
+const COLUMN_NAMES: [&str; 7] = ["t_s", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps"];
+
+/// Where the INS file's header puts each value.
+#[derive(Debug, Clone, Copy)]
+struct InsColumns {
+    /// Column of each of [`COLUMN_NAMES`] (that of `t_s` unused in the GPS time base).
+    idx: [usize; 7],
+    /// Column of `gps_tow_s`, if any.
+    tow_col: Option<usize>,
+    /// No `t_s` column but a `gps_tow_s` one: `t_s` counts from the first row's time of week.
+    gps_time_base: bool,
+    /// 1-based line of the header.
+    header_line: usize,
+}
+
+impl InsColumns {
+    /// Reads the header and finds the columns (any order, extra columns ignored). `t_s` may be
+    /// left out when `gps_tow_s` is given (the GPS time base).
+    fn from_header(
+        rdr: &mut csv::Reader<std::fs::File>,
+        path: &str,
+    ) -> Result<InsColumns, InsError> {
+        let headers = rdr
+            .headers()
+            .map_err(|e| row_err(path, 1, e.to_string()))?
+            .clone();
+        let header_line = headers
+            .position()
+            .map_or(1, |pos| usize::try_from(pos.line()).unwrap_or(1));
+        let col = |name: &str| headers.iter().position(|h| h == name);
+        let tow_col = col("gps_tow_s");
+        // `t_s` may be left out when `gps_tow_s` is given (the GPS time base): t_s then counts
+        // from the first row's time of week, and the receiver maps it once it knows the GPS time.
+        let gps_time_base = col("t_s").is_none() && tow_col.is_some();
+        let mut idx = [0usize; 7];
+        for (k, n) in COLUMN_NAMES.iter().enumerate() {
+            if k == 0 && gps_time_base {
+                continue;
+            }
+            idx[k] = col(n).ok_or_else(|| {
+                row_err(
+                    path,
+                    header_line,
+                    format!(
+                        "no column `{n}`: the header must name t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps (ECEF, metres and m/s; gps_tow_s optional, or gps_tow_s instead of t_s)"
+                    ),
+                )
+            })?;
+        }
+        Ok(InsColumns {
+            idx,
+            tow_col,
+            gps_time_base,
+            header_line,
+        })
+    }
+
+    /// The sample of one row on `line`: every value a finite number; in the GPS time base,
+    /// `t_s = (tow - tow_0) mod 604800` from the first row's `tow_0` (kept in `first_tow`), so
+    /// that it runs on across a week rollover.
+    fn parse_row(
+        &self,
+        rec: &csv::StringRecord,
+        line: usize,
+        path: &str,
+        first_tow: &mut Option<f64>,
+    ) -> Result<InsSample, InsError> {
+        let mut v = [0.0; 7];
+        for k in usize::from(self.gps_time_base)..7 {
+            v[k] = parse_field(rec, self.idx[k], COLUMN_NAMES[k], line, path)?;
+        }
+        let gps_tow_s = match self.tow_col {
+            Some(c) => Some(parse_field(rec, c, "gps_tow_s", line, path)?),
+            None => None,
+        };
+        if let (true, Some(tow)) = (self.gps_time_base, gps_tow_s) {
+            // Seconds since the first row, across a week rollover.
+            let t0 = *first_tow.get_or_insert(tow);
+            v[0] = (tow - t0).rem_euclid(WEEK_S);
+        }
+        Ok(InsSample {
+            t_s: v[0],
+            gps_tow_s,
+            pos_m: Vector3::new(v[1], v[2], v[3]),
+            vel_mps: Vector3::new(v[4], v[5], v[6]),
+        })
+    }
+}
+
+/// A row error of the file `path` on 1-based `line`.
+fn row_err(path: &str, line: usize, message: String) -> InsError {
+    InsError::Row {
+        path: path.to_owned(),
+        line,
+        message,
+    }
+}
+
+/// The `i`-th (0-based) data record and its 1-based line (`i + 2` when the reader does not
+/// know it); a row with another number of values than the header is an error.
+fn read_record(
+    rec: Result<csv::StringRecord, csv::Error>,
+    i: usize,
+    path: &str,
+) -> Result<(csv::StringRecord, usize), InsError> {
+    let rec = rec.map_err(|e| match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            pos,
+            expected_len,
+            len,
+        } => row_err(
+            path,
+            pos.as_ref()
+                .map_or(i + 2, |p| usize::try_from(p.line()).unwrap_or(i + 2)),
+            format!(
+                "{len} values but the header has {expected_len} columns: every row needs one value per header column"
+            ),
+        ),
+        _ => row_err(path, i + 2, format!("{e}")),
+    })?;
+    let line = rec
+        .position()
+        .map_or(i + 2, |pos| usize::try_from(pos.line()).unwrap_or(i + 2));
+    Ok((rec, line))
+}
+
+/// The value of column `c` (named `name`) of a record on `line`: a finite number, else an error
+/// that says whether it is missing or not a number.
+fn parse_field(
+    rec: &csv::StringRecord,
+    c: usize,
+    name: &str,
+    line: usize,
+    path: &str,
+) -> Result<f64, InsError> {
+    let f = rec.get(c).unwrap_or("");
+    f.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| {
+            if f.is_empty() {
+                row_err(
+                    path,
+                    line,
+                    format!("`{name}` is missing: fill it in or delete the row"),
+                )
+            } else {
+                row_err(
+                    path,
+                    line,
+                    format!("{name} = `{f}` is not a finite number: fix or delete the row"),
+                )
+            }
+        })
+}
+
+/// The checks of one row `s` on `line`: `|(x, y, z)|` in [`MIN_RADIUS_M`]..=[`MAX_RADIUS_M`]
+/// (ECEF metres), `|(vx, vy, vz)|` at most [`MAX_SPEED_MPS`], `gps_tow_s` in `[0, 604800)`.
+fn check_row(s: &InsSample, line: usize, path: &str) -> Result<(), InsError> {
+    let r = s.pos_m.norm();
+    if !(MIN_RADIUS_M..=MAX_RADIUS_M).contains(&r) {
+        return Err(row_err(
+            path,
+            line,
+            format!(
+                "the position is {:.1} km from the Earth's centre, outside {:.0}-{:.0} km: x_m,y_m,z_m must be ECEF in metres (not km, not latitude/longitude)",
+                r / 1e3,
+                MIN_RADIUS_M / 1e3,
+                MAX_RADIUS_M / 1e3
+            ),
+        ));
+    }
+    let speed = s.vel_mps.norm();
+    if speed > MAX_SPEED_MPS {
+        return Err(row_err(
+            path,
+            line,
+            format!(
+                "the speed {speed:.1} m/s is above {MAX_SPEED_MPS} m/s: vx_mps,vy_mps,vz_mps must be ECEF velocity in m/s"
+            ),
+        ));
+    }
+    if let Some(tow) = s.gps_tow_s {
+        if !(0.0..WEEK_S).contains(&tow) {
+            return Err(row_err(
+                path,
+                line,
+                format!("gps_tow_s = {tow} is outside a GPS week [0, 604800) s: give the time of week in seconds"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The checks of row `s` on `line` against the previous row `last`: `t_s` strictly increasing,
+/// a step of at most `max_gap_s`, and `gps_tow_s` increasing (a decrease by more than half a
+/// week is a week rollover).
+fn check_step(
+    last: &InsSample,
+    s: &InsSample,
+    max_gap_s: f64,
+    line: usize,
+    path: &str,
+) -> Result<(), InsError> {
+    if s.t_s <= last.t_s {
+        return Err(row_err(
+            path,
+            line,
+            format!(
+                "t_s = {} does not increase (previous {}): sort the file by t_s and remove duplicate rows",
+                s.t_s, last.t_s
+            ),
+        ));
+    }
+    if s.t_s - last.t_s > max_gap_s {
+        return Err(row_err(path, line, format!("gap of {:.3} s before this row (limit {max_gap_s} s): the INS must run at 10 Hz or faster without gaps", s.t_s - last.t_s)));
+    }
+    if let (Some(a), Some(b)) = (last.gps_tow_s, s.gps_tow_s) {
+        // A decrease by more than half a week is a week rollover, not a step back.
+        if b <= a && a - b < WEEK_S / 2.0 {
+            return Err(row_err(
+                path,
+                line,
+                format!("gps_tow_s = {b} does not increase (previous {a}): the GPS time of week must advance with t_s"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Writes `samples` as an INS file [`read_ins_csv`] reads back: the header

@@ -16,9 +16,9 @@
 
 use crate::aiding::{code_doppler_chips_s, DopplerAid};
 use crate::bit_sync::{Bit, BitSync, BitSyncConfig, BitSyncState, MS_PER_BIT};
-use crate::carrier_loop::CarrierLoop;
+use crate::carrier_loop::{CarrierLoop, CarrierOutput};
 use crate::cn0::SmoothedNwpr;
-use crate::code_loop::CodeLoop;
+use crate::code_loop::{CodeLoop, CodeOutput};
 use crate::config::{ConfigError, LoopConfig};
 use crate::fade_detector::FadeDetector;
 use crate::lock_detector::{CodeLockDetector, PllLockConfig, PllLockDetector};
@@ -456,10 +456,45 @@ impl Channel {
 
     /// Processes one code period; `samples` must be exactly the span [`Channel::next_span`]
     /// returned. Returns the epoch report when an integration interval ends.
+    ///
+    /// The steps, in this order (each reads the state the previous one left):
+    /// `Channel::correlate_period` (E, P, L over the period, NCOs advanced, accumulated),
+    /// `Channel::update_bit_sync` (bits and bit edges from the 1 ms prompt),
+    /// `Channel::update_detectors` (C/N0, weak-signal and lock detectors, loss of lock),
+    /// `Channel::interval_complete` (integration time reached on a bit-aligned boundary), then
+    /// once per integration interval `Channel::update_loops` (discriminators, loop filters,
+    /// NCO frequencies), `Channel::build_epoch` (the report) and the state transitions
+    /// `Channel::maybe_hand_over` / `Channel::maybe_switch_loops` at a bit edge.
     pub fn process_code_period(&mut self, samples: &[Complex32]) -> Option<ChannelEpoch> {
         if self.state == ChannelState::Lost {
             return None;
         }
+        let (p, t_start_s, ms_index) = self.correlate_period(samples);
+        let timing = self.update_bit_sync(p, t_start_s, ms_index);
+        self.update_detectors(p, timing.next_is_edge);
+        if !self.interval_complete(ms_index, timing) {
+            return None;
+        }
+        let bit = self.pending_bit.take();
+        let (co, cl) = self.update_loops();
+        let epoch = self.build_epoch(ms_index, timing, &co, &cl, bit);
+        self.acc = [Complex64::new(0.0, 0.0); 3];
+        self.acc_ms = 0;
+        self.maybe_hand_over(timing.next_is_edge);
+        self.maybe_switch_loops(timing.next_is_edge);
+        Some(epoch)
+    }
+
+    /// Correlates one code period and advances the replica over it: records the start of a new
+    /// integration interval, computes E, P, L (replica code phases `c + d/2`, `c`, `c - d/2`,
+    /// NCOs held over the period), advances code and carrier phase by `n / fs`
+    /// ([`Channel::advance`]), counts the period (and the pull-in time, switching the FLL assist
+    /// off after [`ChannelConfig::fll_assist_s`]) and adds E, P, L to the interval's sums.
+    ///
+    /// Returns the 1 ms prompt, the receive time of the period's first sample (`index / fs`, s)
+    /// and the period's `ms_count`.
+    #[inline]
+    fn correlate_period(&mut self, samples: &[Complex32]) -> (Complex64, f64, u64) {
         let state_now = ReplicaState {
             code_phase_chips: self.code_phase_chips,
             code_rate_chips_s: self.code_rate_chips_s,
@@ -500,8 +535,17 @@ impl Channel {
             *a += v;
         }
         self.acc_ms += 1;
+        (p, t_start_s, ms_index)
+    }
 
-        // Bit synchronisation and bits, from 1 ms prompts.
+    /// Bit synchronisation from the 1 ms prompt of code period `ms_index` (first sample at
+    /// receive time `t_start_s`): a completed bit waits in `pending_bit`, tagged with the
+    /// `ms_count` of its first period (`ms_index + 1 - 20`), for the end of the integration
+    /// interval. Once synchronised, bit edges fall on the periods `k` with
+    /// `k mod 20 == (origin + edge) mod 20` (IS-GPS-200 20.3.2: 20 C/A periods per 50 bit/s data
+    /// bit).
+    #[inline]
+    fn update_bit_sync(&mut self, p: Complex64, t_start_s: f64, ms_index: u64) -> BitTiming {
         if let Some(b) = self.bit_sync.push(p, t_start_s) {
             // Reported with the integration interval that ends next (bits end on interval ends
             // once the integrations are bit-aligned).
@@ -517,8 +561,33 @@ impl Channel {
         let next_is_edge = edge_phase.is_some_and(|edge| {
             (ms_index + 1) % MS_PER_BIT as u64 == edge as u64 % MS_PER_BIT as u64
         });
-        // C/N0 from NWPR blocks of 20 prompts aligned to the data bits: measured from the first
-        // bit edge after bit synchronisation (before it, the acquisition's estimate stands).
+        BitTiming {
+            edge_phase,
+            next_is_edge,
+        }
+    }
+
+    /// The detectors fed with every 1 ms prompt: the C/N0 ([`Channel::update_cn0`]), the phase
+    /// lock indicator (`cos 2 phi`), the fade detector, and the bit synchroniser's failure
+    /// (no bit edges within its patience: no usable signal, the channel is lost).
+    #[inline]
+    fn update_detectors(&mut self, p: Complex64, next_is_edge: bool) {
+        self.update_cn0(p, next_is_edge);
+        self.pll_lock.update(p);
+        self.fade.push(p);
+        if matches!(self.bit_sync.state(), BitSyncState::Failed) {
+            // No bit edges within the synchroniser's patience: no usable signal. Release the
+            // channel so the satellite goes back to acquisition.
+            self.state = ChannelState::Lost;
+        }
+    }
+
+    /// C/N0 from NWPR blocks of 20 prompts aligned to the data bits
+    /// (`C/N0 = 10 log10((mu - 1) / (M T (M - mu)))`, `mu` the mean of NBP/WBP, see
+    /// [`crate::cn0`]): measured from the first bit edge after bit synchronisation (before it,
+    /// the acquisition's estimate stands). A new estimate goes to [`Channel::on_cn0_estimate`].
+    #[inline]
+    fn update_cn0(&mut self, p: Complex64, next_is_edge: bool) {
         let estimate = if self.cn0_started {
             self.cn0.push(p)
         } else {
@@ -532,38 +601,46 @@ impl Channel {
             self.cn0.align_block();
         }
         if let Some(c) = estimate {
-            self.cn0_dbhz = c;
-            if c < self.cfg.weak_enter_dbhz {
-                self.weak = true;
-            } else if c > self.cfg.weak_leave_dbhz {
-                self.weak = false;
-            }
-            // Lock decisions once per estimation window.
-            if self.cn0.blocks().is_multiple_of(self.cn0_window_blocks) {
-                let ok = self.code_lock.update(c);
-                self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz {
-                    self.low_cn0_count + 1
-                } else {
-                    0
-                };
-                if !ok && self.low_cn0_count >= self.cfg.lost_estimates {
-                    self.state = ChannelState::Lost;
-                }
-            }
+            self.on_cn0_estimate(c);
         }
-        self.pll_lock.update(p);
-        self.fade.push(p);
-        if matches!(self.bit_sync.state(), BitSyncState::Failed) {
-            // No bit edges within the synchroniser's patience: no usable signal. Release the
-            // channel so the satellite goes back to acquisition.
-            self.state = ChannelState::Lost;
-        }
+    }
 
-        // Integration interval complete?
+    /// A new C/N0 estimate `c` (dB-Hz): stored, the weak-signal flag updated with hysteresis
+    /// (set below [`ChannelConfig::weak_enter_dbhz`], cleared above
+    /// [`ChannelConfig::weak_leave_dbhz`]), and once per estimation window the code lock
+    /// decided: [`ChannelConfig::lost_estimates`] consecutive estimates below
+    /// [`ChannelConfig::cn0_lost_dbhz`] with the code lock detector out release the channel.
+    fn on_cn0_estimate(&mut self, c: f64) {
+        self.cn0_dbhz = c;
+        if c < self.cfg.weak_enter_dbhz {
+            self.weak = true;
+        } else if c > self.cfg.weak_leave_dbhz {
+            self.weak = false;
+        }
+        // Lock decisions once per estimation window.
+        if self.cn0.blocks().is_multiple_of(self.cn0_window_blocks) {
+            let ok = self.code_lock.update(c);
+            self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz {
+                self.low_cn0_count + 1
+            } else {
+                0
+            };
+            if !ok && self.low_cn0_count >= self.cfg.lost_estimates {
+                self.state = ChannelState::Lost;
+            }
+        }
+    }
+
+    /// Whether the integration interval ends with code period `ms_index`: `T_coh` (ms) periods
+    /// accumulated and the next period starting on a boundary of the `T_coh` grid anchored on
+    /// the bit edges (`(ms_index + 1 - edge) mod 20` a multiple of `T_coh`), or on an edge, or
+    /// `T_coh = 1 ms`. A full sum that is not aligned (only after a loop switch) is dropped.
+    #[inline]
+    fn interval_complete(&mut self, ms_index: u64, timing: BitTiming) -> bool {
         let t_coh_ms = (self.carrier.t_coh_s() * 1e3).round() as usize;
         let aligned = t_coh_ms == 1
-            || next_is_edge
-            || edge_phase.is_some_and(|edge| {
+            || timing.next_is_edge
+            || timing.edge_phase.is_some_and(|edge| {
                 let k = (ms_index + 1 + MS_PER_BIT as u64 - edge as u64 % MS_PER_BIT as u64)
                     % MS_PER_BIT as u64;
                 k.is_multiple_of(t_coh_ms as u64)
@@ -574,10 +651,20 @@ impl Channel {
                 self.acc = [Complex64::new(0.0, 0.0); 3];
                 self.acc_ms = 0;
             }
-            return None;
+            return false;
         }
+        true
+    }
+
+    /// Closes the loops at the end of an integration interval: the feed-forward for the next
+    /// interval (the aid's Doppler at its middle, `f + f' (t_next - t_aid + T/2)`; the loop's base
+    /// frequency takes up the step when the aid comes or goes, keeping the NCO continuous), the
+    /// carrier loop on the summed prompt (seed 004 Fig. 4: NCO = feed-forward + filter), the
+    /// carrier-aided DLL on E, P, L (code rate `1.023 MHz (1 + f / f_L1)` + DLL), and the
+    /// Doppler-rate fit of the pull-in ([`Channel::accumulate_rate_fit`]).
+    #[inline]
+    fn update_loops(&mut self) -> (CarrierOutput, CodeOutput) {
         let [ea, pa, la] = self.acc;
-        let bit = self.pending_bit.take();
         let ff_opt = self.feedforward_hz(self.carrier.t_coh_s());
         match (self.ff_applied_hz, ff_opt) {
             (None, Some(f)) => self.carrier.shift_base_hz(-f),
@@ -592,17 +679,46 @@ impl Channel {
             .update(ea, pa, la, code_doppler_chips_s(co.nco_freq_hz));
         self.carrier_freq_hz = co.nco_freq_hz;
         self.code_rate_chips_s = cl.code_rate_chips_s;
+        self.accumulate_rate_fit(co.nco_freq_hz, ff);
+        (co, cl)
+    }
+
+    /// During pull-in, once the FLL assist is off: adds the point `(t, f)` (pull-in time, s;
+    /// NCO frequency less the feed-forward, Hz) to the least-squares sums
+    /// `(n, sum t, sum f, sum t^2, sum t f)`, whose slope
+    /// `(n sum tf - sum t sum f) / (n sum t^2 - (sum t)^2)` presets the Doppler rate of a
+    /// 3rd-order tracking loop at the hand-over ([`Channel::maybe_hand_over`]).
+    #[inline]
+    fn accumulate_rate_fit(&mut self, nco_freq_hz: f64, ff: f64) {
         if self.state == ChannelState::PullIn
             && self.pull_in_ms > (self.cfg.fll_assist_s * 1e3) as u64
         {
             let t = self.pull_in_ms as f64 * 1e-3;
-            let f = co.nco_freq_hz - ff;
+            let f = nco_freq_hz - ff;
             for (acc, v) in self.rate_fit.iter_mut().zip([1.0, t, f, t * t, t * f]) {
                 *acc += v;
             }
         }
+    }
+
+    /// The report of the integration interval that ends with code period `ms_index`: the
+    /// replica state at its first sample (kept by [`Channel::correlate_period`]), the summed
+    /// E, P, L, the discriminator outputs of [`Channel::update_loops`] (`co`, `cl`), the lock
+    /// indicators, and the bit completed in it (`bit`, with the `ms_count` of its first period).
+    /// The interval's first period is `ms_index + 1 - acc_ms`; it is a bit edge when that is
+    /// `edge mod 20`.
+    #[inline]
+    fn build_epoch(
+        &self,
+        ms_index: u64,
+        timing: BitTiming,
+        co: &CarrierOutput,
+        cl: &CodeOutput,
+        bit: Option<(Bit, u64)>,
+    ) -> ChannelEpoch {
+        let [ea, pa, la] = self.acc;
         let (s0, cp0, ph0, f0) = self.acc_start;
-        let epoch = ChannelEpoch {
+        ChannelEpoch {
             prn: self.prn.get(),
             state: self.state,
             sample_index: s0,
@@ -624,18 +740,13 @@ impl Channel {
             t_coh_s: self.carrier.t_coh_s(),
             feedforward_hz: self.acc_feedforward_hz,
             ms_count: ms_index + 1 - self.acc_ms as u64,
-            bit_edge: edge_phase.is_some_and(|edge| {
+            bit_edge: timing.edge_phase.is_some_and(|edge| {
                 (ms_index + 1 - self.acc_ms as u64) % MS_PER_BIT as u64
                     == edge as u64 % MS_PER_BIT as u64
             }),
             bit: bit.map(|(b, _)| b),
             bit_start_ms: bit.map(|(_, m)| m),
-        };
-        self.acc = [Complex64::new(0.0, 0.0); 3];
-        self.acc_ms = 0;
-        self.maybe_hand_over(next_is_edge);
-        self.maybe_switch_loops(next_is_edge);
-        Some(epoch)
+        }
     }
 
     /// Pull-in -> track once the phase is locked, the bits are synchronised and the minimum
@@ -740,4 +851,14 @@ enum TrackLoops {
     Aided,
     /// [`ChannelConfig::weak_track`].
     Weak,
+}
+
+/// Where a code period stands relative to the data bits, from the bit synchroniser.
+#[derive(Debug, Clone, Copy)]
+struct BitTiming {
+    /// Bit edges fall on code periods `k` (counted by `ms_count`) with `k mod 20` equal to this
+    /// (None before bit synchronisation).
+    edge_phase: Option<usize>,
+    /// The next code period starts on a data-bit edge.
+    next_is_edge: bool,
 }
