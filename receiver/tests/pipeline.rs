@@ -362,3 +362,64 @@ fn the_navigation_processor_alone_and_the_file_sink_alone_reproduce_a_run() {
         assert_eq!(read("run"), read("replay"), "{name} differs");
     }
 }
+
+#[test]
+fn a_solution_with_a_fault_raim_cannot_exclude_is_never_a_valid_fix() {
+    use gpsrx_nav::frames::{Llh, Vector3};
+    use gpsrx_nav::pvt::{Landmark, RaimStatus};
+    use gpsrx_receiver::landmarks::LandmarkObservation;
+    use gpsrx_receiver::output::FixQuality;
+    let sim = simulator(13.0);
+    let (_, truth) = sim.receiver_truth(0.0);
+    // A landmark 1 km east of the antenna whose range is 500 m too long, at every epoch: the
+    // solver cannot exclude it (RAIM excludes satellites), so every solution that uses it
+    // fails the test.
+    let llh = Llh::from_ecef(&truth.pos_m);
+    let east = Vector3::new(-llh.lon_rad.sin(), llh.lon_rad.cos(), 0.0);
+    let at = truth.pos_m + 1000.0 * east;
+    let landmarks: Vec<LandmarkObservation> = (0..140)
+        .map(|k| LandmarkObservation {
+            tow_s: 538198.0 + 0.1 * f64::from(k),
+            landmark: Landmark {
+                ecef_m: at,
+                range_m: 1000.0 + 500.0,
+                sigma_m: 1.0,
+            },
+        })
+        .collect();
+    let mut config = ReceiverConfig::default();
+    config.run.tropo = gpsrx_receiver::config::TropoModel::None;
+    config.run.week = Some(2190);
+    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let assistance = Assistance {
+        nav: Some(nav),
+        landmarks,
+        ..Assistance::default()
+    };
+    let mut rx = Receiver::new(&config, 2.048e6, assistance).unwrap_or_else(|e| panic!("{e}"));
+    let mut sink = MemorySink::new();
+    let summary = rx
+        .run(&mut SimSource::new(&sim), &mut sink)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(summary.invalid_fixes > 0, "the fault was never detected");
+    for f in &sink.fixes {
+        let [x, y, z] = f.fix.ecef_m;
+        let error_m = (Vector3::new(x, y, z) - truth.pos_m).norm();
+        if f.fix.quality == FixQuality::None {
+            assert_eq!(f.solution.raim, RaimStatus::FaultDetectedNotExcluded);
+        } else {
+            assert!(
+                error_m < 10.0,
+                "a fix {error_m:.1} m off handed out as valid (RAIM {:?})",
+                f.solution.raim
+            );
+        }
+    }
+    assert_eq!(
+        sink.fixes
+            .iter()
+            .filter(|f| f.fix.quality != FixQuality::None)
+            .count(),
+        summary.fixes
+    );
+}

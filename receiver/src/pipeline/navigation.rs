@@ -30,8 +30,10 @@ use std::collections::BTreeMap;
 pub struct FixStats {
     /// Stream time of the first fix, s.
     pub first_fix_s: Option<f64>,
-    /// Number of fixes.
+    /// Number of valid fixes.
     pub fixes: usize,
+    /// Solutions that failed the integrity test (written flagged, never as fixes).
+    pub invalid_fixes: usize,
     sum_lat_deg: f64,
     sum_lon_deg: f64,
     sum_h_m: f64,
@@ -72,6 +74,8 @@ pub struct NavigationProcessor {
     builder: ObservableBuilder,
     prior: Option<PvtSolution>,
     iono_fallback_said: bool,
+    /// The RAIM outcome last logged (transitions are logged).
+    last_raim: Option<RaimStatus>,
     /// Per channel: receive time of its last channel row.
     last_row_t: BTreeMap<usize, f64>,
     /// Latest sample index a progress report was made for.
@@ -102,6 +106,7 @@ impl NavigationProcessor {
             builder,
             prior: None,
             iono_fallback_said: false,
+            last_raim: None,
             last_row_t: BTreeMap::new(),
             progress_at: 0,
             stats: FixStats::default(),
@@ -347,6 +352,41 @@ impl NavigationProcessor {
         }
     }
 
+    /// Logs a change of the RAIM outcome at INFO: an exclusion (with the residuals of the
+    /// rest), a fault that could not be excluded, and the return to a clean test.
+    fn log_raim(&mut self, t_stream_s: f64, sol: &PvtSolution) {
+        if self.last_raim.as_ref() == Some(&sol.raim) {
+            return;
+        }
+        let residuals = || {
+            sol.residuals_m
+                .iter()
+                .map(|(p, r)| format!("G{p:02} {r:+.1} m"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        match &sol.raim {
+            RaimStatus::FaultExcluded { prn } => tracing::info!(
+                "{t_stream_s:.2} s: RAIM excluded G{prn:02} (a fault in its pseudorange); residuals of the rest: {}",
+                residuals()
+            ),
+            RaimStatus::FaultDetectedNotExcluded => tracing::info!(
+                "{t_stream_s:.2} s: RAIM detected a fault it could not exclude: no valid fix (residuals {})",
+                residuals()
+            ),
+            RaimStatus::Ok
+                if matches!(
+                    self.last_raim,
+                    Some(RaimStatus::FaultExcluded { .. } | RaimStatus::FaultDetectedNotExcluded)
+                ) =>
+            {
+                tracing::info!("{t_stream_s:.2} s: RAIM test passes again")
+            }
+            _ => {}
+        }
+        self.last_raim = Some(sol.raim);
+    }
+
     /// Solves one epoch and hands its observables and fix to the sink.
     fn solve_epoch(
         &mut self,
@@ -356,16 +396,32 @@ impl NavigationProcessor {
     ) -> Result<(), SinkError> {
         let ephs = self.ephemerides(&epoch);
         let solution = self.solution(&epoch, &ephs);
+        let valid = solution.as_ref().is_some_and(passes_integrity);
         sink.observables(&ObservablesReport {
             epoch: obs_epoch(&epoch),
             fix_position_m: solution
                 .as_ref()
+                .filter(|_| valid)
                 .map(|s| [s.pos_ecef_m.x, s.pos_ecef_m.y, s.pos_ecef_m.z]),
             week_decoded: self.decoders.values().any(|d| d.decoded_week().is_some()),
         })?;
         let Some(sol) = solution else {
             return Ok(());
         };
+        let t_stream_s = epoch.sample / self.fs_hz;
+        self.log_raim(t_stream_s, &sol);
+        if !valid {
+            // Written for the record, flagged: quality `none` in pvt.csv, GGA quality 0, absent
+            // from the GeoJSON and KML tracks; it steers nothing.
+            self.stats.invalid_fixes += 1;
+            let mut fix = fix_of(&sol, &epoch, &ephs);
+            fix.quality = FixQuality::None;
+            return sink.fix(&FixReport {
+                fix,
+                solution: sol,
+                t_stream_s,
+            });
+        }
         // Keep the receiver clock within +-0.5 ms of GPS time by whole-millisecond steps.
         let bias_ms = sol.clock_bias_m / SPEED_OF_LIGHT_MPS * 1e3;
         if bias_ms.abs() > 0.5 {
@@ -374,7 +430,6 @@ impl NavigationProcessor {
             tracing::debug!("receiver clock stepped by {step} ms");
             sink.event(&ReceiverEvent::ClockStep { ms: step })?;
         }
-        let t_stream_s = epoch.sample / self.fs_hz;
         if self.stats.first_fix_s.is_none() {
             tracing::info!(
                 "first fix at {:.2} s: {:.7} {:.7} {:.1} m, {} satellites, PDOP {:.1}",
@@ -399,6 +454,14 @@ impl NavigationProcessor {
         self.prior = Some(sol);
         Ok(())
     }
+}
+
+/// Whether a solution may be handed out as a fix: RAIM (the chi-square test of the
+/// a-posteriori variance of the residuals, seed 001) did not detect a fault it could not
+/// exclude. Without redundancy (4 measurements) the test is unavailable and the fix stands,
+/// with `raim = unavailable` in the outputs.
+fn passes_integrity(sol: &PvtSolution) -> bool {
+    !matches!(sol.raim, RaimStatus::FaultDetectedNotExcluded)
 }
 
 /// The observables of an epoch as RINEX writes them.

@@ -178,8 +178,11 @@ pub struct RunSummary {
     pub tracked_prns: Vec<u8>,
     /// Stream time (s from the first sample) of the first fix.
     pub first_fix_s: Option<f64>,
-    /// Number of fixes.
+    /// Number of valid fixes.
     pub fixes: usize,
+    /// Solutions that failed the integrity test (RAIM fault not excluded): written flagged
+    /// (quality `none`, GGA quality 0), never as fixes.
+    pub invalid_fixes: usize,
     /// Mean position of the fixes, LLH degrees/m.
     pub mean_llh: Option<(f64, f64, f64)>,
     /// Mean PDOP.
@@ -422,6 +425,7 @@ impl Receiver {
             tracked_prns: self.nav.tracked_prns(),
             first_fix_s: stats.first_fix_s,
             fixes: stats.fixes,
+            invalid_fixes: stats.invalid_fixes,
             mean_llh: stats.mean_llh(),
             mean_pdop: stats.mean_pdop(),
         })

@@ -10,7 +10,7 @@ use crate::commands::source::open_interruptible;
 use anyhow::Context;
 use gpsrx_ins_aiding::DrParams;
 use gpsrx_receiver::fusion::gnss::GnssFix;
-use gpsrx_receiver::output::{FileSink, Fix};
+use gpsrx_receiver::output::{FileSink, Fix, FixQuality};
 use gpsrx_receiver::pipeline::{AssistanceFiles, FixReport, Progress, Sink, SinkError, Tee};
 use gpsrx_receiver::{Assistance, Receiver, RunSummary};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -41,7 +41,8 @@ struct CommandSink {
 
 impl Sink for CommandSink {
     fn fix(&mut self, report: &FixReport) -> Result<(), SinkError> {
-        if let Some(f) = &mut self.gnss_fixes {
+        // Only valid fixes update the DR filters (a flagged solution steers nothing).
+        if let (Some(f), true) = (&mut self.gnss_fixes, report.fix.quality != FixQuality::None) {
             f.push(GnssFix::from_solution(report.t_stream_s, &report.solution));
         }
         Ok(())
@@ -129,10 +130,20 @@ fn print_report(out: &mut dyn Write, report: &RunReport, args: &RunArgs) -> std:
     match (s.first_fix_s, s.mean_llh) {
         (Some(t), Some((lat, lon, h))) => {
             writeln!(out, "first fix {t:.2} s after the start; {} fixes", s.fixes)?;
+            if s.invalid_fixes > 0 {
+                writeln!(out, "{} more solutions failed the RAIM test and are flagged invalid (quality none in pvt.csv, GGA quality 0, not in the tracks)", s.invalid_fixes)?;
+            }
             writeln!(out, "mean position {lat:.7} deg, {lon:.7} deg, {h:.2} m; mean PDOP {:.2}", s.mean_pdop.unwrap_or(f64::NAN))?;
         }
         _ if s.tracked_prns.is_empty() => writeln!(out,
             "no fix: no satellite was tracked. Check the format, rate, IF and Q sign (gpsrx info FILE), widen the search (--doppler-max, --doppler-center for a front-end LO offset) or integrate longer (--acq-coherent-ms 10 --acq-noncoherent 20)"
+        )?,
+        _ if s.invalid_fixes > 0 => writeln!(out,
+            "no valid fix: all {} solutions failed the RAIM test (a faulty measurement it could not exclude: see the log and the raim column of pvt.csv)",
+            s.invalid_fixes
+        )?,
+        _ if args.nav.is_some() => writeln!(out,
+            "no fix: fewer than 4 satellites were tracked with their time of week known long enough for a position (frame sync takes 6-12 s; see the log for lost channels)"
         )?,
         _ => writeln!(out,
             "no fix: the recording ended before 4 satellites had their ephemeris (subframes 1-3 take 18-30 s; give --nav FILE to start sooner)"
