@@ -423,3 +423,41 @@ fn a_solution_with_a_fault_raim_cannot_exclude_is_never_a_valid_fix() {
         summary.fixes
     );
 }
+
+#[test]
+fn two_seconds_of_zeros_give_no_fix() {
+    // A dropout: the front end delivers zeros from 13 to 15 s. Channels must see it as an
+    // outage (their C/N0 estimate falls, the fade detector never takes "no power" as a new
+    // level), so no fix comes from NCOs coasting through it.
+    let sim = simulator(18.0);
+    let fs = 2.048e6;
+    let (a, b) = ((13.0 * fs) as u64, (15.0 * fs) as u64);
+    let mut src = SimSource::new(&sim);
+    let mut rx = receiver(fs);
+    let mut sink = MemorySink::new();
+    let mut block = vec![Complex32::new(0.0, 0.0); 20_480];
+    loop {
+        let (first, n) = src.read(&mut block).unwrap_or_else(|e| panic!("{e}"));
+        if n == 0 {
+            break;
+        }
+        for (k, s) in block[..n].iter_mut().enumerate() {
+            if (a..b).contains(&(first + k as u64)) {
+                *s = Complex32::new(0.0, 0.0);
+            }
+        }
+        rx.push(&block[..n], &mut sink)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    rx.finish(&mut sink).unwrap_or_else(|e| panic!("{e}"));
+    let before = sink.fixes.iter().filter(|f| f.t_stream_s < 13.0).count();
+    assert!(before > 10, "{before} fixes before the dropout");
+    let during: Vec<f64> = sink
+        .fixes
+        .iter()
+        .filter(|f| f.fix.quality != gpsrx_receiver::output::FixQuality::None)
+        .map(|f| f.t_stream_s)
+        .filter(|t| (13.1..=15.0).contains(t))
+        .collect();
+    assert!(during.is_empty(), "fixes from zeros at {during:?} s");
+}

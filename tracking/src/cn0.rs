@@ -50,7 +50,9 @@ impl NwprBlock {
 
     /// Adds a prompt; returns the block's normalised power `|sum|^2 / sum |p|^2` (1 for noise,
     /// `m` for a pure carrier) when the block holds `m` prompts, and starts a new block.
-    /// Non-finite prompts are skipped.
+    /// Non-finite prompts are skipped. A block without any power (the input was zeros: a
+    /// dropout, a stalled front end) holds no signal and counts as noise (1), so the estimate
+    /// falls to [`CN0_MIN_DBHZ`] instead of freezing at its last value.
     fn push(&mut self, prompt: Complex64, m: u32) -> Option<f64> {
         if !(prompt.re.is_finite() && prompt.im.is_finite()) {
             return None;
@@ -61,9 +63,13 @@ impl NwprBlock {
         if self.n < m {
             return None;
         }
-        let np = (self.wbp > 0.0).then(|| self.sum.norm_sqr() / self.wbp);
+        let np = if self.wbp > 0.0 {
+            self.sum.norm_sqr() / self.wbp
+        } else {
+            1.0
+        };
         *self = Self::EMPTY;
-        np
+        Some(np)
     }
 }
 
@@ -221,6 +227,36 @@ mod tests {
         }
         assert_eq!(out, Some(CN0_MIN_DBHZ));
         assert_eq!(m.push(Complex64::new(f64::NAN, 0.0)), None);
+    }
+
+    #[test]
+    fn zero_prompts_drive_the_estimate_down_instead_of_freezing_it() {
+        // A strong carrier, then zeros (a dropout): the running estimate must fall to the
+        // minimum within its window, never stay at the carrier's value.
+        let mut e = SmoothedNwpr::new(1e-3, 20, 10, 1);
+        let mut last = None;
+        for k in 0..400 {
+            let p = Complex64::new(if (k / 20) % 2 == 0 { 1.0 } else { -1.0 }, 0.0);
+            last = e.push(p).or(last);
+        }
+        assert!(last.is_some_and(|db| db > 50.0), "{last:?}");
+        let mut after = Vec::new();
+        for _ in 0..20 * 100 {
+            if let Some(db) = e.push(Complex64::new(0.0, 0.0)) {
+                after.push(db);
+            }
+        }
+        assert_eq!(after.len(), 100, "an estimate per block of zeros");
+        assert!(after.windows(2).all(|w| w[1] <= w[0]), "{after:?}");
+        // Below a 25 dB-Hz loss threshold within 0.4 s, at the minimum within 2 s.
+        assert!(after[19] < 25.0, "{after:?}");
+        assert_eq!(after.last().copied(), Some(CN0_MIN_DBHZ));
+        let mut n = NwprEstimator::new(1e-3, 20, 5);
+        let mut out = None;
+        for _ in 0..100 {
+            out = n.push(Complex64::new(0.0, 0.0)).or(out);
+        }
+        assert_eq!(out, Some(CN0_MIN_DBHZ));
     }
 }
 

@@ -17,7 +17,9 @@
 //! relative spread of about `sqrt((1 + 2 C/N0 T) / M) / (1 + C/N0 T)` (0.19 at 30 dB-Hz), so
 //! two blocks in a row below a quarter of the mean do not happen. A fade that lasts
 //! [`REBASE_BLOCKS`] takes the new level as the reference (a front-end gain change, not a
-//! blockage); the C/N0 test releases a channel that has really lost its signal.
+//! blockage); the C/N0 test releases a channel that has really lost its signal. A level of no
+//! power at all (zeros from a dropout or a stalled front end) is never taken as a reference:
+//! it stays a fade.
 
 use num_complex::Complex64;
 
@@ -91,7 +93,7 @@ impl FadeDetector {
                 self.faded = false;
                 self.faded_blocks = 0;
                 self.low = 0;
-            } else if self.faded_blocks >= REBASE_BLOCKS {
+            } else if self.faded_blocks >= REBASE_BLOCKS && w > 0.0 {
                 // A lasting new level: take it as the reference.
                 self.faded = false;
                 self.faded_blocks = 0;
@@ -232,5 +234,24 @@ mod tests {
         }
         assert!(!d.faded());
         assert_eq!(d.blocks, 0);
+    }
+
+    #[test]
+    fn zeros_stay_a_fade_and_never_become_the_reference() {
+        let mut d = FadeDetector::new();
+        for k in 0..1000 {
+            d.push(Complex64::new(if k % 40 < 20 { 30.0 } else { -30.0 }, 0.0));
+        }
+        assert!(!d.faded());
+        // Ten seconds of zeros: faded at once, and still faded (no rebase to a level of 0).
+        for _ in 0..10_000 {
+            d.push(Complex64::new(0.0, 0.0));
+        }
+        assert!(d.faded());
+        // The signal comes back: the fade ends.
+        for _ in 0..100 {
+            d.push(Complex64::new(30.0, 0.0));
+        }
+        assert!(!d.faded());
     }
 }
