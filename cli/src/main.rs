@@ -1,10 +1,16 @@
 //! `gpsrx`: the command-line GPS L1 C/A receiver.
+//!
+//! Exit status (see [`gpsrx_cli::exit`]): 0 done (also when standard output is closed early, as
+//! by `| head`), 1 an error (one line on standard error), 2 `gpsrx run` made no valid fix.
 
 use clap::Parser;
 use gpsrx_cli::cli::{Cli, Command};
 use gpsrx_cli::commands;
+use gpsrx_cli::exit::{error_message, is_broken_pipe, Completion};
+use std::io::Write;
+use std::process::ExitCode;
 
-fn main() {
+fn main() -> ExitCode {
     let cli = Cli::parse();
     let filter = tracing_subscriber::EnvFilter::try_from_env("GPSRX_LOG").unwrap_or_else(|_| {
         tracing_subscriber::EnvFilter::new(if cli.verbose { "debug" } else { "info" })
@@ -14,19 +20,26 @@ fn main() {
         .with_writer(std::io::stderr)
         .with_target(false)
         .init();
+    let done = |r: anyhow::Result<()>| r.map(|()| Completion::Done);
     let result = match cli.command {
-        Command::Simulate(args) => commands::simulate::run(&args),
-        Command::Info(args) => commands::info::run(&args),
-        Command::Demo(args) => commands::demo::run(&args),
-        Command::Acquire(args) => commands::acquire::run(&args),
-        Command::Track(args) => commands::track::run(&args),
+        Command::Simulate(args) => done(commands::simulate::run(&args)),
+        Command::Info(args) => done(commands::info::run(&args)),
+        Command::Demo(args) => done(commands::demo::run(&args)),
+        Command::Acquire(args) => done(commands::acquire::run(&args)),
+        Command::Track(args) => done(commands::track::run(&args)),
         Command::Run(args) => commands::run::run(&args),
-        Command::Config(args) => commands::config::run(&args),
-        Command::Study(args) => gpsrx_studies::run(&args),
-        Command::Bench(args) => commands::bench::run(&args),
+        Command::Config(args) => done(commands::config::run(&args)),
+        Command::Study(args) => done(gpsrx_studies::run(&args)),
+        Command::Bench(args) => done(commands::bench::run(&args)),
     };
-    if let Err(e) = result {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
+    match result {
+        Ok(c) => ExitCode::from(c.exit_status()),
+        // `gpsrx ... | head`: the reader has what it wanted.
+        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
+        Err(e) => {
+            // If standard error is gone too there is no one left to tell.
+            let _ = writeln!(std::io::stderr(), "error: {}", error_message(&e));
+            ExitCode::FAILURE
+        }
     }
 }

@@ -5,6 +5,7 @@ mod common;
 
 mod acquisition;
 mod aided_run;
+mod bad_input;
 mod bench;
 mod dr_run;
 mod ins_simulate;

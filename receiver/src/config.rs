@@ -153,12 +153,86 @@ impl ReceiverConfig {
         Self::from_toml(&text, &path.display().to_string())
     }
 
-    /// Checks every value against its valid range.
+    /// Checks every value against its valid range: the tracking loops (and
+    /// `[tracking] cn0_lost_dbhz` within [`CN0_LOST_RANGE_DBHZ`]), `[run]` and `[dr]`.
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.tracking
             .validate()
             .map_err(|e| ConfigError::Invalid(format!("tracking configuration: {e}")))?;
-        self.run.validate()
+        let (lo, hi) = CN0_LOST_RANGE_DBHZ;
+        let cn0_lost = self.tracking.cn0_lost_dbhz;
+        if !(lo..=hi).contains(&cn0_lost) {
+            return Err(ConfigError::Invalid(format!(
+                "[tracking] cn0_lost_dbhz = {cn0_lost}: use {lo} to {hi} dB-Hz (the C/N0 below which a channel counts as lost; default 25)"
+            )));
+        }
+        self.run.validate()?;
+        self.dr.validate()
+    }
+}
+
+/// The valid range of `[tracking] cn0_lost_dbhz`, dB-Hz: below 10 dB-Hz no channel is ever
+/// released (it tracks noise), above 45 dB-Hz nearly every real signal is.
+pub const CN0_LOST_RANGE_DBHZ: (f64, f64) = (10.0, 45.0);
+
+/// The valid range of a full GPS week (`[run] week`, `--week`): week 1024 began in August
+/// 1999, week 4096 comes in 2058.
+pub const WEEK_RANGE: (u32, u32) = (1024, 4096);
+
+impl DrRunConfig {
+    /// Checks every value that is set against its valid range.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let check = |key: &str, value: Option<f64>, lo: f64, lo_open: bool, hi: f64, unit: &str| {
+            let Some(v) = value else {
+                return Ok(());
+            };
+            let above_lo = if lo_open { v > lo } else { v >= lo };
+            if v.is_finite() && above_lo && v <= hi {
+                return Ok(());
+            }
+            let open = if lo_open { "(" } else { "[" };
+            Err(ConfigError::Invalid(format!(
+                "[dr] {key} = {v}: use a value in {open}{lo}, {hi}] {unit}"
+            )))
+        };
+        check(
+            "sf_g_dps_per_v",
+            self.sf_g_dps_per_v,
+            0.0,
+            true,
+            1000.0,
+            "deg/s/V (seed 000: 45.045)",
+        )?;
+        check(
+            "v_nom_v",
+            self.v_nom_v,
+            -10.0,
+            false,
+            10.0,
+            "V (seed 000: 2.5)",
+        )?;
+        check(
+            "sf_n_m_per_pulse",
+            self.sf_n_m_per_pulse,
+            0.0,
+            true,
+            10.0,
+            "m/pulse (seed 000: 0.1)",
+        )?;
+        check(
+            "update_interval_s",
+            self.update_interval_s,
+            0.0,
+            true,
+            60.0,
+            "s",
+        )?;
+        match self.filter.as_deref() {
+            None | Some("proposed" | "conventional") => Ok(()),
+            Some(other) => Err(ConfigError::Invalid(format!(
+                "[dr] filter = \"{other}\": use \"proposed\" or \"conventional\""
+            ))),
+        }
     }
 }
 
@@ -207,6 +281,14 @@ impl RunSettings {
         }
         if let Some(p) = self.prns.iter().find(|p| !(1..=32).contains(*p)) {
             return bad(format!("PRN {p}: GPS PRNs are 1 to 32"));
+        }
+        if let Some(w) = self.week {
+            let (lo, hi) = WEEK_RANGE;
+            if !(lo..=hi).contains(&w) {
+                return bad(format!(
+                    "GPS week {w} (--week, [run] week): give the full week number, {lo} to {hi} (e.g. 2190 for 1 January 2022)"
+                ));
+            }
         }
         Ok(())
     }

@@ -12,9 +12,11 @@ pub mod if_sim;
 pub mod report;
 pub mod steady_state;
 
+use anyhow::Context;
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
+use std::io::Write;
 use std::path::PathBuf;
 
 /// `gpsrx study`.
@@ -66,24 +68,32 @@ pub fn run(args: &StudyArgs) -> anyhow::Result<()> {
         StudyKind::Dr(a) => (dr::run(a, true)?, &a.common.out),
     };
     let written = report.write(out)?;
-    println!("{}", report.table.to_markdown());
-    if !report.conclusions_md.trim().is_empty() {
-        println!("{}\n", report.conclusions_md.trim_end());
-    }
-    println!(
-        "wrote {}, {}, {} and {} plot(s) in {}",
-        file_name(&written.markdown),
-        file_name(&written.csv),
-        file_name(&written.json),
-        // Some studies draw their own plots (shaded outages): count what is there.
-        std::fs::read_dir(out)
-            .map(|d| d
-                .filter_map(Result::ok)
+    let plots = std::fs::read_dir(out)
+        .map(|d| {
+            d.filter_map(Result::ok)
                 .filter(|e| e.path().extension().is_some_and(|x| x == "png"))
-                .count())
-            .unwrap_or(written.plots.len()),
-        out.display()
-    );
+                .count()
+        })
+        .unwrap_or(written.plots.len());
+    // A closed pipe (`| head`) or a full disk is an error to report, not a panic: the
+    // binary ends quietly on a broken pipe.
+    let mut stdout = std::io::stdout().lock();
+    let mut print = || -> std::io::Result<()> {
+        writeln!(stdout, "{}", report.table.to_markdown())?;
+        if !report.conclusions_md.trim().is_empty() {
+            writeln!(stdout, "{}\n", report.conclusions_md.trim_end())?;
+        }
+        writeln!(
+            stdout,
+            "wrote {}, {}, {} and {plots} plot(s) in {}",
+            file_name(&written.markdown),
+            file_name(&written.csv),
+            file_name(&written.json),
+            out.display()
+        )?;
+        stdout.flush()
+    };
+    print().context("cannot write to standard output")?;
     Ok(())
 }
 

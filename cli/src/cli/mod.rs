@@ -27,6 +27,12 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// The exit status of `gpsrx run`, shown by `gpsrx run --help`.
+pub const RUN_EXIT_STATUS: &str = "Exit status:
+  0  at least one valid fix (also when standard output is closed early, e.g. by `| head`)
+  1  an error: bad input, a file that cannot be read or written (one line on standard error)
+  2  the recording was processed to the end but gave no valid fix (the summary says why)";
+
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
@@ -41,6 +47,7 @@ pub enum Command {
     /// Acquire and track satellites; write every integration interval to CSV.
     Track(TrackArgs),
     /// Process a recording into position fixes and standard files (RINEX, NMEA, GeoJSON, KML, CSV).
+    #[command(after_help = RUN_EXIT_STATUS)]
     Run(RunArgs),
     /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
     Config(ConfigArgs),

@@ -9,6 +9,7 @@ use gpsrx_dsp::acquisition::{AcqConfig, AcqResult, AcquisitionEngine, SearchTarg
 use gpsrx_dsp::Prn;
 use gpsrx_samples::{open_source, SampleSource};
 use num_complex::Complex32;
+use std::io::Write;
 
 pub use crate::cli::AcquireArgs;
 
@@ -83,9 +84,14 @@ pub fn run(args: &AcquireArgs) -> anyhow::Result<()> {
             .iter()
             .filter(|r| args.all || r.detected)
             .collect();
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        let text = serde_json::to_string_pretty(&rows)?;
+        let mut out = crate::exit::stdout();
+        writeln!(out, "{text}")?;
+        out.flush()?;
     } else {
-        print!("{}", render_table(&report, args.all));
+        let mut out = crate::exit::stdout();
+        write!(out, "{}", render_table(&report, args.all))?;
+        out.flush()?;
     }
     Ok(())
 }

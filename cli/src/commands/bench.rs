@@ -31,6 +31,7 @@ use num_complex::Complex32;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::hint::black_box;
+use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
@@ -143,9 +144,14 @@ pub struct BenchReport {
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let report = bench(args)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        let text = serde_json::to_string_pretty(&report)?;
+        let mut out = crate::exit::stdout();
+        writeln!(out, "{text}")?;
+        out.flush()?;
     } else {
-        print_report(&report);
+        let mut out = crate::exit::stdout();
+        print_report(&mut out, &report)?;
+        out.flush()?;
     }
     Ok(())
 }
@@ -480,14 +486,15 @@ fn median(v: &[f64]) -> f64 {
     }
 }
 
-fn print_report(r: &BenchReport) {
-    println!("gpsrx bench on {} ({} threads)", r.cpu, r.threads);
-    println!();
-    println!("correlator throughput, Msamples/s on one core (4000-sample blocks at 4 MHz, code and carrier generated inside):");
-    println!(
+fn print_report(out: &mut dyn Write, r: &BenchReport) -> std::io::Result<()> {
+    writeln!(out, "gpsrx bench on {} ({} threads)", r.cpu, r.threads)?;
+    writeln!(out)?;
+    writeln!(out, "correlator throughput, Msamples/s on one core (4000-sample blocks at 4 MHz, code and carrier generated inside):")?;
+    writeln!(
+        out,
         "  {:<14} {:<6} {:>9} {:>9} {:>9}",
         "kernel", "input", "1 tap", "3 taps", "5 taps"
-    );
+    )?;
     let mut keys: Vec<(String, String)> = Vec::new();
     for c in &r.correlators {
         let k = (c.kernel.clone(), c.format.clone());
@@ -502,23 +509,24 @@ fn print_report(r: &BenchReport) {
                 .find(|c| &c.kernel == kernel && &c.format == format && c.taps == taps)
                 .map_or("-".to_string(), |c| format!("{:.0}", c.msps_per_core))
         };
-        println!(
+        writeln!(
+            out,
             "  {:<14} {:<6} {:>9} {:>9} {:>9}",
             kernel,
             format,
             cell(1),
             cell(3),
             cell(5)
-        );
+        )?;
     }
-    println!(
+    writeln!(
+        out,
         "  (scalar reference correlate(), cf32, 3 taps: {:.0})",
         r.reference_msps_per_core
-    );
-    println!();
+    )?;
+    writeln!(out)?;
     let a = &r.acquisition;
-    println!(
-        "acquisition: {}-PRN cold search, {} ms x {} non-coherent, +-{:.0} Hz, {:.0} MHz, {} threads: {:.0} ms (median of {}; {} satellites found)",
+    writeln!(out, "acquisition: {}-PRN cold search, {} ms x {} non-coherent, +-{:.0} Hz, {:.0} MHz, {} threads: {:.0} ms (median of {}; {} satellites found)",
         a.prns,
         a.coherent_ms,
         a.noncoherent,
@@ -528,18 +536,20 @@ fn print_report(r: &BenchReport) {
         r.acquisition_ms,
         a.runs,
         a.detected
-    );
+    )?;
     if let Some(e) = &r.end_to_end {
-        println!();
-        println!(
+        writeln!(out)?;
+        writeln!(
+            out,
             "end to end: {:.1} s of {} at {:.0} MHz, {} satellites simulated ({:.1} s to simulate)",
             e.duration_s,
             e.format,
             e.fs_hz / 1e6,
             e.satellites_simulated,
             e.simulate_s
-        );
-        println!(
+        )?;
+        writeln!(
+            out,
             "  file to fixes in {:.2} s: {:.1}x real time; {} satellites tracked, {} fixes{}",
             e.wall_s,
             e.realtime_factor,
@@ -548,17 +558,22 @@ fn print_report(r: &BenchReport) {
             e.mean_horizontal_error_m.map_or(String::new(), |h| format!(
                 ", mean fix {h:.2} m from the antenna (horizontal)"
             ))
-        );
+        )?;
         match e.peak_rss_mb {
-            Some(m) => println!(
+            Some(m) => writeln!(
+                out,
                 "  peak resident memory {m:.1} MB{}",
                 if e.peak_rss_reset {
                     ""
                 } else {
                     " (could not reset the peak: includes the simulation)"
                 }
-            ),
-            None => println!("  peak resident memory: unknown (no /proc/self/status)"),
+            )?,
+            None => writeln!(
+                out,
+                "  peak resident memory: unknown (no /proc/self/status)"
+            )?,
         }
     }
+    Ok(())
 }

@@ -2,13 +2,17 @@
 
 use crate::cli::ConfigArgs;
 use gpsrx_tracking::ChannelConfig;
+use std::io::Write;
 
 /// Runs `gpsrx config`.
 pub fn run(args: &ConfigArgs) -> anyhow::Result<()> {
     if !args.default {
         anyhow::bail!("say what to print: `gpsrx config --default` prints the default gpsrx.toml");
     }
-    print!("{}", default_toml()?);
+    let text = default_toml()?;
+    let mut out = crate::exit::stdout();
+    out.write_all(text.as_bytes())?;
+    out.flush()?;
     Ok(())
 }
 

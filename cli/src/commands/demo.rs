@@ -6,6 +6,7 @@ use crate::commands::simulate::{print_report, simulate};
 use anyhow::Context;
 use gpsrx_nav::frames::{enu_rotation, Vector3};
 use gpsrx_samples::sim::Scenario;
+use std::io::Write;
 use std::path::PathBuf;
 
 /// Runs `gpsrx demo`.
@@ -15,22 +16,25 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         scenario.duration_s = d;
     }
     let (dir, _tmp) = super::work_dir(args.keep.as_deref())?;
-    println!("gpsrx demo: {}", scenario.description);
-    println!(
+    let mut out = crate::exit::stdout();
+    writeln!(out, "gpsrx demo: {}", scenario.description)?;
+    writeln!(
+        out,
         "simulating {:.0} s of {} at {:.3} MHz into {}",
         scenario.duration_s,
         scenario.output.format,
         scenario.output.fs_hz / 1e6,
         dir.display()
-    );
+    )?;
     let report = simulate(&scenario, &PathBuf::new(), &dir, true)?;
-    print_report(&report);
-    print_truth_summary(&report.truth_sv_path)?;
-    println!(
+    print_report(&mut out, &report)?;
+    print_truth_summary(&mut out, &report.truth_sv_path)?;
+    writeln!(
+        out,
         "\nrunning the receiver on it (gpsrx run {} --out {})",
         report.data_path.display(),
         dir.join("run").display()
-    );
+    )?;
     let run_args = RunArgs {
         source: SourceArgs {
             file: report.data_path.clone(),
@@ -67,13 +71,14 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     };
     let (run_report, fixes) = run_file(&run_args, true)?;
     let summary = &run_report.receiver;
-    println!(
+    writeln!(
+        out,
         "processed {:.1} s in {:.1} s ({:.1}x real time); satellites tracked: {:?}",
         summary.duration_s,
         summary.wall_s,
         summary.duration_s / summary.wall_s.max(1e-9),
         summary.tracked_prns
-    );
+    )?;
     match (summary.first_fix_s, truth_position(&report.truth_path)?) {
         (Some(t), Some(truth)) => {
             let (mut h2, mut v2) = (0.0, 0.0);
@@ -89,34 +94,44 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
             }
             let n = fixes.len() as f64;
             let last = &fixes[fixes.len() - 1];
-            println!(
+            writeln!(
+                out,
                 "first fix {t:.1} s after the start (subframes 1-3 complete at 24.1 s); {} fixes",
                 fixes.len()
-            );
-            println!(
+            )?;
+            writeln!(
+                out,
                 "last fix: {:.7} deg, {:.7} deg, {:.2} m, {} satellites, PDOP {:.2}",
                 last.llh.lat_rad.to_degrees(),
                 last.llh.lon_rad.to_degrees(),
                 last.llh.h_m,
                 last.n_sv,
                 last.pdop
-            );
-            println!(
+            )?;
+            writeln!(
+                out,
                 "error against the truth: horizontal RMS {:.2} m, vertical RMS {:.2} m",
                 (h2 / n).sqrt(),
                 (v2 / n).sqrt()
-            );
+            )?;
         }
-        _ => println!("no fix (the recording is too short: subframes 1-3 need about 24 s here)"),
+        _ => writeln!(
+            out,
+            "no fix (the recording is too short: subframes 1-3 need about 24 s here)"
+        )?,
     }
     if args.keep.is_none() {
-        println!("(temporary files removed; use --keep DIR to keep them)");
+        writeln!(
+            out,
+            "(temporary files removed; use --keep DIR to keep them)"
+        )?;
     }
+    out.flush()?;
     Ok(())
 }
 
 /// Prints what a receiver should find at the first sample: the truth of every satellite.
-fn print_truth_summary(truth_sv: &std::path::Path) -> anyhow::Result<()> {
+fn print_truth_summary(out: &mut dyn Write, truth_sv: &std::path::Path) -> anyhow::Result<()> {
     let mut rdr = csv::Reader::from_path(truth_sv)
         .with_context(|| format!("cannot read {}", truth_sv.display()))?;
     let headers = rdr.headers()?.clone();
@@ -134,8 +149,14 @@ fn print_truth_summary(truth_sv: &std::path::Path) -> anyhow::Result<()> {
         col("cn0_dbhz")?,
         col("pseudorange_m")?,
     );
-    println!("\ntruth at the first sample (what acquisition should find):");
-    println!("  PRN  code phase(chips)  Doppler(Hz)  C/N0(dB-Hz)  pseudorange(m)");
+    writeln!(
+        out,
+        "\ntruth at the first sample (what acquisition should find):"
+    )?;
+    writeln!(
+        out,
+        "  PRN  code phase(chips)  Doppler(Hz)  C/N0(dB-Hz)  pseudorange(m)"
+    )?;
     for rec in rdr.records() {
         let rec = rec?;
         if rec.get(t).and_then(|v| v.parse::<f64>().ok()) != Some(0.0) {
@@ -146,14 +167,15 @@ fn print_truth_summary(truth_sv: &std::path::Path) -> anyhow::Result<()> {
                 .and_then(|v| v.parse::<f64>().ok())
                 .unwrap_or(f64::NAN)
         };
-        println!(
+        writeln!(
+            out,
             "  G{:02}  {:17.3}  {:11.1}  {:11.1}  {:14.1}",
             rec.get(prn).unwrap_or("?").parse::<u8>().unwrap_or(0),
             f(cp),
             f(dop),
             f(cn0),
             f(pr)
-        );
+        )?;
     }
     Ok(())
 }

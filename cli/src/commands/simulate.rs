@@ -14,6 +14,7 @@ use gpsrx_nav::frames::Llh;
 use gpsrx_receiver::fusion::vehicle::{vehicle_truth, EcefState};
 use gpsrx_samples::sim::{Scenario, SimReport, Simulator};
 use indicatif::{ProgressBar, ProgressStyle};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Runs `gpsrx simulate`.
@@ -38,6 +39,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         scenario.output.fs_hz = fs;
     }
     let (report, sensors) = simulate_with_sensors(&scenario, &base, &args.out, !args.json)?;
+    let mut out = crate::exit::stdout();
     if args.json {
         let mut v = serde_json::to_value(&report)?;
         if let Some(map) = v.as_object_mut() {
@@ -51,17 +53,19 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
                 }
             }
         }
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        let text = serde_json::to_string_pretty(&v)?;
+        writeln!(out, "{text}")?;
     } else {
-        print_report_with_ins(&report, sensors.ins.as_ref());
+        print_report_with_ins(&mut out, &report, sensors.ins.as_ref())?;
         let dr = sensors.dr.as_ref().map(|f| (&f.path, f.rows));
         let accel = sensors.accel.as_ref().map(|f| (&f.path, f.rows));
         for (what, f) in [("dr:", dr), ("accel:", accel)] {
             if let Some((path, rows)) = f {
-                println!("{what:<10} {} ({rows} rows)", path.display());
+                writeln!(out, "{what:<10} {} ({rows} rows)", path.display())?;
             }
         }
     }
+    out.flush()?;
     Ok(())
 }
 
@@ -283,19 +287,24 @@ pub fn simulate_with_sensors(
     Ok((report, sensors))
 }
 
-/// Prints a human summary of a run.
-pub fn print_report(r: &SimReport) {
-    print_report_with_ins(r, None);
+/// Writes a human summary of a run to `out`.
+pub fn print_report(out: &mut dyn Write, r: &SimReport) -> std::io::Result<()> {
+    print_report_with_ins(out, r, None)
 }
 
-/// Prints a human summary of a run and of the `ins.csv` it wrote, if any.
-pub fn print_report_with_ins(r: &SimReport, ins: Option<&InsOutput>) {
-    println!("satellites ({}):", r.satellites.len());
-    println!("  PRN  elev(deg)  C/N0(dB-Hz)");
+/// Writes a human summary of a run and of the `ins.csv` it wrote, if any, to `out`.
+pub fn print_report_with_ins(
+    out: &mut dyn Write,
+    r: &SimReport,
+    ins: Option<&InsOutput>,
+) -> std::io::Result<()> {
+    writeln!(out, "satellites ({}):", r.satellites.len())?;
+    writeln!(out, "  PRN  elev(deg)  C/N0(dB-Hz)")?;
     for (prn, el, cn0) in &r.satellites {
-        println!("  G{prn:02}  {el:9.1}  {cn0:11.1}");
+        writeln!(out, "  G{prn:02}  {el:9.1}  {cn0:11.1}")?;
     }
-    println!(
+    writeln!(
+        out,
         "recording: {} ({}, {:.3} MHz, {:.1} s, {} samples, {:.1} MB, {} clipped)",
         r.data_path.display(),
         r.format,
@@ -304,18 +313,18 @@ pub fn print_report_with_ins(r: &SimReport, ins: Option<&InsOutput>) {
         r.samples,
         r.bytes as f64 / 1e6,
         r.clipped
-    );
-    println!("metadata:  {}", r.meta_path.display());
-    println!(
+    )?;
+    writeln!(out, "metadata:  {}", r.meta_path.display())?;
+    writeln!(
+        out,
         "truth:     {} and {}",
         r.truth_path.display(),
         r.truth_sv_path.display()
-    );
+    )?;
     if let Some(ins) = ins {
         let c = &ins.config;
         let b = c.accel_bias_enu_mps2;
-        println!(
-            "ins:       {} ({} rows at {} Hz; accel bias ENU [{}, {}, {}] m/s^2, VRW {} m/s/sqrt(s), scale factor {}, latency {} s, band limit {})",
+        writeln!(out, "ins:       {} ({} rows at {} Hz; accel bias ENU [{}, {}, {}] m/s^2, VRW {} m/s/sqrt(s), scale factor {}, latency {} s, band limit {})",
             ins.path.display(),
             ins.rows,
             c.rate_hz,
@@ -327,13 +336,15 @@ pub fn print_report_with_ins(r: &SimReport, ins: Option<&InsOutput>) {
             c.latency_s,
             c.band_limit_alpha_rad_s
                 .map_or("none".to_string(), |a| format!("{a} rad/s"))
-        );
+        )?;
     }
-    println!(
+    writeln!(
+        out,
         "simulated {:.1} s in {:.2} s: {:.1}x real time ({:.1} Msamples/s)",
         r.duration_s,
         r.wall_s,
         r.realtime_factor,
         r.samples as f64 / r.wall_s.max(1e-9) / 1e6
-    );
+    )?;
+    Ok(())
 }

@@ -145,9 +145,9 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
         summaries: BTreeMap::new(),
         writer,
     };
-    receiver
-        .run(src.as_mut(), &mut sink)
-        .context("tracking (or writing the tracking CSV) failed")?;
+    let run = receiver.run(src.as_mut(), &mut sink);
+    crate::commands::run::warn_source(src.as_ref());
+    run.context("tracking (or writing the tracking CSV) failed")?;
     if let Some(mut w) = sink.writer {
         w.flush().context("cannot write the tracking CSV")?;
     }
@@ -162,13 +162,20 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
 /// Runs `gpsrx track`.
 pub fn run(args: &TrackArgs) -> anyhow::Result<()> {
     let summaries = track_file(args)?;
+    let mut out = crate::exit::stdout();
     if args.acquisition.json {
-        println!("{}", serde_json::to_string_pretty(&summaries)?);
+        let text = serde_json::to_string_pretty(&summaries)?;
+        writeln!(out, "{text}")?;
+        out.flush()?;
         return Ok(());
     }
-    println!("PRN  state    C/N0(dB-Hz)  Doppler(Hz)  first lock(s)  bit edge(ms mod 20)  bits");
+    writeln!(
+        out,
+        "PRN  state    C/N0(dB-Hz)  Doppler(Hz)  first lock(s)  bit edge(ms mod 20)  bits"
+    )?;
     for s in &summaries {
-        println!(
+        writeln!(
+            out,
             "{:3}  {:7}  {:11.1}  {:11.1}  {:>13}  {:>19}  {:4}",
             s.prn,
             s.state,
@@ -181,10 +188,11 @@ pub fn run(args: &TrackArgs) -> anyhow::Result<()> {
                 .map(|t| format!("{t:.2}"))
                 .unwrap_or_else(|| "-".into()),
             s.bits
-        );
+        )?;
     }
     if let Some(p) = &args.out {
-        println!("every integration interval written to {}", p.display());
+        writeln!(out, "every integration interval written to {}", p.display())?;
     }
+    out.flush()?;
     Ok(())
 }

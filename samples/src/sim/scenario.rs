@@ -23,6 +23,15 @@ pub const DEFAULT_SCENARIO_TOML: &str = include_str!("../../scenarios/default.to
 /// the vehicle trajectory of `gpsrx study dr`.
 pub const URBAN_DRIVE_TOML: &str = include_str!("../../scenarios/urban-drive.toml");
 
+/// The highest sampling rate the simulator writes, Hz: 100 MHz. A GPS L1 C/A receiver needs
+/// 2-5 MHz, a few tens of MHz at most; the simulator generates 0.1 s of samples per work unit in
+/// memory, so a rate far above this would exhaust it.
+pub const MAX_FS_HZ: f64 = 100e6;
+
+/// The most samples one simulation writes (`duration_s * fs_hz`): 1e11, e.g. 1000 s at 100 MHz
+/// or 13.5 h at 2.048 MHz (200 GB as ci8).
+pub const MAX_SAMPLES: f64 = 1e11;
+
 /// A complete simulation scenario.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -543,7 +552,8 @@ impl Scenario {
         })
     }
 
-    /// Checks values that TOML types cannot.
+    /// Checks values that TOML types cannot, and the size of the recording: `fs_hz` at most
+    /// [`MAX_FS_HZ`], `duration_s * fs_hz` at most [`MAX_SAMPLES`].
     pub fn validate(&self) -> Result<(), SimError> {
         let bad = |m: String| Err(SimError::Scenario(m));
         self.start_time()?;
@@ -557,6 +567,19 @@ impl Scenario {
             return bad(format!(
                 "[output] fs_hz = {fs} is too low for GPS L1 C/A: at least {min_fs} Hz for {} samples",
                 if fmt.is_complex() { "complex" } else { "real" }
+            ));
+        }
+        if fs > MAX_FS_HZ {
+            return bad(format!(
+                "[output] fs_hz (--fs) = {fs} Hz is above the simulator's limit of {} MHz (a GPS L1 C/A receiver needs a few MHz, at most a few tens): use a lower rate",
+                MAX_FS_HZ / 1e6
+            ));
+        }
+        let samples = self.duration_s * fs;
+        if samples > MAX_SAMPLES {
+            return bad(format!(
+                "duration_s x fs_hz = {} s x {fs} Hz = {samples:.3e} samples is above the simulator's limit of {MAX_SAMPLES:.0e} samples (e.g. 1000 s at 100 MHz, 13.5 h at 2.048 MHz): shorten duration_s (--duration) or lower fs_hz (--fs)",
+                self.duration_s
             ));
         }
         let f_if = self.output.if_hz;

@@ -7,13 +7,15 @@
 //! fixes are then fused with the DR logs (`dr_inputs`).
 
 use crate::commands::source::open_interruptible;
-use anyhow::Context;
+use crate::exit::Completion;
 use gpsrx_ins_aiding::DrParams;
 use gpsrx_receiver::fusion::gnss::GnssFix;
-use gpsrx_receiver::output::{FileSink, Fix, FixQuality};
+use gpsrx_receiver::output::{ChannelRow, FileSink, Fix, FixQuality};
 use gpsrx_receiver::pipeline::{AssistanceFiles, FixReport, Progress, Sink, SinkError, Tee};
 use gpsrx_receiver::{Assistance, Receiver, RunSummary};
+use gpsrx_samples::SampleSource;
 use indicatif::{ProgressBar, ProgressStyle};
+use std::collections::BTreeSet;
 use std::io::Write;
 
 mod dr_inputs;
@@ -24,22 +26,40 @@ use dr_inputs::{write_fused_outputs, DrInputs};
 /// What `gpsrx run` produced: the receiver's summary and, with `--dr`/`--accel`, the fusion's.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct RunReport {
-    /// The receiver's summary.
+    /// The receiver's summary. Its `tracked_prns` are the satellites whose channel reached bit
+    /// sync or carrier lock in the tracking state (a channel that only pulled in on noise is
+    /// not a tracked satellite): see [`RunReport::dropped_prns`] for the others.
     #[serde(flatten)]
     pub receiver: RunSummary,
+    /// Satellites that were searched for and had a channel, but never reached bit sync or
+    /// carrier lock in tracking (pull-in on noise or a signal too weak), ascending.
+    pub dropped_prns: Vec<u8>,
     /// With `--dr`/`--accel`: rows of `fused.csv` by source (gnss, fused, dr).
     pub fused_rows: Option<[usize; 3]>,
     /// With `--dr`: the calibrated sensor parameters at the end.
     pub dr_params: Option<DrParams>,
 }
 
-/// The command's own sink beside the files: the progress bar and the fixes for DR fusion.
+/// The command's own sink beside the files: the progress bar, the fixes for DR fusion and the
+/// satellites whose channels locked.
 struct CommandSink {
     bar: ProgressBar,
     gnss_fixes: Option<Vec<GnssFix>>,
+    /// PRNs with a channel at all.
+    channel_prns: BTreeSet<u8>,
+    /// PRNs whose channel reached carrier lock in tracking or bit sync at some point.
+    locked_prns: BTreeSet<u8>,
 }
 
 impl Sink for CommandSink {
+    fn channel(&mut self, row: &ChannelRow) -> Result<(), SinkError> {
+        self.channel_prns.insert(row.prn);
+        if is_locked(row) {
+            self.locked_prns.insert(row.prn);
+        }
+        Ok(())
+    }
+
     fn fix(&mut self, report: &FixReport) -> Result<(), SinkError> {
         // Only valid fixes update the DR filters (a flagged solution steers nothing).
         if let (Some(f), true) = (&mut self.gnss_fixes, report.fix.quality != FixQuality::None) {
@@ -58,16 +78,44 @@ impl Sink for CommandSink {
     }
 }
 
-/// The assistance inputs named on the command line.
+/// Whether a channel row shows a satellite really tracked: bit sync, or carrier lock after the
+/// hand-over from pull-in to the tracking loops (state `track`). A lock indicator that flickers
+/// on during pull-in alone is what a channel on noise shows (on a simulated recording of two
+/// satellites the 10 ms search pulled in a third PRN that declared carrier lock in 2 of its 22
+/// rows, all in pull-in).
+fn is_locked(row: &ChannelRow) -> bool {
+    row.bit_sync || (row.carrier_lock && row.state == "track")
+}
+
+/// The assistance inputs named on the command line. A navigation file without a single GPS
+/// ephemeris (a header only, or only other systems' records) is an error: it would assist
+/// nothing.
 fn assistance(args: &RunArgs) -> anyhow::Result<Assistance> {
-    Ok(Assistance::read(&AssistanceFiles {
+    let assistance = Assistance::read(&AssistanceFiles {
         nav: args.nav.as_deref(),
         ins: args.ins.as_deref(),
         ins_max_gap_s: args.ins_max_gap,
         ins_band_limit_rad_s: args.ins_band_limit,
         no_aiding: args.no_aiding,
         landmarks: args.landmarks.as_deref(),
-    })?)
+    })?;
+    if let (Some(nav), Some(path)) = (&assistance.nav, &args.nav) {
+        if nav.ephemerides.is_empty() {
+            anyhow::bail!(
+                "the navigation file {} holds no GPS ephemeris (a header only, or no GPS records): give a broadcast navigation file with ephemeris records (e.g. brdcDDD0.YYn for the day of the recording), or leave out --nav to decode the ephemerides from the signal",
+                path.display()
+            );
+        }
+    }
+    Ok(assistance)
+}
+
+/// Logs what the source had to fix up while reading (NaN values read as 0, trailing bytes
+/// dropped, a duration cut at the end of the file).
+pub(crate) fn warn_source(src: &dyn SampleSource) {
+    for w in src.warnings() {
+        tracing::warn!("{w}");
+    }
 }
 
 /// Runs the receiver on the recording of `args`; returns the report and the fixes.
@@ -92,12 +140,25 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunRepor
     let extra = CommandSink {
         bar: bar.clone(),
         gnss_fixes: dr_inputs.as_ref().map(|_| Vec::new()),
+        channel_prns: BTreeSet::new(),
+        locked_prns: BTreeSet::new(),
     };
     let mut sink = Tee(files, extra);
-    let summary = receiver.run(src.as_mut(), &mut sink)?;
+    let run = receiver.run(src.as_mut(), &mut sink);
     bar.finish_and_clear();
+    warn_source(src.as_ref());
+    let mut summary = run?;
     let Tee(files, extra) = sink;
+    // Tracked: the satellites whose channel locked; the rest were searched and dropped.
+    let searched: BTreeSet<u8> = extra
+        .channel_prns
+        .iter()
+        .chain(&summary.tracked_prns)
+        .copied()
+        .collect();
+    summary.tracked_prns = extra.locked_prns.iter().copied().collect();
     let mut report = RunReport {
+        dropped_prns: searched.difference(&extra.locked_prns).copied().collect(),
         receiver: summary,
         ..RunReport::default()
     };
@@ -109,11 +170,18 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunRepor
     Ok((report, files.into_fixes()))
 }
 
-/// Runs `gpsrx run`.
-pub fn run(args: &RunArgs) -> anyhow::Result<()> {
+/// Runs `gpsrx run`: [`Completion::NoValidFix`] (exit status 2) when the recording was
+/// processed to the end without a valid fix (the summary says why).
+pub fn run(args: &RunArgs) -> anyhow::Result<Completion> {
     let (report, _) = run_file(args, true)?;
-    print_report(&mut std::io::stdout().lock(), &report, args)
-        .context("cannot write the summary to standard output")
+    let mut out = crate::exit::stdout();
+    print_report(&mut out, &report, args)?;
+    out.flush()?;
+    Ok(if report.receiver.fixes == 0 {
+        Completion::NoValidFix
+    } else {
+        Completion::Done
+    })
 }
 
 /// The summary, for people.
@@ -127,6 +195,13 @@ fn print_report(out: &mut dyn Write, report: &RunReport, args: &RunArgs) -> std:
         s.duration_s / s.wall_s.max(1e-9)
     )?;
     writeln!(out, "satellites tracked: {:?}", s.tracked_prns)?;
+    if !report.dropped_prns.is_empty() {
+        writeln!(
+            out,
+            "searched and dropped (never locked): {:?}",
+            report.dropped_prns
+        )?;
+    }
     match (s.first_fix_s, s.mean_llh) {
         (Some(t), Some((lat, lon, h))) => {
             writeln!(out, "first fix {t:.2} s after the start; {} fixes", s.fixes)?;
