@@ -358,3 +358,35 @@ fn three_satellites_and_one_landmark_give_fixes() {
     );
     assert!(none.is_empty());
 }
+
+#[test]
+fn the_broadcast_utc_weeks_are_resolved_with_the_decoded_week() {
+    // 30 s without --week: the reference week is today's, years after the recording. The
+    // 8-bit WN_t of subframe 4 page 18 must be resolved against the decoded 10-bit week, so
+    // the RINEX header carries the week of the navigation file the simulator encoded (its
+    // DELTA-UTC line), not one 256 weeks off.
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let data = simulate(
+        "[receiver]\nkind = \"static\"\nllh_deg = [35.1796, 129.0756, 20.0]",
+        30.0,
+        dir.path(),
+    );
+    let out = dir.path().join("out");
+    run(&data, &out, &[]);
+    let nav = gpsrx_nav::rinex_nav::read_rinex_nav(&nav_file()).unwrap_or_else(|e| panic!("{e}"));
+    let utc = nav
+        .utc
+        .unwrap_or_else(|| panic!("no DELTA-UTC in the navigation file"));
+    let text = std::fs::read_to_string(out.join("ephemeris.rnx")).unwrap_or_else(|e| panic!("{e}"));
+    let gput = text
+        .lines()
+        .find(|l| l.starts_with("GPUT"))
+        .unwrap_or_else(|| panic!("no GPUT line (page 18 not decoded?):\n{text}"));
+    // "GPUT a0 a1 tot wnt" (RINEX 3 TIME SYSTEM CORR).
+    let week: u32 = gput
+        .split_whitespace()
+        .nth(4)
+        .and_then(|w| w.parse().ok())
+        .unwrap_or_else(|| panic!("no week in `{gput}`"));
+    assert_eq!(week, utc.wnt, "`{gput}`");
+}

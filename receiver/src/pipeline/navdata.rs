@@ -64,6 +64,8 @@ pub struct NavDecoder {
     pub iono: Option<KlobucharParams>,
     /// Latest GPS-UTC parameters (weeks resolved).
     pub utc: Option<UtcParams>,
+    /// Latest GPS-UTC parameters as broadcast (8-bit weeks).
+    utc_broadcast: Option<UtcParams>,
     /// Time tag: `ms_count` of a subframe's first code period and that subframe's TOW (s).
     time_tag: Option<(u64, u32)>,
     reference_week: u32,
@@ -89,6 +91,7 @@ impl NavDecoder {
             ephemeris: None,
             iono: None,
             utc: None,
+            utc_broadcast: None,
             time_tag: None,
             reference_week,
             week: None,
@@ -243,7 +246,7 @@ impl NavDecoder {
         match sf.payload {
             SubframePayload::Page18 { iono, utc } => {
                 self.iono = Some(iono);
-                self.utc = Some(utc.resolve_weeks(self.reference_week));
+                self.utc_broadcast = Some(utc);
             }
             _ => {
                 if let Some(eph) = self.assembler.push(&sf) {
@@ -251,6 +254,12 @@ impl NavDecoder {
                     events.push(NavEvent::Ephemeris(Box::new(eph)));
                 }
             }
+        }
+        // The 8-bit WN_t and WN_LSF (IS-GPS-200 20.3.3.5.2.4) resolved against the decoded
+        // 10-bit week once known (page 18 may come before subframe 1): against the reference
+        // week alone, which may be years away, they can land 256 weeks off.
+        if let Some(utc) = self.utc_broadcast {
+            self.utc = Some(utc.resolve_weeks(self.week()));
         }
     }
 }
