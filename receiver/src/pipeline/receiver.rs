@@ -96,14 +96,20 @@ pub struct AssistanceFiles<'a> {
 /// An assistance file that cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum AssistanceError {
-    /// The navigation file.
-    #[error("cannot read the navigation file {path}: {source}")]
+    /// The navigation file cannot be read (the error names the file and line).
+    #[error("cannot read the navigation file: {source}")]
     Nav {
         /// The file.
         path: String,
         /// Why.
         #[source]
         source: gpsrx_nav::rinex_nav::RinexError,
+    },
+    /// The navigation file holds no GPS ephemeris.
+    #[error("the navigation file {path} holds no GPS ephemeris (a header only, or no GPS records): give a broadcast navigation file with ephemeris records (e.g. brdcDDD0.YYn for the day of the recording), or leave out --nav to decode the ephemerides from the signal")]
+    NavWithoutEphemeris {
+        /// The file.
+        path: String,
     },
     /// The INS file.
     #[error(transparent)]
@@ -117,12 +123,19 @@ impl Assistance {
     /// Reads the assistance files (each optional), checking each; the INS span is logged.
     pub fn read(files: &AssistanceFiles<'_>) -> Result<Self, AssistanceError> {
         let nav = match files.nav {
-            Some(p) => Some(gpsrx_nav::rinex_nav::read_rinex_nav(p).map_err(|source| {
-                AssistanceError::Nav {
-                    path: p.display().to_string(),
-                    source,
+            Some(p) => {
+                let path = p.display().to_string();
+                let nav = gpsrx_nav::rinex_nav::read_rinex_nav(p).map_err(|source| {
+                    AssistanceError::Nav {
+                        path: path.clone(),
+                        source,
+                    }
+                })?;
+                if nav.ephemerides.is_empty() {
+                    return Err(AssistanceError::NavWithoutEphemeris { path });
                 }
-            })?),
+                Some(nav)
+            }
             None => None,
         };
         let landmarks = match files.landmarks {

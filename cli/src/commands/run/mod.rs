@@ -87,27 +87,17 @@ fn is_locked(row: &ChannelRow) -> bool {
     row.bit_sync || (row.carrier_lock && row.state == "track")
 }
 
-/// The assistance inputs named on the command line. A navigation file without a single GPS
-/// ephemeris (a header only, or only other systems' records) is an error: it would assist
-/// nothing.
+/// The assistance inputs named on the command line (a navigation file without a single GPS
+/// ephemeris is an error: [`Assistance::read`]).
 fn assistance(args: &RunArgs) -> anyhow::Result<Assistance> {
-    let assistance = Assistance::read(&AssistanceFiles {
+    Ok(Assistance::read(&AssistanceFiles {
         nav: args.nav.as_deref(),
         ins: args.ins.as_deref(),
         ins_max_gap_s: args.ins_max_gap,
         ins_band_limit_rad_s: args.ins_band_limit,
         no_aiding: args.no_aiding,
         landmarks: args.landmarks.as_deref(),
-    })?;
-    if let (Some(nav), Some(path)) = (&assistance.nav, &args.nav) {
-        if nav.ephemerides.is_empty() {
-            anyhow::bail!(
-                "the navigation file {} holds no GPS ephemeris (a header only, or no GPS records): give a broadcast navigation file with ephemeris records (e.g. brdcDDD0.YYn for the day of the recording), or leave out --nav to decode the ephemerides from the signal",
-                path.display()
-            );
-        }
-    }
-    Ok(assistance)
+    })?)
 }
 
 /// Logs what the source had to fix up while reading (NaN values read as 0, trailing bytes
