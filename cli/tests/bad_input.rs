@@ -407,10 +407,12 @@ rate_hz = 1.0
     let (report, _) = run_file(&args, false).unwrap_or_else(|e| panic!("{e:#}"));
     assert_eq!(report.receiver.tracked_prns, vec![26, 31]);
     assert!(
-        !report.dropped_prns.is_empty(),
+        !report.receiver.dropped_prns.is_empty(),
         "the weak search pulled in no noise channel: the test no longer tests anything"
     );
-    assert!(!report.dropped_prns.contains(&26) && !report.dropped_prns.contains(&31));
+    assert!(
+        !report.receiver.dropped_prns.contains(&26) && !report.receiver.dropped_prns.contains(&31)
+    );
     // Every dropped PRN has rows in channels.csv, none with bit sync or lock in tracking.
     let mut rdr =
         csv::Reader::from_path(out.join("channels.csv")).unwrap_or_else(|e| panic!("{e}"));
@@ -432,14 +434,14 @@ rate_hz = 1.0
         let r = r.unwrap_or_else(|e| panic!("{e}"));
         let p: u8 = r[prn].parse().unwrap_or_else(|e| panic!("{e}"));
         seen.insert(p);
-        if report.dropped_prns.contains(&p) {
+        if report.receiver.dropped_prns.contains(&p) {
             assert!(
                 &r[bit] == "0" && !(&r[lock] == "1" && &r[state] == "track"),
                 "{r:?}"
             );
         }
     }
-    for p in &report.dropped_prns {
+    for p in &report.receiver.dropped_prns {
         assert!(seen.contains(p), "G{p:02} has no channel row");
     }
 }

@@ -5,6 +5,9 @@ use gpsrx_receiver::output::Fix;
 use gpsrx_samples::sim::{Scenario, Simulator};
 use std::path::{Path, PathBuf};
 
+/// A static antenna in Busan (the `[receiver]` table of the scenarios below).
+const STATIC_BUSAN: &str = "[receiver]\nkind = \"static\"\nllh_deg = [35.1796, 129.0756, 20.0]";
+
 fn nav_file() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data/brdc0010.22n")
 }
@@ -97,11 +100,7 @@ fn simulate_and_run(label: &str, receiver: &str, duration_s: f64, extra: &[&str]
 #[test]
 fn static_receiver_fixes_within_a_metre() {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let data = simulate(
-        "[receiver]\nkind = \"static\"\nllh_deg = [35.1796, 129.0756, 20.0]",
-        16.0,
-        dir.path(),
-    );
+    let data = simulate(STATIC_BUSAN, 16.0, dir.path());
     let out = dir.path().join("out");
     let fixes = run(
         &data,
@@ -251,11 +250,7 @@ fn outage_of_all_satellites_then_fixes_again() {
 #[test]
 fn a_recording_too_short_for_a_fix_ends_with_a_message_not_an_error() {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let data = simulate(
-        "[receiver]\nkind = \"static\"\nllh_deg = [35.1796, 129.0756, 20.0]",
-        3.0,
-        dir.path(),
-    );
+    let data = simulate(STATIC_BUSAN, 3.0, dir.path());
     let fixes = run(&data, &dir.path().join("out"), &[]);
     assert!(fixes.is_empty());
 }
@@ -266,11 +261,7 @@ fn observables_before_the_first_fix_carry_the_decoded_week() {
     // --week the reference week is today's; the epochs before subframe 1 were labelled with it
     // and must be written with the decoded week 2190, in increasing time.
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let data = simulate(
-        "[receiver]\nkind = \"static\"\nllh_deg = [35.1796, 129.0756, 20.0]",
-        16.0,
-        dir.path(),
-    );
+    let data = simulate(STATIC_BUSAN, 16.0, dir.path());
     let out = dir.path().join("out");
     let fixes = run(&data, &out, &[]);
     assert!(fixes.is_empty(), "{} fixes from 16 s", fixes.len());
@@ -366,11 +357,7 @@ fn the_broadcast_utc_weeks_are_resolved_with_the_decoded_week() {
     // the RINEX header carries the week of the navigation file the simulator encoded (its
     // DELTA-UTC line), not one 256 weeks off.
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let data = simulate(
-        "[receiver]\nkind = \"static\"\nllh_deg = [35.1796, 129.0756, 20.0]",
-        30.0,
-        dir.path(),
-    );
+    let data = simulate(STATIC_BUSAN, 30.0, dir.path());
     let out = dir.path().join("out");
     run(&data, &out, &[]);
     let nav = gpsrx_nav::rinex_nav::read_rinex_nav(&nav_file()).unwrap_or_else(|e| panic!("{e}"));

@@ -108,11 +108,10 @@ impl Sink for TrackSink {
 /// `gpsrx acquire` for the cold start, re-acquisition every second of signal); returns a
 /// summary per satellite and writes every report to `--out`.
 pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
-    let mut config = gpsrx_receiver::ReceiverConfig {
+    let config = gpsrx_receiver::ReceiverConfig {
         tracking: args.loops.channel_config()?,
         ..Default::default()
     };
-    config.run.prns = args.acquisition.prn.clone();
     let src_cfg = args.acquisition.source.to_config()?;
     let mut src = open_interruptible(&src_cfg)?;
     let (acq, targets, _) = search_plan(&args.acquisition)?;
@@ -129,8 +128,7 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
         prns,
         cold_targets: Some(targets),
     };
-    let mut receiver =
-        Receiver::new(&config, src.fs_hz(), Assistance::default())?.with_search(search)?;
+    let mut receiver = Receiver::with_search(&config, src.fs_hz(), Assistance::default(), search)?;
     let writer = match &args.out {
         Some(p) => {
             let f = std::fs::File::create(p)

@@ -13,7 +13,7 @@ use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
 use crate::pipeline::navdata::current_gps_week;
 use crate::pipeline::navigation::NavigationProcessor;
-use crate::pipeline::ring::SampleWindow;
+use crate::pipeline::ring::{block_samples, SampleWindow};
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult};
 use gpsrx_dsp::Prn;
@@ -23,10 +23,6 @@ use gpsrx_samples::{SampleError, SampleSource};
 use gpsrx_tracking::AidingPort;
 use num_complex::Complex32;
 use std::path::Path;
-
-/// Samples processed per block, as a fraction of a second (10 ms). 40 ms blocks measured no
-/// faster on 2 cores, with more memory.
-const BLOCK_S: f64 = 0.01;
 
 /// Seconds of signal between re-acquisition searches.
 const REACQUISITION_INTERVAL_S: f64 = 1.0;
@@ -187,8 +183,11 @@ pub struct RunSummary {
     pub duration_s: f64,
     /// Wall-clock seconds.
     pub wall_s: f64,
-    /// Satellites tracked at some point.
+    /// Satellites tracked at some point (bit sync, or carrier lock in the tracking loops).
     pub tracked_prns: Vec<u8>,
+    /// Satellites that had a channel but were never tracked (pull-in on noise, or a signal
+    /// too weak to hold), ascending.
+    pub dropped_prns: Vec<u8>,
     /// Stream time (s from the first sample) of the first fix.
     pub first_fix_s: Option<f64>,
     /// Number of valid fixes.
@@ -206,7 +205,6 @@ pub struct RunSummary {
 #[derive(Debug)]
 pub struct Receiver {
     fs_hz: f64,
-    channel_config: gpsrx_tracking::ChannelConfig,
     block: usize,
     window: SampleWindow,
     manager: ChannelManager,
@@ -228,9 +226,14 @@ impl Receiver {
         fs_hz: f64,
         assistance: Assistance,
     ) -> Result<Self, ReceiverError> {
-        config.validate()?;
+        Self::with_search(config, fs_hz, assistance, Self::configured_search(config))
+    }
+
+    /// The search [`ReceiverConfig`] describes: its integration and Doppler range, the
+    /// 10 ms x 10 weak-signal fallback, re-acquisition every second.
+    fn configured_search(config: &ReceiverConfig) -> SearchSettings {
         let run = &config.run;
-        let settings = SearchSettings {
+        SearchSettings {
             acq: AcqConfig {
                 coherent_ms: run.acq_coherent_ms,
                 noncoherent: run.acq_noncoherent,
@@ -242,8 +245,20 @@ impl Receiver {
             reacquisition_interval_s: Some(REACQUISITION_INTERVAL_S),
             prns: run.prns.iter().filter_map(|&p| Prn::new(p).ok()).collect(),
             cold_targets: None,
-        };
-        let manager = ChannelManager::new(fs_hz, config.tracking, settings)?;
+        }
+    }
+
+    /// A receiver that searches with `search` instead of the configured search: another
+    /// acquisition engine, an assisted cold start, no weak-signal fallback (`gpsrx track`).
+    pub fn with_search(
+        config: &ReceiverConfig,
+        fs_hz: f64,
+        assistance: Assistance,
+        search: SearchSettings,
+    ) -> Result<Self, ReceiverError> {
+        config.validate()?;
+        let run = &config.run;
+        let manager = ChannelManager::new(fs_hz, config.tracking, search)?;
         // The week that resolves the broadcast 10-bit week: the configured one, else the
         // navigation file's, else today's.
         let reference_week = run
@@ -275,8 +290,7 @@ impl Receiver {
         );
         Ok(Self {
             fs_hz,
-            channel_config: config.tracking,
-            block: ((fs_hz * BLOCK_S).ceil() as usize).max(1),
+            block: block_samples(fs_hz),
             window: SampleWindow::new(),
             manager,
             nav,
@@ -306,14 +320,6 @@ impl Receiver {
             InsFeedForward::new(ins.track, nav.clone(), reference_week, ins.band_limit_rad_s)
                 .allow_unhealthy(run.allow_unhealthy),
         )
-    }
-
-    /// Replaces the configured search (before any sample): another acquisition engine, an
-    /// assisted cold start, no weak-signal search.
-    pub fn with_search(mut self, settings: SearchSettings) -> Result<Self, ReceiverError> {
-        let tracking = self.channel_config;
-        self.manager = ChannelManager::new(self.fs_hz, tracking, settings)?;
-        Ok(self)
     }
 
     /// The sampling rate, Hz.
@@ -425,8 +431,11 @@ impl Receiver {
             }
             let end = self.window.end();
             self.catch_up(end, sink)?;
-            // A last round on the final samples, as at the end of a source.
-            self.step(end, sink)?;
+            // A last round on the samples after the last whole block (a run has done it
+            // already, at the end of its source).
+            if self.processed_to.is_some_and(|done| done < end) {
+                self.step(end, sink)?;
+            }
             sink.finish(&self.nav.end()).map_err(ReceiverError::Sink)?;
             self.finished = true;
         }
@@ -436,6 +445,7 @@ impl Receiver {
             duration_s: samples as f64 / self.fs_hz,
             wall_s: self.started.elapsed().as_secs_f64(),
             tracked_prns: self.nav.tracked_prns(),
+            dropped_prns: self.nav.dropped_prns(),
             first_fix_s: stats.first_fix_s,
             fixes: stats.fixes,
             invalid_fixes: stats.invalid_fixes,

@@ -8,12 +8,9 @@
 //! file length. The whole receiver is [`crate::pipeline::Receiver`].
 
 use crate::pipeline::channel_manager::ChannelManager;
-use crate::pipeline::ring::SampleWindow;
+use crate::pipeline::ring::{block_samples, SampleWindow};
 use gpsrx_samples::{SampleError, SampleSource};
 use gpsrx_tracking::{AidingPort, Channel, ChannelEpoch};
-
-/// Samples read per block, as a fraction of a second (10 ms).
-const BLOCK_S: f64 = 0.01;
 
 /// An external Doppler source for the aiding port.
 pub type AidSource<'a> = &'a dyn AidingPort;
@@ -30,7 +27,7 @@ pub fn track(
     mut on_epoch: impl FnMut(usize, &ChannelEpoch),
 ) -> Result<Vec<Channel>, SampleError> {
     let fs = src.fs_hz();
-    let block = ((fs * BLOCK_S).ceil() as usize).max(1);
+    let block = block_samples(fs);
     let mut manager = ChannelManager::with_channels(fs, channels);
     let mut window = SampleWindow::new();
     loop {

@@ -10,12 +10,11 @@ use crate::commands::source::open_interruptible;
 use crate::exit::Completion;
 use gpsrx_ins_aiding::DrParams;
 use gpsrx_receiver::fusion::gnss::GnssFix;
-use gpsrx_receiver::output::{ChannelRow, FileSink, Fix, FixQuality};
+use gpsrx_receiver::output::{FileSink, Fix, FixQuality};
 use gpsrx_receiver::pipeline::{AssistanceFiles, FixReport, Progress, Sink, SinkError, Tee};
 use gpsrx_receiver::{Assistance, Receiver, RunSummary};
 use gpsrx_samples::SampleSource;
 use indicatif::{ProgressBar, ProgressStyle};
-use std::collections::BTreeSet;
 use std::io::Write;
 
 mod dr_inputs;
@@ -26,40 +25,22 @@ use dr_inputs::{write_fused_outputs, DrInputs};
 /// What `gpsrx run` produced: the receiver's summary and, with `--dr`/`--accel`, the fusion's.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct RunReport {
-    /// The receiver's summary. Its `tracked_prns` are the satellites whose channel reached bit
-    /// sync or carrier lock in the tracking state (a channel that only pulled in on noise is
-    /// not a tracked satellite): see [`RunReport::dropped_prns`] for the others.
+    /// The receiver's summary (tracked and dropped satellites, fixes).
     #[serde(flatten)]
     pub receiver: RunSummary,
-    /// Satellites that were searched for and had a channel, but never reached bit sync or
-    /// carrier lock in tracking (pull-in on noise or a signal too weak), ascending.
-    pub dropped_prns: Vec<u8>,
     /// With `--dr`/`--accel`: rows of `fused.csv` by source (gnss, fused, dr).
     pub fused_rows: Option<[usize; 3]>,
     /// With `--dr`: the calibrated sensor parameters at the end.
     pub dr_params: Option<DrParams>,
 }
 
-/// The command's own sink beside the files: the progress bar, the fixes for DR fusion and the
-/// satellites whose channels locked.
+/// The command's own sink beside the files: the progress bar and the fixes for DR fusion.
 struct CommandSink {
     bar: ProgressBar,
     gnss_fixes: Option<Vec<GnssFix>>,
-    /// PRNs with a channel at all.
-    channel_prns: BTreeSet<u8>,
-    /// PRNs whose channel reached carrier lock in tracking or bit sync at some point.
-    locked_prns: BTreeSet<u8>,
 }
 
 impl Sink for CommandSink {
-    fn channel(&mut self, row: &ChannelRow) -> Result<(), SinkError> {
-        self.channel_prns.insert(row.prn);
-        if is_locked(row) {
-            self.locked_prns.insert(row.prn);
-        }
-        Ok(())
-    }
-
     fn fix(&mut self, report: &FixReport) -> Result<(), SinkError> {
         // Only valid fixes update the DR filters (a flagged solution steers nothing).
         if let (Some(f), true) = (&mut self.gnss_fixes, report.fix.quality != FixQuality::None) {
@@ -76,15 +57,6 @@ impl Sink for CommandSink {
         ));
         Ok(())
     }
-}
-
-/// Whether a channel row shows a satellite really tracked: bit sync, or carrier lock after the
-/// hand-over from pull-in to the tracking loops (state `track`). A lock indicator that flickers
-/// on during pull-in alone is what a channel on noise shows (on a simulated recording of two
-/// satellites the 10 ms search pulled in a third PRN that declared carrier lock in 2 of its 22
-/// rows, all in pull-in).
-fn is_locked(row: &ChannelRow) -> bool {
-    row.bit_sync || (row.carrier_lock && row.state == "track")
 }
 
 /// The assistance inputs named on the command line (a navigation file without a single GPS
@@ -130,25 +102,14 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunRepor
     let extra = CommandSink {
         bar: bar.clone(),
         gnss_fixes: dr_inputs.as_ref().map(|_| Vec::new()),
-        channel_prns: BTreeSet::new(),
-        locked_prns: BTreeSet::new(),
     };
     let mut sink = Tee(files, extra);
     let run = receiver.run(src.as_mut(), &mut sink);
     bar.finish_and_clear();
     warn_source(src.as_ref());
-    let mut summary = run?;
+    let summary = run?;
     let Tee(files, extra) = sink;
-    // Tracked: the satellites whose channel locked; the rest were searched and dropped.
-    let searched: BTreeSet<u8> = extra
-        .channel_prns
-        .iter()
-        .chain(&summary.tracked_prns)
-        .copied()
-        .collect();
-    summary.tracked_prns = extra.locked_prns.iter().copied().collect();
     let mut report = RunReport {
-        dropped_prns: searched.difference(&extra.locked_prns).copied().collect(),
         receiver: summary,
         ..RunReport::default()
     };
@@ -185,11 +146,11 @@ fn print_report(out: &mut dyn Write, report: &RunReport, args: &RunArgs) -> std:
         s.duration_s / s.wall_s.max(1e-9)
     )?;
     writeln!(out, "satellites tracked: {:?}", s.tracked_prns)?;
-    if !report.dropped_prns.is_empty() {
+    if !report.receiver.dropped_prns.is_empty() {
         writeln!(
             out,
             "searched and dropped (never locked): {:?}",
-            report.dropped_prns
+            report.receiver.dropped_prns
         )?;
     }
     match (s.first_fix_s, s.mean_llh) {
