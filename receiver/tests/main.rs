@@ -1,4 +1,5 @@
 //! Integration tests of the receiver library: the pipeline driven in memory against the
 //! simulator's truth (one test binary for the crate).
 
+mod faults;
 mod pipeline;

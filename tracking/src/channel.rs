@@ -406,6 +406,11 @@ impl Channel {
         self.cn0_dbhz
     }
 
+    /// The carrier NCO frequency (the Doppler the channel holds), Hz.
+    pub fn doppler_hz(&self) -> f64 {
+        self.carrier_freq_hz
+    }
+
     /// Sets the external Doppler estimate valid at receive time `t_s` (the aiding port), fed
     /// forward from the next integration interval on: the NCO gets its mean over that interval,
     /// extrapolated with its rate. `None` removes the aid. Switching the aid on or off keeps the
@@ -444,6 +449,19 @@ impl Channel {
         self.carrier.reset_history();
         self.bit_sync.reset();
         self.bit_sync_origin_ms = self.ms_count;
+    }
+
+    /// Forgets the data-bit edges (after samples were lost, the bits no longer fall where they
+    /// did): the bit synchroniser starts again on the coming prompts; the loops keep running.
+    /// Only a channel integrating 1 ms: longer integrations are aligned to the bit edges and
+    /// would stop until new ones are found.
+    pub fn restart_bit_sync(&mut self) {
+        if (self.carrier.t_coh_s() * 1e3).round() as usize != 1 {
+            return;
+        }
+        self.bit_sync.reset();
+        self.bit_sync_origin_ms = self.ms_count;
+        self.pending_bit = None;
     }
 
     fn advance(&mut self, n: usize) {

@@ -9,6 +9,11 @@
 //!   in the latest samples; a PRN that has been tracked (and lost) at every interval, one never
 //!   found less and less often (1, 2, 4, then every 8 intervals), since most of the 32 are
 //!   below the horizon.
+//! - Hot re-acquisition: a satellite whose channel lost the signal in the last
+//!   [`HOT_FOR_S`] s is also searched every [`HOT_INTERVAL_S`] s between those searches, in a
+//!   narrow Doppler window around its last Doppler, so that it is found again within a
+//!   fraction of a second of the signal's return (after a blockage or a dropout); its SV time
+//!   is carried over by the navigation processor, so fixes resume at its first bit edge.
 //! - Work: every channel processes the code periods the sample window holds, in parallel
 //!   (rayon), concurrently with a due search (rayon `join`), so a search never stalls tracking.
 
@@ -31,6 +36,16 @@ const WEAK_SEARCH_BELOW: usize = 4;
 /// Longest wait between two searches of a PRN that was never found, in search intervals:
 /// a PRN searched and not found waits 1, 2, 4, then 8 intervals before the next search.
 const MAX_BACKOFF_INTERVALS: u32 = 8;
+
+/// How long after a loss a satellite is searched in the narrow hot window, s.
+const HOT_FOR_S: f64 = 60.0;
+/// Seconds of signal between two hot searches.
+const HOT_INTERVAL_S: f64 = 0.2;
+/// Half width of the hot Doppler window: this much, Hz, plus [`HOT_DOPPLER_RATE_HZ_S`] per
+/// second since the loss (the full search at every interval covers faster changes).
+const HOT_DOPPLER_HZ: f64 = 250.0;
+/// See [`HOT_DOPPLER_HZ`], Hz/s.
+const HOT_DOPPLER_RATE_HZ_S: f64 = 25.0;
 
 /// How the manager searches.
 #[derive(Debug, Clone)]
@@ -349,10 +364,9 @@ impl ChannelManager {
             .filter(|c| c.state() != ChannelState::Lost);
         let oldest = live.map(|c| c.next_span().0).min().unwrap_or(end);
         let keep = self.search_samples() as u64;
-        let search_from = self
-            .schedule
-            .as_ref()
-            .map_or(u64::MAX, |s| s.next_tick.saturating_sub(keep));
+        let search_from = self.schedule.as_ref().map_or(u64::MAX, |s| {
+            s.next_tick.min(s.next_hot_tick).saturating_sub(keep)
+        });
         oldest.min(search_from)
     }
 
@@ -364,6 +378,17 @@ impl ChannelManager {
                 .channels
                 .iter()
                 .all(|c| c.state() == ChannelState::Lost)
+    }
+
+    /// Every live channel forgets its data-bit edges ([`Channel::restart_bit_sync`]).
+    pub fn restart_bit_sync(&mut self) {
+        for c in self
+            .channels
+            .iter_mut()
+            .filter(|c| c.state() != ChannelState::Lost)
+        {
+            c.restart_bit_sync();
+        }
     }
 
     /// The channels, in the order they were started.
@@ -414,6 +439,10 @@ struct SearchSchedule {
     next_tick: u64,
     /// Samples between ticks.
     interval: u64,
+    /// Sample index of the next hot search tick, and the samples between them.
+    next_hot_tick: u64,
+    hot_interval: u64,
+    fs_hz: f64,
     /// Per PRN (index 0 = PRN 1): sample index before which it is not searched again.
     not_before: [u64; 32],
     /// Per PRN: the current wait after a fruitless search, in intervals.
@@ -425,9 +454,13 @@ struct SearchSchedule {
 impl SearchSchedule {
     fn new(interval_s: f64, channels: &[Channel], fs: f64) -> Self {
         let interval = ((interval_s * fs) as u64).max(1);
+        let hot_interval = ((HOT_INTERVAL_S * fs) as u64).max(1);
         let mut s = Self {
             next_tick: interval,
             interval,
+            next_hot_tick: hot_interval,
+            hot_interval,
+            fs_hz: fs,
             not_before: [0; 32],
             backoff: [1; 32],
             tracked: [false; 32],
@@ -438,8 +471,9 @@ impl SearchSchedule {
         s
     }
 
-    /// The first sample and the targets of the search due in this block, if one is: the wanted
-    /// PRNs without a live channel whose back-off has run out.
+    /// The first sample and the targets of the search due in this block, if one is: at a
+    /// tick, the wanted PRNs without a live channel whose back-off has run out (full Doppler
+    /// range); between ticks, at a hot tick, the recently lost ones in their hot window.
     fn due(
         &mut self,
         prns: &[Prn],
@@ -448,26 +482,53 @@ impl SearchSchedule {
         channels: &[Channel],
     ) -> Option<DueSearch> {
         let now = window.end();
-        if now < self.next_tick || now - window.start() < keep as u64 {
+        let full = now >= self.next_tick;
+        let hot = now >= self.next_hot_tick;
+        if !(full || hot) || now - window.start() < keep as u64 {
             return None;
         }
-        self.next_tick = now + self.interval;
+        self.next_hot_tick = now + self.hot_interval;
+        if full {
+            self.next_tick = now + self.interval;
+        }
         let live = |p: Prn| {
             channels
                 .iter()
                 .any(|c| c.prn() == p && c.state() != ChannelState::Lost)
         };
         let targets: Vec<SearchTarget> = wanted_prns(prns)
-            .filter(|&p| !live(p) && (self.tracked[p.index()] || now >= self.not_before[p.index()]))
-            .map(SearchTarget::full)
+            .filter(|&p| !live(p))
+            .filter_map(|p| {
+                if full {
+                    (self.tracked[p.index()] || now >= self.not_before[p.index()])
+                        .then(|| SearchTarget::full(p))
+                } else {
+                    self.hot_target(p, now, channels)
+                }
+            })
             .collect();
         tracing::debug!(
-            "re-acquisition at sample {now}: {} PRN(s) searched",
+            "{} search at sample {now}: {} PRN(s)",
+            if full { "re-acquisition" } else { "hot" },
             targets.len()
         );
         (!targets.is_empty()).then(|| DueSearch {
             first: now - keep as u64,
             targets,
+        })
+    }
+
+    /// The narrow search of `p` at sample `now` if its latest channel lost the signal less
+    /// than [`HOT_FOR_S`] ago: around that channel's last Doppler.
+    fn hot_target(&self, p: Prn, now: u64, channels: &[Channel]) -> Option<SearchTarget> {
+        let last = channels.iter().rev().find(|c| c.prn() == p)?;
+        let since_s = now.saturating_sub(last.next_span().0) as f64 / self.fs_hz;
+        (since_s < HOT_FOR_S).then(|| {
+            SearchTarget::around(
+                p,
+                last.doppler_hz(),
+                HOT_DOPPLER_HZ + HOT_DOPPLER_RATE_HZ_S * since_s,
+            )
         })
     }
 

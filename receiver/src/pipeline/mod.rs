@@ -8,11 +8,13 @@
 //! - [`aiding`]: the INS-velocity Doppler feed-forward for the channels' aiding port;
 //! - [`ring`]: the window of recent samples addressed by absolute index;
 //! - [`navdata`]: frame sync, subframes, ephemerides and SV time per satellite;
+//! - [`discontinuity`]: lost samples found by a carrier-phase jump common to the satellites;
 //! - [`observables`]: pseudoranges, carrier phase, Doppler at common receiver epochs;
 //! - [`tracker`]: channels alone over a stream (loop studies).
 
 pub mod aiding;
 pub mod channel_manager;
+pub mod discontinuity;
 pub mod navdata;
 pub mod navigation;
 pub mod observables;

@@ -43,6 +43,18 @@ pub enum NavEvent {
     Ephemeris(Box<Ephemeris>),
     /// A subframe failed parity.
     ParityFailure,
+    /// A subframe's HOW disagrees with the SV time kept (a carried-over time, or the time of
+    /// the previous subframes): the bit stream or the time is wrong (a gap in the samples?).
+    /// The HOW's time is taken.
+    TowMismatch {
+        /// HOW time minus the time kept, ms.
+        error_ms: f64,
+    },
+    /// The channel's data-bit edges disagree with a carried-over SV time (which is dropped).
+    BitEdgeMismatch {
+        /// SV time at the channel's bit edge modulo 20 ms, folded into [-10, 10), ms.
+        offset_ms: f64,
+    },
 }
 
 /// The navigation-message decoder of one satellite.
@@ -66,8 +78,13 @@ pub struct NavDecoder {
     pub utc: Option<UtcParams>,
     /// Latest GPS-UTC parameters as broadcast (8-bit weeks).
     utc_broadcast: Option<UtcParams>,
-    /// Time tag: `ms_count` of a subframe's first code period and that subframe's TOW (s).
-    time_tag: Option<(u64, u32)>,
+    /// Time tag: `ms_count` of a code period and the SV time (TOW, s) at its start: a
+    /// subframe's first period and its HOW time, or a carried-over time
+    /// ([`NavDecoder::carry_time`]).
+    time_tag: Option<(u64, f64)>,
+    /// The time tag was carried over (not read from a HOW), so the subframe boundaries are
+    /// found from it rather than from a preamble.
+    carried: bool,
     reference_week: u32,
     /// Full transmission week from subframe 1 (10-bit week resolved with the reference week).
     week: Option<u32>,
@@ -93,6 +110,7 @@ impl NavDecoder {
             utc: None,
             utc_broadcast: None,
             time_tag: None,
+            carried: false,
             reference_week,
             week: None,
             subframes_ok: 0,
@@ -127,7 +145,49 @@ impl NavDecoder {
         self.next_subframe = None;
         self.candidate = None;
         self.time_tag = None;
+        self.carried = false;
         self.consecutive_failures = 0;
+    }
+
+    /// Takes an SV time known from elsewhere (carried over an outage by the navigation
+    /// processor): the code period `ms_count` started at SV time `sv_tow_s` (a whole 20 ms, a
+    /// data-bit edge). The bit stream restarts; subframes are decoded from the next 6 s
+    /// boundary of that time on, and the first HOW confirms it ([`NavEvent::TowMismatch`]
+    /// otherwise). Every bit must start on a 20 ms boundary of this time, else it is dropped
+    /// ([`NavEvent::BitEdgeMismatch`]).
+    pub fn carry_time(&mut self, ms_count: u64, sv_tow_s: f64) {
+        self.reset_sync();
+        self.time_tag = Some((ms_count, sv_tow_s));
+        self.carried = true;
+    }
+
+    /// Whether the SV time is a carried-over one not yet confirmed by a HOW.
+    pub fn time_carried(&self) -> bool {
+        self.carried
+    }
+
+    /// With a carried-over time and no subframe position yet: checks that the bit `ms` starts
+    /// on a 20 ms boundary of SV time and starts the subframe at a 6 s boundary.
+    fn align_from_time(&mut self, ms: u64, events: &mut Vec<NavEvent>) {
+        let Some(sv) = self.sv_tow_s(ms, 0.0) else {
+            return;
+        };
+        let sv_ms = sv * 1e3;
+        let off = sv_ms - (sv_ms / 20.0).round() * 20.0;
+        if off.abs() > 0.5 {
+            events.push(NavEvent::BitEdgeMismatch { offset_ms: off });
+            self.reset_sync();
+            return;
+        }
+        let in_subframe = sv_ms.rem_euclid(6000.0);
+        if !(0.5..=6000.0 - 0.5).contains(&in_subframe) {
+            // This bit opens a subframe: keep it alone.
+            let last = self.bits.len().saturating_sub(1);
+            self.bits.drain(..last);
+            self.next_subframe = Some(0);
+        } else if self.bits.len() > SUBFRAME_BITS {
+            self.bits.pop_front();
+        }
     }
 
     /// SV transmit time (TOW, s; may exceed a week's end by a fraction, which the caller's
@@ -135,7 +195,7 @@ impl NavDecoder {
     pub fn sv_tow_s(&self, ms_count: u64, code_phase_chips: f64) -> Option<f64> {
         let (m0, tow0) = self.time_tag?;
         let dm = ms_count as f64 - m0 as f64;
-        Some(f64::from(tow0) + dm * 1e-3 + code_phase_chips / CA_CHIP_RATE_HZ)
+        Some(tow0 + dm * 1e-3 + code_phase_chips / CA_CHIP_RATE_HZ)
     }
 
     /// Feeds one bit (+1/-1 as decided by the channel) whose first code period is `ms`.
@@ -144,10 +204,19 @@ impl NavDecoder {
         if let Some(&(_, last_ms)) = self.bits.back() {
             if ms != last_ms + 20 {
                 // A gap in the bit stream: the positions no longer line up.
-                self.reset_sync();
+                if self.carried {
+                    self.bits.clear();
+                    self.next_subframe = None;
+                } else {
+                    self.reset_sync();
+                }
             }
         }
         self.bits.push_back((u8::from(value < 0), ms));
+        if self.carried && self.next_subframe.is_none() {
+            self.align_from_time(ms, &mut events);
+            return events;
+        }
         match self.next_subframe {
             Some(start) => {
                 if self.bits.len() >= start + SUBFRAME_BITS {
@@ -232,7 +301,18 @@ impl NavDecoder {
         self.subframes_ok += 1;
         self.consecutive_failures = 0;
         let tow_s = sf.how.subframe_start_tow_s();
-        self.time_tag = Some((first_ms, tow_s));
+        if let Some(kept) = self.sv_tow_s(first_ms, 0.0) {
+            // The HOW against the time kept (week roll-over folded).
+            let mut err = f64::from(tow_s) - kept;
+            err -= (err / 604_800.0).round() * 604_800.0;
+            if err.abs() > 1e-4 {
+                events.push(NavEvent::TowMismatch {
+                    error_ms: err * 1e3,
+                });
+            }
+        }
+        self.time_tag = Some((first_ms, f64::from(tow_s)));
+        self.carried = false;
         events.push(NavEvent::Subframe {
             id: sf.how.subframe_id,
             tow_s,

@@ -10,6 +10,7 @@ use crate::config::{IonoModel, RunSettings, TropoModel};
 use crate::landmarks::LandmarkObservation;
 use crate::output::{ChannelRow, Fix, FixQuality, ObsEpoch, SatObs, SatView};
 use crate::pipeline::aiding::InsFeedForward;
+use crate::pipeline::discontinuity::{Discontinuity, DiscontinuityMonitor};
 use crate::pipeline::navdata::{NavDecoder, NavEvent};
 use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
 use crate::pipeline::sink::{
@@ -87,6 +88,73 @@ pub struct NavigationProcessor {
     searched: BTreeSet<u8>,
     /// PRNs whose channel reached bit sync or carrier lock in tracking.
     locked: BTreeSet<u8>,
+    /// Per PRN: its SV time, kept over a loss of the signal (see [`SvClock`]).
+    sv_clocks: BTreeMap<u8, SvClock>,
+    /// Watches for lost samples.
+    monitor: DiscontinuityMonitor,
+    /// A gap being recovered from: its stream time (s), and the clock bias (m) and drift (m/s)
+    /// of the last fix before it with that fix's stream time (s).
+    gap: Option<GapRecovery>,
+    /// The last valid fix: stream time (s), clock bias after any clock step (m), clock drift
+    /// (m/s).
+    last_clock: Option<(f64, f64, f64)>,
+    /// Carried SV times refused at the new bit edge: `(stream time s, PRN, offset ms)`.
+    refused: Vec<(f64, u8, f64)>,
+    /// Consecutive solutions that failed the integrity test.
+    failed_in_row: u32,
+    /// A valid fix came since the receiver time was last forgotten.
+    time_trusted: bool,
+}
+
+/// What is kept over a sample gap to measure it once the time is re-established.
+#[derive(Debug, Clone, Copy)]
+struct GapRecovery {
+    t_s: f64,
+    before: Option<(f64, f64, f64)>,
+}
+
+impl GapRecovery {
+    /// The gap's length (ms) from the clock bias `bias_m` of the first fix after it, at stream
+    /// time `t_s`: the receiver counts samples, so lost samples make its time run late by the
+    /// gap and the clock bias (receiver minus GPS time) drops by `c g` from its prediction
+    /// `b0 + d (t - t0)`.
+    fn length_ms(&self, t_s: f64, bias_m: f64) -> Option<f64> {
+        let (t0, b0, d) = self.before?;
+        let predicted = b0 + d * (t_s - t0);
+        Some(-(bias_m - predicted) / SPEED_OF_LIGHT_MPS * 1e3)
+    }
+}
+
+/// The longest outage an SV time is carried over, s. The carried time is a prediction with
+/// the code rate at the loss; it must be right to well within 10 ms (half a data bit), which
+/// holds for minutes (a Doppler change of 1 Hz/s costs 0.3 us over 30 s; a receiver moving
+/// 300 m/s off the prediction costs 1 us per second).
+const SV_CLOCK_CARRY_S: f64 = 120.0;
+
+/// Solutions failing the integrity test in a row, after a valid one, that make the receiver
+/// time suspect.
+const FAILURES_TO_DISTRUST_TIME: u32 = 5;
+
+/// A satellite's SV time at a sample, with its rate: where the code of the last usable report
+/// stood. After the channel has lost the signal, the SV time of a new channel's bit edge is
+/// predicted from it, `sv(k) = sv_ref + (k - k_ref) / fs * r / 1.023 MHz` for the code rate `r`,
+/// and rounded to the 20 ms data bit (the bit edge the channel found): the satellite's time is
+/// known again as soon as its new channel has bit sync, without waiting 6-12 s for frame sync.
+#[derive(Debug, Clone, Copy)]
+struct SvClock {
+    /// Sample index of the reference point.
+    sample: u64,
+    /// SV time at it (TOW, s).
+    sv_tow_s: f64,
+    /// SV seconds per receiver second (code rate / 1.023 MHz).
+    rate: f64,
+}
+
+impl SvClock {
+    /// The predicted SV time at sample `k` for samples at `fs_hz`.
+    fn at(&self, k: u64, fs_hz: f64) -> f64 {
+        self.sv_tow_s + (k as f64 - self.sample as f64) / fs_hz * self.rate
+    }
 }
 
 impl NavigationProcessor {
@@ -119,7 +187,37 @@ impl NavigationProcessor {
             cn0_lost_dbhz,
             searched: BTreeSet::new(),
             locked: BTreeSet::new(),
+            sv_clocks: BTreeMap::new(),
+            monitor: DiscontinuityMonitor::new(fs_hz),
+            gap: None,
+            last_clock: None,
+            refused: Vec::new(),
+            failed_in_row: 0,
+            time_trusted: false,
         }
+    }
+
+    /// After every channel has reported up to sample `end`: looks for lost samples. On a
+    /// discontinuity the SV times are dropped (every decoder must find frame sync again, the
+    /// HOW gives the time), carrier smoothing restarts, and no fix is made until then; returns
+    /// it so that the channels can find their bit edges again.
+    pub fn end_block(
+        &mut self,
+        end: u64,
+        sink: &mut dyn Sink,
+    ) -> Result<Option<Discontinuity>, SinkError> {
+        let Some(d) = self.monitor.evaluate(end) else {
+            return Ok(None);
+        };
+        let t_s = d.sample as f64 / self.fs_hz;
+        tracing::warn!(
+            "{t_s:.3} s: samples lost (the carrier phase of {} of {} satellites jumped at once): no fix until the receiver time is re-established from the satellites' time of week",
+            d.jumped,
+            d.watched
+        );
+        self.forget_time(t_s);
+        sink.event(&ReceiverEvent::SampleGap { t_s })?;
+        Ok(Some(d))
     }
 
     /// The fixes so far, summarised.
@@ -165,12 +263,16 @@ impl NavigationProcessor {
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
         sink.channel_epoch(channel, e)?;
+        self.monitor.push(e);
         self.searched.insert(e.prn);
         let locked = e.bit.is_some() || (e.pll_lock && e.state == ChannelState::Track);
         if locked && e.cn0_dbhz >= self.cn0_lost_dbhz {
             self.locked.insert(e.prn);
         }
         self.decode(e, aiding, sink)?;
+        if let Some(off_ms) = self.track_sv_clock(e) {
+            self.on_refused(e.t_rx_s, e.prn, off_ms, sink)?;
+        }
         self.channel_row(channel, e, sink)?;
         let ready = match self.decoders.get(&e.prn) {
             Some(d) => self.builder.push(e, d),
@@ -232,6 +334,19 @@ impl NavigationProcessor {
                             iode: eph.iode,
                         })?;
                     }
+                    NavEvent::TowMismatch { error_ms } => {
+                        tracing::warn!(
+                            "G{:02}: the HOW time differs from the SV time kept by {error_ms:.3} ms (a gap in the samples?): the HOW's time is taken",
+                            e.prn
+                        );
+                    }
+                    NavEvent::BitEdgeMismatch { offset_ms } => {
+                        tracing::info!(
+                            "G{:02}: the bit edges found disagree with the SV time carried over the outage by {offset_ms:.3} ms (samples lost?): waiting for frame sync",
+                            e.prn
+                        );
+                        self.sv_clocks.remove(&e.prn);
+                    }
                     _ => {}
                 }
             }
@@ -244,6 +359,133 @@ impl NavigationProcessor {
             })?;
         }
         Ok(())
+    }
+
+    /// After lost samples: every SV time is dropped (the decoders find frame sync again and the
+    /// HOW gives the time), carrier smoothing restarts, and the clock of the last fix is kept
+    /// to measure the gap once the time is back.
+    fn forget_time(&mut self, t_s: f64) {
+        for dec in self.decoders.values_mut() {
+            dec.reset_sync();
+        }
+        self.sv_clocks.clear();
+        self.builder.restart();
+        self.gap = Some(GapRecovery {
+            t_s,
+            before: self.last_clock,
+        });
+        self.prior = None;
+    }
+
+    /// A carried SV time refused at `t_s` for `prn`, `off_ms` off the bit edge: when
+    /// [`crate::pipeline::discontinuity::MIN_SATELLITES`] satellites are refused within 2 s by
+    /// the same offset (0.1 ms), samples were lost during the outage (that offset plus a
+    /// whole number of 20 ms bits): reported as a gap.
+    fn on_refused(
+        &mut self,
+        t_s: f64,
+        prn: u8,
+        off_ms: f64,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        self.refused.retain(|r| t_s - r.0 < 2.0 && r.1 != prn);
+        self.refused.push((t_s, prn, off_ms));
+        let agreeing = self
+            .refused
+            .iter()
+            .filter(|r| (r.2 - off_ms).abs() < 0.1)
+            .count();
+        if agreeing >= crate::pipeline::discontinuity::MIN_SATELLITES {
+            self.refused.clear();
+            tracing::warn!(
+                "{t_s:.3} s: samples lost during the outage: the SV times carried over it are {:.3} ms (modulo 20 ms) off the new bit edges of {agreeing} satellites; waiting for frame sync",
+                -off_ms
+            );
+            self.forget_time(t_s);
+            sink.event(&ReceiverEvent::SampleGap { t_s })?;
+        }
+        Ok(())
+    }
+
+    /// Solutions keep failing the integrity test while SV times carried over an outage are in
+    /// use: samples may have been lost during the outage by a whole number of data bits, which
+    /// the bit edges cannot show. The carried times are dropped (frame sync gives the time).
+    fn drop_carried_times(&mut self, t_s: f64) {
+        let carried: Vec<u8> = self
+            .decoders
+            .iter()
+            .filter(|(_, d)| d.time_carried())
+            .map(|(p, _)| *p)
+            .collect();
+        if carried.is_empty() {
+            return;
+        }
+        tracing::warn!(
+            "{t_s:.2} s: the solutions fail the integrity test with the SV times carried over the outage (samples lost during it?): those of {} satellites dropped, waiting for frame sync",
+            carried.len()
+        );
+        for p in carried {
+            if let Some(d) = self.decoders.get_mut(&p) {
+                d.reset_sync();
+            }
+            self.sv_clocks.remove(&p);
+        }
+        self.builder.restart();
+        self.failed_in_row = 0;
+        self.gap.get_or_insert(GapRecovery {
+            t_s,
+            before: self.last_clock,
+        });
+    }
+
+    /// Keeps the satellite's SV time from every usable report, and carries it over to a new
+    /// channel of the same satellite after a loss ([`SvClock`]): at the new channel's first
+    /// bit edge in phase lock, the predicted SV time is rounded to the 20 ms bit; a prediction
+    /// more than 1 ms off a bit boundary (samples lost, or a wrong bit edge) is not used.
+    /// Returns the offset (ms) of a refused carried time.
+    fn track_sv_clock(&mut self, e: &ChannelEpoch) -> Option<f64> {
+        let usable =
+            e.pll_lock && e.state != ChannelState::Lost && e.cn0_dbhz >= self.cn0_lost_dbhz;
+        let dec = self.decoders.get_mut(&e.prn)?;
+        if !usable {
+            return None;
+        }
+        if let Some(sv) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) {
+            self.sv_clocks.insert(
+                e.prn,
+                SvClock {
+                    sample: e.sample_index,
+                    sv_tow_s: sv,
+                    rate: e.code_rate_chips_s / gpsrx_dsp::constants::CA_CHIP_RATE_HZ,
+                },
+            );
+            return None;
+        }
+        let clock = self.sv_clocks.get(&e.prn)?;
+        let elapsed_s = (e.sample_index as f64 - clock.sample as f64) / self.fs_hz;
+        if !e.bit_edge || !(0.0..=SV_CLOCK_CARRY_S).contains(&elapsed_s) {
+            return None;
+        }
+        // SV time at the start of the code period that opens this interval (a bit edge).
+        let edge_ms = (clock.at(e.sample_index, self.fs_hz)
+            - e.code_phase_chips / gpsrx_dsp::constants::CA_CHIP_RATE_HZ)
+            * 1e3;
+        let bit_ms = (edge_ms / 20.0).round() * 20.0;
+        let off_ms = edge_ms - bit_ms;
+        if off_ms.abs() > 1.0 {
+            tracing::info!(
+                "G{:02}: the SV time carried over {elapsed_s:.1} s falls {off_ms:+.3} ms off the new bit edge (samples lost?): waiting for frame sync",
+                e.prn
+            );
+            self.sv_clocks.remove(&e.prn);
+            return Some(off_ms);
+        }
+        dec.carry_time(e.ms_count, bit_ms * 1e-3);
+        tracing::info!(
+            "G{:02}: SV time carried over {elapsed_s:.1} s without the signal (bit edge {off_ms:+.3} ms from the prediction)",
+            e.prn
+        );
+        None
     }
 
     /// The channel's row, at most once per fix interval.
@@ -434,6 +676,24 @@ impl NavigationProcessor {
         };
         let t_stream_s = epoch.sample / self.fs_hz;
         self.log_raim(t_stream_s, &sol);
+        self.failed_in_row = if valid { 0 } else { self.failed_in_row + 1 };
+        if self.failed_in_row >= 3 {
+            self.drop_carried_times(t_stream_s);
+        }
+        if self.failed_in_row >= FAILURES_TO_DISTRUST_TIME && self.time_trusted {
+            // Every solution fails after good ones: the receiver time itself may be wrong
+            // (samples lost by whole data bits, which neither the carrier nor the bits show).
+            tracing::warn!(
+                "{t_stream_s:.2} s: {} solutions in a row fail the integrity test: the receiver time may be wrong (samples lost?); re-establishing it from the satellites' time of week",
+                self.failed_in_row
+            );
+            self.time_trusted = false;
+            self.forget_time(t_stream_s);
+            sink.event(&ReceiverEvent::SampleGap { t_s: t_stream_s })?;
+        }
+        if valid {
+            self.time_trusted = true;
+        }
         if !valid {
             // Written for the record, flagged: quality `none` in pvt.csv, GGA quality 0, absent
             // from the GeoJSON and KML tracks; it steers nothing.
@@ -446,14 +706,36 @@ impl NavigationProcessor {
                 t_stream_s,
             });
         }
+        if let Some(gap) = self.gap.take() {
+            let length = gap.length_ms(t_stream_s, sol.clock_bias_m);
+            match length {
+                Some(ms) => tracing::warn!(
+                    "{t_stream_s:.2} s: receiver time re-established; the samples lost at {:.3} s were {ms:.3} ms of signal",
+                    gap.t_s
+                ),
+                None => tracing::warn!(
+                    "{t_stream_s:.2} s: receiver time re-established after the samples lost at {:.3} s",
+                    gap.t_s
+                ),
+            }
+            if let Some(length_ms) = length {
+                sink.event(&ReceiverEvent::GapMeasured {
+                    t_s: gap.t_s,
+                    length_ms,
+                })?;
+            }
+        }
         // Keep the receiver clock within +-0.5 ms of GPS time by whole-millisecond steps.
         let bias_ms = sol.clock_bias_m / SPEED_OF_LIGHT_MPS * 1e3;
+        let mut bias_after_m = sol.clock_bias_m;
         if bias_ms.abs() > 0.5 {
             let step = -bias_ms.round() as i64;
             self.builder.step_clock_ms(step);
+            bias_after_m += step as f64 * 1e-3 * SPEED_OF_LIGHT_MPS;
             tracing::debug!("receiver clock stepped by {step} ms");
             sink.event(&ReceiverEvent::ClockStep { ms: step })?;
         }
+        self.last_clock = Some((t_stream_s, bias_after_m, sol.clock_drift_mps.unwrap_or(0.0)));
         if self.stats.first_fix_s.is_none() {
             tracing::info!(
                 "first fix at {:.2} s: {:.7} {:.7} {:.1} m, {} satellites, PDOP {:.1}",

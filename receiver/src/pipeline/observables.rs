@@ -135,6 +135,17 @@ impl ObservableBuilder {
         }
     }
 
+    /// Restarts every satellite's carrier smoothing and flags a loss of lock (the receiver time
+    /// or the SV times changed: samples were lost), and drops the epochs not yet emitted.
+    pub fn restart(&mut self) {
+        for lost in self.lli.values_mut() {
+            *lost = true;
+        }
+        self.smoothing.clear();
+        self.phase_rate.clear();
+        self.pending.clear();
+    }
+
     /// Takes one channel report (with the decoder of its satellite); returns the epochs that
     /// are complete (no channel can add to them any more).
     pub fn push(&mut self, e: &ChannelEpoch, dec: &NavDecoder) -> Vec<ObservableEpoch> {

@@ -508,6 +508,13 @@ impl Receiver {
         self.manager
             .drain_reports(|i, e| nav.on_report(i, e, aiding, sink))
             .map_err(ReceiverError::Sink)?;
+        if nav
+            .end_block(end, sink)
+            .map_err(ReceiverError::Sink)?
+            .is_some()
+        {
+            self.manager.restart_bit_sync();
+        }
         if let Some(outcome) = found {
             let first = outcome.first();
             let started = self.manager.start_found(outcome);

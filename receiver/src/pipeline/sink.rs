@@ -80,6 +80,21 @@ pub enum ReceiverEvent {
         /// The step, ms.
         ms: i64,
     },
+    /// Samples were lost at this point of the stream (a carrier-phase jump common to the
+    /// satellites): the receiver time is re-established from the satellites, and no fix is
+    /// made until it is.
+    SampleGap {
+        /// Stream time of the gap (as counted by the samples received), s.
+        t_s: f64,
+    },
+    /// The receiver time was re-established after a [`ReceiverEvent::SampleGap`]: the length of
+    /// the gap, from the jump of the receiver clock bias between the fixes before and after.
+    GapMeasured {
+        /// Stream time of the gap, s.
+        t_s: f64,
+        /// Samples lost, as time, ms.
+        length_ms: f64,
+    },
 }
 
 /// Where the processing stands, about five times per second of signal.

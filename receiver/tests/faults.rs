@@ -1,0 +1,393 @@
+//! Faults in the sample stream, made from the simulator's samples: whole and fractional
+//! milliseconds cut out (a front end dropping samples), zeros (an ADC dropout) and blocked
+//! signals (the simulator's outages). Against the simulator's truth: no wrong fix is handed out
+//! as a valid one, the gap is reported with its length, and fixes come back quickly.
+
+use gpsrx_core::frames::Llh;
+use gpsrx_nav::rinex_nav::parse_rinex_nav;
+use gpsrx_receiver::output::FixQuality;
+use gpsrx_receiver::pipeline::{MemorySink, ReceiverEvent};
+use gpsrx_receiver::{Assistance, Receiver, ReceiverConfig};
+use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
+use gpsrx_samples::sim::{Scenario, Simulator};
+use num_complex::Complex32;
+use std::path::Path;
+
+const FS_HZ: f64 = 2.048e6;
+const LLH_DEG: [f64; 3] = [36.3721, 127.3604, 80.0];
+
+/// A static receiver, 2.048 MHz, the built-in broadcast ephemerides, with `outages` (TOML
+/// `[[outages]]` tables) blocking the signals.
+fn simulator(duration_s: f64, outages: &str) -> Simulator {
+    let text = format!(
+        r#"
+duration_s = {duration_s}
+seed = 11
+nav = "builtin:brdc0010.22n"
+[start]
+week = 2190
+tow_s = 538198.0
+[output]
+format = "cf32_le"
+fs_hz = {FS_HZ}
+[receiver]
+kind = "static"
+llh_deg = [{}, {}, {}]
+[clock]
+bias_s = 3.0e-4
+drift_s_s = 4.0e-8
+{outages}
+"#,
+        LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
+    );
+    let sc = Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
+    Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn receiver() -> Receiver {
+    let mut config = ReceiverConfig::default();
+    config.run.tropo = gpsrx_receiver::config::TropoModel::None;
+    config.run.week = Some(2190);
+    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let assistance = Assistance {
+        nav: Some(nav),
+        ..Assistance::default()
+    };
+    Receiver::new(&config, FS_HZ, assistance).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// What happens to the stream.
+#[derive(Debug, Clone, Copy)]
+enum Fault {
+    /// `len_s` of samples removed at `at_s` (simulator time).
+    Cut { at_s: f64, len_s: f64 },
+    /// Samples from `at_s` for `len_s` set to zero.
+    Zeros { at_s: f64, len_s: f64 },
+    /// Nothing (blockages come from the scenario).
+    None,
+}
+
+/// Runs the receiver on the simulator's samples with `fault`.
+fn run(sim: &Simulator, fault: Fault) -> MemorySink {
+    let mut rx = receiver();
+    let mut sink = MemorySink::new();
+    let mut buf = Vec::new();
+    for chunk in 0..sim.chunk_count() {
+        let first = chunk * sim.chunk_samples() as u64;
+        sim.generate_chunk(chunk, &mut buf);
+        let keep: Vec<Complex32> = buf
+            .iter()
+            .enumerate()
+            .filter_map(|(k, s)| {
+                let t = (first + k as u64) as f64 / FS_HZ;
+                match fault {
+                    Fault::Cut { at_s, len_s } if t >= at_s && t < at_s + len_s => None,
+                    Fault::Zeros { at_s, len_s } if t >= at_s && t < at_s + len_s => {
+                        Some(Complex32::new(0.0, 0.0))
+                    }
+                    _ => Some(*s),
+                }
+            })
+            .collect();
+        rx.push(&keep, &mut sink).unwrap_or_else(|e| panic!("{e}"));
+    }
+    rx.finish(&mut sink).unwrap_or_else(|e| panic!("{e}"));
+    sink
+}
+
+/// Horizontal-and-vertical error of every valid fix, with its stream time.
+fn errors(sink: &MemorySink) -> Vec<(f64, f64)> {
+    let truth = Llh::from_degrees(LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]).to_ecef();
+    sink.fixes
+        .iter()
+        .filter(|f| f.fix.quality != FixQuality::None)
+        .map(|f| {
+            let e = f.fix.ecef_m;
+            let d =
+                ((e[0] - truth.x).powi(2) + (e[1] - truth.y).powi(2) + (e[2] - truth.z).powi(2))
+                    .sqrt();
+            (f.t_stream_s, d)
+        })
+        .collect()
+}
+
+/// The 95th percentile of the errors.
+fn p95(errs: &[(f64, f64)]) -> f64 {
+    let mut e: Vec<f64> = errs.iter().map(|x| x.1).collect();
+    e.sort_by(f64::total_cmp);
+    e.get(((e.len() as f64) * 0.95) as usize)
+        .or(e.last())
+        .copied()
+        .unwrap_or(f64::NAN)
+}
+
+fn describe(name: &str, sink: &MemorySink, fault_s: f64) {
+    let errs = errors(sink);
+    let after: Vec<&(f64, f64)> = errs.iter().filter(|(t, _)| *t > fault_s).collect();
+    let worst = after.iter().map(|x| x.1).fold(0.0, f64::max);
+    let resumed = after.first().map(|x| x.0 - fault_s);
+    let events: Vec<String> = sink
+        .events
+        .iter()
+        .filter(|e| !matches!(e, ReceiverEvent::Acquired { .. }))
+        .map(|e| format!("{e:?}"))
+        .collect();
+    let invalid = sink
+        .fixes
+        .iter()
+        .filter(|f| f.fix.quality == FixQuality::None && f.t_stream_s > fault_s)
+        .count();
+    eprintln!("{name}: {invalid} invalid after");
+    eprintln!(
+        "{name}: {} fixes, p95 {:.2} m, after the fault: {} fixes, worst {worst:.1} m, first after {resumed:?} s\n  events: {}",
+        errs.len(),
+        p95(&errs),
+        after.len(),
+        events.join("; ")
+    );
+}
+
+/// The 95th-percentile error of the clean run of the [`DURATION_S`] scenario, m.
+fn clean_p95() -> f64 {
+    static P95: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+    *P95.get_or_init(|| p95(&errors(&run(&simulator(DURATION_S, ""), Fault::None))))
+}
+
+/// The scenario's length and the time of the faults, s (fixes come from about 8 s on; frame
+/// sync after a gap takes up to two subframes, 12 s).
+const DURATION_S: f64 = 32.0;
+const FAULT_AT_S: f64 = 16.0;
+
+/// Asserts that no valid fix is off by more than three times the clean run's 95 % error.
+fn assert_no_wrong_fix(name: &str, sink: &MemorySink) {
+    let bound = 3.0 * clean_p95();
+    let wrong: Vec<(f64, f64)> = errors(sink).into_iter().filter(|e| e.1 > bound).collect();
+    assert!(
+        wrong.is_empty(),
+        "{name}: valid fixes off by more than {bound:.1} m: {wrong:?}"
+    );
+}
+
+/// Stream times of the reported sample gaps.
+fn gaps(sink: &MemorySink) -> Vec<f64> {
+    sink.events
+        .iter()
+        .filter_map(|e| match e {
+            ReceiverEvent::SampleGap { t_s } => Some(*t_s),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn whole_millisecond_gaps_are_reported_measured_and_give_no_wrong_fix() {
+    let sim = simulator(DURATION_S, "");
+    for ms in [1.0, 20.0, 31.0] {
+        let name = format!("{ms} ms cut");
+        let sink = run(
+            &sim,
+            Fault::Cut {
+                at_s: FAULT_AT_S,
+                len_s: ms * 1e-3,
+            },
+        );
+        assert_no_wrong_fix(&name, &sink);
+        let g = gaps(&sink);
+        assert!(
+            g.len() == 1 && (g[0] - FAULT_AT_S).abs() < 0.05,
+            "{name}: gaps reported at {g:?} s"
+        );
+        // The time comes back with frame sync, and the gap is measured from the clock bias.
+        let measured: Vec<f64> = sink
+            .events
+            .iter()
+            .filter_map(|e| match e {
+                ReceiverEvent::GapMeasured { length_ms, .. } => Some(*length_ms),
+                _ => None,
+            })
+            .collect();
+        assert!(
+            measured.len() == 1 && (measured[0] - ms).abs() < 0.05,
+            "{name}: measured {measured:?} ms"
+        );
+        let back = errors(&sink).iter().find(|e| e.0 > FAULT_AT_S).map(|e| e.0);
+        assert!(
+            back.is_some_and(|t| t < FAULT_AT_S + 13.0),
+            "{name}: fixes back at {back:?} s"
+        );
+    }
+}
+
+#[test]
+fn a_fractional_millisecond_gap_and_a_half_second_gap_give_no_wrong_fix() {
+    let sim = simulator(DURATION_S, "");
+    for len_s in [1.25e-3, 0.5] {
+        let name = format!("{len_s} s cut");
+        let sink = run(
+            &sim,
+            Fault::Cut {
+                at_s: FAULT_AT_S,
+                len_s,
+            },
+        );
+        assert_no_wrong_fix(&name, &sink);
+        let g = gaps(&sink);
+        assert!(
+            !g.is_empty() && g[0] >= FAULT_AT_S - 0.01 && g[0] < FAULT_AT_S + 3.0,
+            "{name}: gaps reported at {g:?} s"
+        );
+    }
+}
+
+/// The first valid fix after `t_s`, s after it.
+fn back_after(sink: &MemorySink, t_s: f64) -> Option<f64> {
+    errors(sink).iter().find(|e| e.0 > t_s).map(|e| e.0 - t_s)
+}
+
+#[test]
+fn outages_of_two_seconds_end_in_fixes_within_a_second() {
+    // Zeros from the ADC, and every signal blocked (noise only), both for 2 s.
+    let zeros = run(
+        &simulator(22.0, ""),
+        Fault::Zeros {
+            at_s: FAULT_AT_S,
+            len_s: 2.0,
+        },
+    );
+    let blocked = run(
+        &simulator(22.0, "[[outages]]\nstart_s = 16.0\nend_s = 18.0\n"),
+        Fault::None,
+    );
+    for (name, sink) in [("zeros", &zeros), ("blockage", &blocked)] {
+        assert_no_wrong_fix(name, sink);
+        let during: Vec<f64> = errors(sink)
+            .iter()
+            .map(|e| e.0)
+            .filter(|t| (FAULT_AT_S + 0.1..FAULT_AT_S + 2.0).contains(t))
+            .collect();
+        assert!(
+            during.is_empty(),
+            "{name}: fixes during the outage at {during:?}"
+        );
+        let back = back_after(sink, FAULT_AT_S + 2.0);
+        assert!(
+            back.is_some_and(|b| b <= 1.0),
+            "{name}: fixes back {back:?} s after the outage"
+        );
+        assert!(
+            gaps(sink).is_empty(),
+            "{name}: an outage is not a gap: {:?}",
+            gaps(sink)
+        );
+    }
+}
+
+#[test]
+fn a_thirty_second_blockage_ends_in_fixes_within_two_seconds() {
+    let sink = run(
+        &simulator(46.0, "[[outages]]\nstart_s = 12.0\nend_s = 42.0\n"),
+        Fault::None,
+    );
+    assert_no_wrong_fix("30 s blockage", &sink);
+    let back = back_after(&sink, 42.0);
+    assert!(
+        back.is_some_and(|b| b <= 2.0),
+        "fixes back {back:?} s after the blockage"
+    );
+}
+
+#[test]
+#[ignore]
+fn measure_faults() {
+    let sim = simulator(26.0, "");
+    let at = 16.0;
+    describe("clean", &run(&sim, Fault::None), at);
+    let only = std::env::var("GPSRX_ONLY").ok();
+    for (name, f) in [
+        (
+            "cut 1 ms",
+            Fault::Cut {
+                at_s: at,
+                len_s: 1e-3,
+            },
+        ),
+        (
+            "cut 1.25 ms",
+            Fault::Cut {
+                at_s: at,
+                len_s: 1.25e-3,
+            },
+        ),
+        (
+            "cut 20 ms",
+            Fault::Cut {
+                at_s: at,
+                len_s: 20e-3,
+            },
+        ),
+        (
+            "cut 31 ms",
+            Fault::Cut {
+                at_s: at,
+                len_s: 31e-3,
+            },
+        ),
+        (
+            "cut 0.5 s",
+            Fault::Cut {
+                at_s: at,
+                len_s: 0.5,
+            },
+        ),
+        (
+            "zeros 2 s",
+            Fault::Zeros {
+                at_s: at,
+                len_s: 2.0,
+            },
+        ),
+    ] {
+        if only.as_deref().is_some_and(|o| o != name) {
+            continue;
+        }
+        describe(name, &run(&sim, f), at);
+    }
+    let blocked = simulator(26.0, "[[outages]]\nstart_s = 16.0\nend_s = 18.0\n");
+    describe("blocked 2 s", &run(&blocked, Fault::None), at);
+}
+
+#[test]
+#[ignore]
+fn measure_series() {
+    let sim = simulator(26.0, "");
+    let s = run(
+        &sim,
+        Fault::Zeros {
+            at_s: 16.0,
+            len_s: 2.0,
+        },
+    );
+    for f in &s.fixes {
+        if f.t_stream_s > 17.0 && f.t_stream_s < 22.0 {
+            let truth = Llh::from_degrees(LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]).to_ecef();
+            let e = f.fix.ecef_m;
+            let d =
+                ((e[0] - truth.x).powi(2) + (e[1] - truth.y).powi(2) + (e[2] - truth.z).powi(2))
+                    .sqrt();
+            eprintln!(
+                "{:.1} {:?} n={} {:.1} m bias {:.1} raim {} {:?}",
+                f.t_stream_s,
+                f.fix.quality,
+                f.fix.n_sv,
+                d,
+                f.fix.clock_bias_m,
+                f.fix.raim,
+                f.solution
+                    .residuals_m
+                    .iter()
+                    .map(|(p, r)| format!("{p}:{r:.1}"))
+                    .collect::<Vec<_>>()
+            );
+        }
+    }
+}
