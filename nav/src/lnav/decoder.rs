@@ -237,6 +237,46 @@ pub fn decode_subframe_any_polarity(
     }
 }
 
+/// Decodes the telemetry and hand-over words alone (the first 60 bits of a subframe, of either
+/// polarity, with the standard D29 = D30 = 0 of the previous word 10): both words' parity, the
+/// preamble and a subframe ID of 1-5 must check. The HOW gives the subframe's time 1.2 s into
+/// it, without waiting for the whole subframe (used to re-establish the time).
+pub fn decode_tlm_how(bits: &[u8]) -> Option<(How, Polarity)> {
+    let bits = bits.get(..60)?;
+    if bits.iter().any(|&b| b > 1) {
+        return None;
+    }
+    let polarity = preamble_polarity(bits)?;
+    let (mut d29, mut d30) = match polarity {
+        Polarity::Normal => (false, false),
+        Polarity::Inverted => (true, true),
+    };
+    let mut words = [0u32; 2];
+    for (k, data) in words.iter_mut().enumerate() {
+        let word30 = bits[30 * k..30 * k + 30]
+            .iter()
+            .fold(0u32, |acc, &b| (acc << 1) | u32::from(b));
+        *data = parity_check(word30, d29, d30)?;
+        (d29, d30) = last_two_bits(word30);
+    }
+    if words[0] >> 16 != PREAMBLE {
+        return None;
+    }
+    let subframe_id = ((words[1] >> 2) & 0b111) as u8;
+    if !(1..=5).contains(&subframe_id) {
+        return None;
+    }
+    Some((
+        How {
+            tow_count: words[1] >> 7,
+            alert: words[1] & (1 << 6) != 0,
+            anti_spoof: words[1] & (1 << 5) != 0,
+            subframe_id,
+        },
+        polarity,
+    ))
+}
+
 fn decode_inner(
     bits: &[u8; 300],
     d29_prev: bool,

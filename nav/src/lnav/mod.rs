@@ -9,8 +9,9 @@ mod parity;
 
 pub use assembler::{ephemeris_from_subframes, EphemerisAssembler};
 pub use decoder::{
-    decode_subframe, decode_subframe_any_polarity, is_inverted_preamble, preamble_polarity,
-    DecodedSubframe, How, Polarity, Subframe1, Subframe2, Subframe3, SubframePayload, Tlm,
+    decode_subframe, decode_subframe_any_polarity, decode_tlm_how, is_inverted_preamble,
+    preamble_polarity, DecodedSubframe, How, Polarity, Subframe1, Subframe2, Subframe3,
+    SubframePayload, Tlm,
 };
 pub use encoder::{LnavEncoder, PAGE18_SV_ID, PAGE25_SV_ID, PREAMBLE, SUBFRAMES_PER_WEEK};
 pub use parity::{parity_bits, parity_check, parity_encode};

@@ -4,9 +4,9 @@
 use crate::common::brdc;
 use gpsrx_nav::lnav::fields::{self as fd, Field};
 use gpsrx_nav::lnav::{
-    decode_subframe, decode_subframe_any_polarity, is_inverted_preamble, parity_bits, parity_check,
-    parity_encode, DecodedSubframe, EphemerisAssembler, LnavEncoder, LnavError, Polarity,
-    SubframePayload,
+    decode_subframe, decode_subframe_any_polarity, decode_tlm_how, is_inverted_preamble,
+    parity_bits, parity_check, parity_encode, DecodedSubframe, EphemerisAssembler, LnavEncoder,
+    LnavError, Polarity, SubframePayload,
 };
 use gpsrx_nav::{Ephemeris, GpsTime, KlobucharParams, UtcParams};
 
@@ -386,4 +386,28 @@ fn assembler_requires_matching_issue_of_data_and_resolves_weeks() {
     asm.push(&sfs[0]);
     asm.push(&sfs[1]);
     assert!(asm.push(&sf3_other).is_none());
+}
+
+#[test]
+fn the_tlm_and_how_alone_give_the_subframe_time_in_either_polarity() {
+    let eph = &brdc().ephemerides[0];
+    let enc = LnavEncoder::new(eph, None, None).expect("fits");
+    // IS-GPS-200 20.3.3.2: the HOW carries the TOW count of the next subframe; the subframe
+    // starting at TOW 538218 s is subframe 4 ((538218 / 6) mod 5 = 3 -> ID 4).
+    let bits = enc.subframe_bits(538_218, 2190);
+    let (how, pol) = decode_tlm_how(&bits[..60]).expect("TLM and HOW check");
+    assert_eq!(how.subframe_start_tow_s(), 538_218);
+    assert_eq!(how.subframe_id, 4);
+    assert_eq!(pol, Polarity::Normal);
+    let inverted: Vec<u8> = bits[..60].iter().map(|b| 1 - b).collect();
+    let (how_inv, pol_inv) = decode_tlm_how(&inverted).expect("inverted checks too");
+    assert_eq!(how_inv, how);
+    assert_eq!(pol_inv, Polarity::Inverted);
+    // One bit flipped in the HOW fails its parity; 59 bits are not enough.
+    let mut bad = bits[..60].to_vec();
+    bad[40] ^= 1;
+    assert!(decode_tlm_how(&bad).is_none());
+    assert!(decode_tlm_how(&bits[..59]).is_none());
+    // Shifted by one bit: no preamble.
+    assert!(decode_tlm_how(&bits[1..61]).is_none());
 }

@@ -37,18 +37,105 @@ const CLUSTER_S: f64 = 0.006;
 const STEADY_REPORTS: u32 = 50;
 /// Weakest C/N0 watched, dB-Hz (below it the phase noise hides the jumps).
 const MIN_CN0_DBHZ: f64 = 30.0;
+/// Reports before a jump that give the carrier's phase and frequency there (the frequency
+/// to about 0.2 Hz at 40 dB-Hz with 1 ms reports).
+const PRE_REPORTS: usize = 80;
 /// Longest integration watched, s (a 20 ms integration smears a jump over a bit).
 const MAX_T_COH_S: f64 = 0.005;
 
 /// A discontinuity found.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Discontinuity {
-    /// Sample index of the earliest jump.
+    /// Sample index of the jump (the median of the satellites that show it clearly).
     pub sample: u64,
     /// Satellites whose carrier phase jumped.
     pub jumped: usize,
     /// Satellites watched at the time.
     pub watched: usize,
+    /// Per satellite: PRN, the step of its carrier phase over the jump (rad, modulo pi:
+    /// Costas) and its carrier frequency, Hz ([`NcoPoint::phase_step`]).
+    pub steps: Vec<(u8, f64, f64)>,
+}
+
+/// A channel's carrier at one report: NCO and residual phase.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NcoPoint {
+    /// Sample index of the report's start.
+    pub sample: u64,
+    /// Accumulated NCO phase at it, cycles.
+    pub phase_cycles: f64,
+    /// NCO frequency over the report, Hz.
+    pub freq_hz: f64,
+    /// Integration time, s.
+    pub t_coh_s: f64,
+    /// Residual phase of the prompt, `atan(Q / I)`, rad.
+    pub residual_rad: f64,
+}
+
+impl NcoPoint {
+    /// The carrier of report `e`.
+    pub fn of(e: &ChannelEpoch) -> Self {
+        Self {
+            sample: e.sample_index,
+            phase_cycles: e.carrier_phase_cycles,
+            freq_hz: e.doppler_hz,
+            t_coh_s: e.t_coh_s,
+            residual_rad: if e.prompt.re != 0.0 {
+                (e.prompt.im / e.prompt.re).atan()
+            } else {
+                0.0
+            },
+        }
+    }
+
+    /// The signal's carrier phase at the middle of the report, rad: the NCO phase there plus
+    /// the prompt's residual.
+    fn signal_phase_rad(&self) -> f64 {
+        std::f64::consts::TAU * (self.phase_cycles + 0.5 * self.freq_hz * self.t_coh_s)
+            + self.residual_rad
+    }
+
+    /// The step of the signal's carrier phase (rad, modulo pi) between the reports `pre`
+    /// (before a jump) and `post` (after it). Each report's signal phase is taken relative to
+    /// the NCO line `phi_ref + 2 pi f_ref (t - t_ref)` of the last report before (`psi`, small
+    /// in lock); a straight line fitted to `psi` over `pre` (the NCO frequency of one report
+    /// is as noisy as the loop) is extrapolated over the few milliseconds to each report of
+    /// `post`, and the differences are averaged as `e^{2 i d}`. The loops' reaction does not
+    /// enter: the signal phase is NCO plus residual.
+    ///
+    /// Returns the step and the carrier frequency before the jump from the same fit
+    /// (`f_ref + b / 2 pi`: one report's NCO frequency is as noisy as the loop, several Hz,
+    /// while the step to explain is `2 pi f g`).
+    pub fn phase_step(pre: &[NcoPoint], post: &[NcoPoint], fs_hz: f64) -> Option<(f64, f64)> {
+        let r = pre.last()?;
+        if pre.len() < 4 || post.is_empty() {
+            return None;
+        }
+        let t = |p: &NcoPoint| (p.sample as f64 - r.sample as f64) / fs_hz;
+        let psi = |p: &NcoPoint| {
+            let d = p.signal_phase_rad()
+                - r.signal_phase_rad()
+                - std::f64::consts::TAU * r.freq_hz * t(p);
+            d - (d / std::f64::consts::PI).round() * std::f64::consts::PI
+        };
+        // Least-squares line psi = a + b t over `pre`.
+        let n = pre.len() as f64;
+        let (st, sp, stt, stp) = pre.iter().fold((0.0, 0.0, 0.0, 0.0), |acc, p| {
+            let (ti, pi) = (t(p), psi(p));
+            (acc.0 + ti, acc.1 + pi, acc.2 + ti * ti, acc.3 + ti * pi)
+        });
+        let den = n * stt - st * st;
+        if den <= 0.0 {
+            return None;
+        }
+        let b = (n * stp - st * sp) / den;
+        let a = (sp - b * st) / n;
+        let z: num_complex::Complex64 = post
+            .iter()
+            .map(|p| num_complex::Complex64::from_polar(1.0, 2.0 * (psi(p) - a - b * t(p))))
+            .sum();
+        Some((0.5 * z.arg(), r.freq_hz + b / std::f64::consts::TAU))
+    }
 }
 
 #[derive(Debug, Default)]
@@ -60,6 +147,8 @@ struct Watch {
     last_sample: u64,
     /// Mean prompt power before the window, exponentially averaged (0: none yet).
     ref_power: f64,
+    /// The carrier NCO of the latest reports.
+    nco: VecDeque<NcoPoint>,
 }
 
 /// Watches every satellite's carrier phase for a common jump.
@@ -92,9 +181,16 @@ impl DiscontinuityMonitor {
             && e.cn0_dbhz >= MIN_CN0_DBHZ
             && e.prompt.norm_sqr() > 0.0
             && gap <= 2.5 * e.t_coh_s;
+        // The NCO history is kept whatever the lock (a jump unlocks the phase detector).
+        w.nco.push_back(NcoPoint::of(e));
+        if w.nco.len() > PRE_REPORTS + 40 {
+            w.nco.pop_front();
+        }
         if !watched {
+            let nco = std::mem::take(&mut w.nco);
             *w = Watch {
                 last_sample: e.sample_index,
+                nco,
                 ..Watch::default()
             };
             return;
@@ -104,11 +200,13 @@ impl DiscontinuityMonitor {
             .push_back((e.sample_index, p * p, e.prompt.norm_sqr()));
         if w.recent.len() > 2 * WINDOW {
             if let Some((_, _, old)) = w.recent.pop_front() {
-                w.ref_power = if w.ref_power > 0.0 {
-                    0.95 * w.ref_power + 0.05 * old
-                } else {
-                    old
-                };
+                // The reference follows slow changes of the signal level, never a collapse
+                // (a blockage must not become the new level).
+                if w.ref_power <= 0.0 {
+                    w.ref_power = old;
+                } else if old > 0.3 * w.ref_power {
+                    w.ref_power = 0.95 * w.ref_power + 0.05 * old;
+                }
             }
         }
         w.steady += 1;
@@ -134,6 +232,31 @@ impl DiscontinuityMonitor {
             .push((w.recent[WINDOW].0, e.prn, (step / sigma_d).powi(2)));
     }
 
+    /// Per satellite of `best`: the carrier-phase step over the jump at sample `jump` (the
+    /// same instant for every satellite), from up to [`PRE_REPORTS`] reports before it to up to 8 after it,
+    /// leaving out the report that straddles it and one more on each side.
+    fn phase_steps(&self, best: &BTreeMap<u8, (f64, u64)>, jump: u64) -> Vec<(u8, f64, f64)> {
+        best.keys()
+            .filter_map(|prn| {
+                let w = self.watches.get(prn)?;
+                let pts: Vec<NcoPoint> = w.nco.iter().copied().collect();
+                // The first report that starts after the jump; the one before straddles it.
+                let k = pts.iter().position(|p| p.sample > jump)?;
+                let pre = &pts[k.saturating_sub(PRE_REPORTS + 2)..k.saturating_sub(2)];
+                let post = &pts[(k + 1).min(pts.len())..(k + 9).min(pts.len())];
+                let (step, freq_hz) = NcoPoint::phase_step(pre, post, self.fs_hz)?;
+                // The two halves of `post` must agree (a loop slipping right after the jump
+                // gives no clean step): within 0.3 rad, modulo pi.
+                let half = post.len() / 2;
+                let (a, _) = NcoPoint::phase_step(pre, &post[..half], self.fs_hz)?;
+                let (b, _) = NcoPoint::phase_step(pre, &post[half..], self.fs_hz)?;
+                let d = a - b;
+                let d = d - (d / std::f64::consts::PI).round() * std::f64::consts::PI;
+                (d.abs() < 0.3).then_some((*prn, step, freq_hz))
+            })
+            .collect()
+    }
+
     /// After all channels have reported up to sample `end`: the discontinuity among the steps
     /// old enough to be complete, if any. At each step's time `t`, every satellite's largest
     /// normalised step within [`CLUSTER_S`] after it is summed: `S = sum_i max z_i^2`. Without
@@ -147,27 +270,36 @@ impl DiscontinuityMonitor {
         let ready = end.saturating_sub(settle);
         self.steps.sort_unstable_by_key(|s| s.0);
         let mut found = None;
-        for (i, &(t0, _, _)) in self.steps.iter().enumerate() {
+        for (i, &(t0, ..)) in self.steps.iter().enumerate() {
             if t0 + cluster > ready {
                 break;
             }
-            let mut best: BTreeMap<u8, f64> = BTreeMap::new();
-            for &(_, prn, z2) in self.steps[i..].iter().take_while(|s| s.0 < t0 + cluster) {
-                let b = best.entry(prn).or_insert(0.0);
-                *b = b.max(z2);
+            // Per PRN: the largest normalised step, and where.
+            let mut best: BTreeMap<u8, (f64, u64)> = BTreeMap::new();
+            for &(at, prn, z2) in self.steps[i..].iter().take_while(|s| s.0 < t0 + cluster) {
+                let b = best.entry(prn).or_insert((0.0, at));
+                if z2 > b.0 {
+                    *b = (z2, at);
+                }
             }
             let n = best.len();
-            let sum: f64 = best.values().sum();
-            let strong = best.values().filter(|&&z2| z2 > 25.0).count();
+            let sum: f64 = best.values().map(|b| b.0).sum();
+            let strong = best.values().filter(|b| b.0 > 25.0).count();
             if n >= MIN_SATELLITES
                 && strong >= MIN_SATELLITES
                 && sum > MIN_SUM_PER_SAT * n as f64 + MIN_SUM
             {
                 tracing::debug!("carrier phase steps at sample {t0}: {best:?}");
+                // The jump's instant: the median split of the satellites that show it clearly.
+                let mut ats: Vec<u64> = best.values().filter(|b| b.0 > 25.0).map(|b| b.1).collect();
+                ats.sort_unstable();
+                let jump = ats.get(ats.len() / 2).copied().unwrap_or(t0);
+                let steps = self.phase_steps(&best, jump);
                 found = Some(Discontinuity {
-                    sample: t0,
+                    sample: jump,
                     jumped: strong,
                     watched: n,
+                    steps,
                 });
                 break;
             }
@@ -178,8 +310,140 @@ impl DiscontinuityMonitor {
             for w in self.watches.values_mut() {
                 w.steady = 0;
                 w.recent.clear();
+                w.nco.clear();
             }
         }
         found
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{PI, TAU};
+
+    const FS: f64 = 2.048e6;
+    const FREQS: [f64; 8] = [
+        -3120.4, -1877.9, -640.2, 199.1, 874.6, 1502.3, 2280.8, 3411.7,
+    ];
+
+    /// Deterministic standard normal numbers (xorshift and Box-Muller).
+    struct Noise(u64);
+    impl Noise {
+        fn uniform(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        }
+        fn normal(&mut self) -> f64 {
+            (-2.0 * self.uniform().ln()).sqrt() * (TAU * self.uniform()).cos()
+        }
+    }
+
+    /// A 1 ms report of satellite `i` at 45 dB-Hz whose signal phase is `2 pi f t + jump`
+    /// against an NCO at `2 pi f t` (the loop has not reacted yet), with unit noise per arm
+    /// and `power` times the nominal signal power.
+    fn report(i: usize, k: u64, jump_rad: f64, power: f64, noise: &mut Noise) -> ChannelEpoch {
+        let f = FREQS[i];
+        let t = k as f64 * 1e-3;
+        let amp = (2.0 * 10f64.powf(4.5) * 1e-3 * power).sqrt();
+        let resid = jump_rad;
+        let prompt =
+            Complex64::from_polar(amp, resid) + Complex64::new(noise.normal(), noise.normal());
+        ChannelEpoch {
+            prn: i as u8 + 1,
+            state: ChannelState::Track,
+            sample_index: (t * FS) as u64,
+            t_rx_s: t,
+            code_phase_chips: 0.0,
+            code_rate_chips_s: 1.023e6,
+            carrier_phase_cycles: f * t,
+            doppler_hz: f,
+            cn0_dbhz: 45.0,
+            pll_lock: true,
+            pll_lock_metric: 0.9,
+            code_lock: true,
+            prompt,
+            early: prompt,
+            late: prompt,
+            phase_error_cycles: 0.0,
+            freq_error_hz: 0.0,
+            code_error_chips: 0.0,
+            t_coh_s: 1e-3,
+            feedforward_hz: None,
+            ms_count: k,
+            bit_edge: false,
+            bit: None,
+            bit_start_ms: None,
+        }
+    }
+
+    /// Runs 8 satellites for 400 ms; from `at_ms` satellite `i` gets `jump(i)` and `power(i)`.
+    fn run(
+        at_ms: u64,
+        jump: impl Fn(usize) -> f64,
+        power: impl Fn(usize) -> f64,
+    ) -> Option<Discontinuity> {
+        let mut m = DiscontinuityMonitor::new(FS);
+        let mut noise = Noise(0x9E37_79B9_7F4A_7C15);
+        let mut found = None;
+        for block in 0..40u64 {
+            for i in 0..8 {
+                for k in block * 10..(block + 1) * 10 {
+                    let (j, p) = if k >= at_ms {
+                        (jump(i), power(i))
+                    } else {
+                        (0.0, 1.0)
+                    };
+                    m.push(&report(i, k, j, p, &mut noise));
+                }
+            }
+            if let Some(d) = m.evaluate(((block + 1) as f64 * 0.01 * FS) as u64) {
+                found.get_or_insert(d);
+            }
+        }
+        found
+    }
+
+    #[test]
+    fn a_common_phase_jump_is_found_at_its_sample_with_its_steps() {
+        // 31 ms lost: each carrier steps by 2 pi f g (modulo pi).
+        let g = 0.031;
+        let step = |i: usize| {
+            let x = TAU * FREQS[i] * g;
+            x - (x / PI).round() * PI
+        };
+        let d = run(200, step, |_| 1.0).expect("found");
+        assert!(
+            (d.sample as f64 / FS - 0.2).abs() < 0.004,
+            "at {}",
+            d.sample as f64 / FS
+        );
+        assert!(d.jumped >= MIN_SATELLITES);
+        assert!(d.steps.len() >= 6, "{:?}", d.steps);
+        for &(prn, s, f) in &d.steps {
+            let i = usize::from(prn) - 1;
+            let err = s - step(i);
+            let err = err - (err / PI).round() * PI;
+            assert!(
+                err.abs() < 0.15,
+                "G{prn}: step {s:.3} against {:.3}",
+                step(i)
+            );
+            assert!((f - FREQS[i]).abs() < 1.0, "G{prn}: {f} Hz");
+        }
+    }
+
+    #[test]
+    fn noise_a_lone_slip_and_a_blockage_are_not_lost_samples() {
+        assert_eq!(run(200, |_| 0.0, |_| 1.0), None);
+        // One satellite slips a quarter cycle.
+        assert_eq!(
+            run(200, |i| if i == 3 { PI / 2.0 } else { 0.0 }, |_| 1.0),
+            None
+        );
+        // Every signal blocked: the power collapses, the phases are noise.
+        assert_eq!(run(200, |i| i as f64 * 0.4, |_| 0.0), None);
     }
 }

@@ -9,12 +9,14 @@
 //! - [`ring`]: the window of recent samples addressed by absolute index;
 //! - [`navdata`]: frame sync, subframes, ephemerides and SV time per satellite;
 //! - [`discontinuity`]: lost samples found by a carrier-phase jump common to the satellites;
+//! - [`gap_length`]: the length of lost time from the bit edges and carrier-phase steps;
 //! - [`observables`]: pseudoranges, carrier phase, Doppler at common receiver epochs;
 //! - [`tracker`]: channels alone over a stream (loop studies).
 
 pub mod aiding;
 pub mod channel_manager;
 pub mod discontinuity;
+pub mod gap_length;
 pub mod navdata;
 pub mod navigation;
 pub mod observables;

@@ -17,8 +17,8 @@ use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
 use gpsrx_nav::atmosphere::{KlobucharParams, UtcParams};
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::lnav::{
-    decode_subframe_any_polarity, preamble_polarity, DecodedSubframe, EphemerisAssembler, Polarity,
-    SubframePayload,
+    decode_subframe_any_polarity, decode_tlm_how, preamble_polarity, DecodedSubframe,
+    EphemerisAssembler, Polarity, SubframePayload,
 };
 use std::collections::VecDeque;
 
@@ -85,6 +85,10 @@ pub struct NavDecoder {
     /// The time tag was carried over (not read from a HOW), so the subframe boundaries are
     /// found from it rather than from a preamble.
     carried: bool,
+    /// A rough SV time (`ms_count`, TOW s, tolerance s) while unsynchronised: a TLM and HOW
+    /// that pass parity with a time within the tolerance give frame sync at once
+    /// ([`NavDecoder::hint_time`]).
+    hint: Option<(u64, f64, f64)>,
     reference_week: u32,
     /// Full transmission week from subframe 1 (10-bit week resolved with the reference week).
     week: Option<u32>,
@@ -111,6 +115,7 @@ impl NavDecoder {
             utc_broadcast: None,
             time_tag: None,
             carried: false,
+            hint: None,
             reference_week,
             week: None,
             subframes_ok: 0,
@@ -146,6 +151,7 @@ impl NavDecoder {
         self.candidate = None;
         self.time_tag = None;
         self.carried = false;
+        self.hint = None;
         self.consecutive_failures = 0;
     }
 
@@ -159,6 +165,51 @@ impl NavDecoder {
         self.reset_sync();
         self.time_tag = Some((ms_count, sv_tow_s));
         self.carried = true;
+    }
+
+    /// Gives a rough SV time while unsynchronised: code period `ms_count` started near SV time
+    /// `sv_tow_s`, within `tolerance_s`. Frame sync then needs only a telemetry word with the
+    /// preamble and a hand-over word, both passing parity, whose time agrees (1.2 s after a
+    /// subframe starts, instead of a whole subframe and the next preamble: 6-12 s). A false
+    /// match needs 20 parity and preamble bits and the 17-bit TOW count to agree.
+    pub fn hint_time(&mut self, ms_count: u64, sv_tow_s: f64, tolerance_s: f64) {
+        if self.time_tag.is_none() {
+            self.hint = Some((ms_count, sv_tow_s, tolerance_s));
+        }
+    }
+
+    /// Whether a rough time is held ([`NavDecoder::hint_time`]).
+    pub fn has_hint(&self) -> bool {
+        self.hint.is_some()
+    }
+
+    /// Frame sync from the TLM and HOW ending at the newest bit, if they agree with the hint.
+    fn sync_from_hint(&mut self, events: &mut Vec<NavEvent>) -> bool {
+        let Some((m0, sv0, tol)) = self.hint else {
+            return false;
+        };
+        let n = self.bits.len();
+        if n < 60 {
+            return false;
+        }
+        let head: Vec<u8> = self.bits.iter().skip(n - 60).map(|&(b, _)| b).collect();
+        let Some((how, _)) = decode_tlm_how(&head) else {
+            return false;
+        };
+        let first_ms = self.bits[n - 60].1;
+        let tow = how.subframe_start_tow_s();
+        let mut err = f64::from(tow) - (sv0 + (first_ms as f64 - m0 as f64) * 1e-3);
+        err -= (err / 604_800.0).round() * 604_800.0;
+        if err.abs() > tol {
+            return false;
+        }
+        self.hint = None;
+        self.candidate = None;
+        self.time_tag = Some((first_ms, f64::from(tow)));
+        self.bits.drain(..n - 60);
+        self.next_subframe = Some(0);
+        events.push(NavEvent::FrameSync { tow_s: tow });
+        true
     }
 
     /// Whether the SV time is a carried-over one not yet confirmed by a HOW.
@@ -246,6 +297,9 @@ impl NavDecoder {
     /// Confirms a candidate with the next TLM preamble, or looks for a subframe ending at the
     /// newest bit.
     fn search(&mut self, events: &mut Vec<NavEvent>) {
+        if self.sync_from_hint(events) {
+            return;
+        }
         if let Some((sf, first_ms, polarity)) = self.candidate {
             // The next subframe starts 300 bits (6000 ms) after the candidate's first bit.
             let next_ms = first_ms + 6000;

@@ -1,0 +1,104 @@
+//! The length of lost time, from what the satellites show after it.
+//!
+//! Samples lost for a time `g` leave two traces:
+//!
+//! - the data-bit edges: SV time kept across the gap runs `g` late, so at a channel's new bit
+//!   edge (a whole 20 ms of true SV time) the kept time is `-g` modulo 20 ms off a bit
+//!   boundary: `g = o + 20 k` ms for the measured offset `o` in [0, 20) and an unknown `k`;
+//! - the carrier phase: each channel's residual carrier phase steps by `2 pi f_i g` (modulo pi,
+//!   the Costas ambiguity) for its carrier frequency `f_i`.
+//!
+//! The candidates `o + 20 k` are scored by how well they explain the phase steps `d_i`:
+//! `S(g) = mean_i cos(2 (2 pi f_i g - d_i))`. The right `g` scores near 1 (measured: 0.73 for
+//! a 31 ms gap at 40-45 dB-Hz, the next candidate 0.25); a wrong one is a random mean of
+//! cosines (standard deviation `1 / sqrt(2 n)`, 0.25 for eight satellites). A length is returned only with at least [`MIN_STEPS`] steps, a
+//! best score of at least [`MIN_SCORE`] and every other candidate [`MIN_MARGIN`] below it:
+//! otherwise the length is unknown and the time must come from the navigation message.
+
+/// Fewest phase steps that can resolve a length.
+pub const MIN_STEPS: usize = 4;
+/// Lowest score accepted.
+pub const MIN_SCORE: f64 = 0.6;
+/// Least margin of the best score over any other candidate.
+pub const MIN_MARGIN: f64 = 0.3;
+
+/// The lost time (ms) given its value modulo 20 ms (`offset_ms`, in [0, 20)) and the phase
+/// steps `(step rad, carrier frequency Hz)`, searched up to `max_ms`; `None` when not resolved.
+pub fn resolve_gap_ms(offset_ms: f64, steps: &[(f64, f64)], max_ms: f64) -> Option<f64> {
+    if steps.len() < MIN_STEPS || !offset_ms.is_finite() || !max_ms.is_finite() {
+        return None;
+    }
+    let score = |g_ms: f64| {
+        let g = g_ms * 1e-3;
+        steps
+            .iter()
+            .map(|&(d, f)| (2.0 * (std::f64::consts::TAU * f * g - d)).cos())
+            .sum::<f64>()
+            / steps.len() as f64
+    };
+    // A length of (almost) zero is not a gap.
+    let first_k = if offset_ms < 0.5 { 1 } else { 0 };
+    let mut scored: Vec<(f64, f64)> = Vec::new();
+    let mut k = first_k;
+    loop {
+        let g = offset_ms + 20.0 * f64::from(k);
+        if g > max_ms {
+            break;
+        }
+        scored.push((score(g), g));
+        k += 1;
+    }
+    scored.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let (best, g) = *scored.first()?;
+    let runner_up = scored
+        .iter()
+        .skip(1)
+        .find(|s| (s.1 - g).abs() > 1e-9)
+        .map_or(f64::NEG_INFINITY, |s| s.0);
+    (best >= MIN_SCORE && best - runner_up >= MIN_MARGIN).then_some(g)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Steps `2 pi f g` folded into (-pi/2, pi/2], with a little noise.
+    fn steps_for(g_ms: f64, freqs: &[f64], noise: &[f64]) -> Vec<(f64, f64)> {
+        freqs
+            .iter()
+            .zip(noise.iter().cycle())
+            .map(|(&f, &n)| {
+                let phi = std::f64::consts::TAU * f * g_ms * 1e-3 + n;
+                let folded = phi - (phi / std::f64::consts::PI).round() * std::f64::consts::PI;
+                (folded, f)
+            })
+            .collect()
+    }
+
+    const FREQS: [f64; 8] = [
+        -3120.4, -1877.9, -640.2, 199.1, 874.6, 1502.3, 2280.8, 3411.7,
+    ];
+    const NOISE: [f64; 5] = [0.08, -0.12, 0.05, -0.03, 0.1];
+
+    #[test]
+    fn the_lengths_of_whole_millisecond_gaps_are_found() {
+        for g in [1.0, 11.0, 20.0, 31.0, 60.0, 500.0] {
+            let steps = steps_for(g, &FREQS, &NOISE);
+            let offset = g % 20.0;
+            assert_eq!(resolve_gap_ms(offset, &steps, 1000.0), Some(g), "{g} ms");
+        }
+    }
+
+    #[test]
+    fn too_few_or_inconsistent_steps_resolve_nothing() {
+        let steps = steps_for(31.0, &FREQS[..3], &NOISE);
+        assert_eq!(resolve_gap_ms(11.0, &steps, 1000.0), None);
+        // Steps that no length explains (random phases).
+        let random: Vec<(f64, f64)> = FREQS
+            .iter()
+            .zip([1.2, -0.7, 0.3, 1.5, -1.1, 0.9, -0.2, 0.6])
+            .map(|(&f, d)| (d, f))
+            .collect();
+        assert_eq!(resolve_gap_ms(11.0, &random, 1000.0), None);
+    }
+}
