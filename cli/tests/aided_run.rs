@@ -1,7 +1,7 @@
 //! INS aiding end to end: the feed-forward Doppler against the simulator's truth, and
 //! `gpsrx run --ins` through a 5 g turn with narrow loops, aided and unaided.
 
-use crate::common::{run, truth};
+use crate::common::{run, run_report, truth};
 use gpsrx_cli::commands::simulate::write_ins_for;
 use gpsrx_ins_aiding::error_model::InsErrorConfig;
 use gpsrx_ins_aiding::read_ins_csv;
@@ -211,7 +211,7 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
     let unaided_out = dir.path().join("unaided");
     let mut aided_args = common.to_vec();
     aided_args.extend_from_slice(&["--ins", ins]);
-    let aided = run(&report.data_path, &aided_out, &aided_args);
+    let (aided_report, aided) = run_report(&report.data_path, &aided_out, &aided_args);
     let mut unaided_args = common.to_vec();
     unaided_args.extend_from_slice(&["--ins", ins, "--no-aiding"]);
     let unaided = run(&report.data_path, &unaided_out, &unaided_args);
@@ -252,6 +252,104 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
         aided_turn.len()
     );
     assert!(rms < 2.0, "aided fix error in the turn {rms} m RMS");
+
+    // A good INS passes the integrity monitor: admitted within 2 s of the start, never
+    // rejected (not in the turn either), aiding the rest of the run.
+    let a = aided_report
+        .receiver
+        .ins_aiding
+        .unwrap_or_else(|| panic!("no INS summary"));
+    eprintln!("good INS: {a:?}");
+    assert_eq!(a.rejections, 0, "a good INS rejected: {a:?}");
+    assert!(a.aided_fraction > 0.93, "{a:?}");
+}
+
+/// Issue 13: an INS whose time base is 1 s late (the output stamped `t` is the INS solution of
+/// `t - 1`) agrees with the loops while the vehicle cruises, but in a 5 g turn its velocity is
+/// up to 49 m/s off: the integrity monitor must drop it there (the default 18 Hz loops, which
+/// hold a 5 g turn unaided, then run unaided), re-admit it once it agrees again for 5 s after
+/// the turn, and the fixes must be those of a run without `--ins` (same first fix, as many and
+/// as accurate in the turn).
+#[test]
+fn an_ins_1s_late_is_dropped_in_a_turn_and_the_fixes_are_the_unaided_ones() {
+    let dir = tmp();
+    // The turn after the first fix (about 12 s: frame sync), 10 s left after it.
+    let (turn_at, turn_s) = (13.0, 4.0);
+    let sc = turn_scenario(28.0, turn_at, turn_s);
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let report = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    let ins_path = dir.path().join("ins_late.csv");
+    let late = InsErrorConfig {
+        latency_s: 1.0,
+        ..InsErrorConfig::default()
+    };
+    write_ins_for(&sim, &late, &ins_path).unwrap_or_else(|e| panic!("{e}"));
+    let nav = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data/brdc0010.22n");
+    let nav = nav.to_str().unwrap_or_default();
+    let ins = ins_path.to_str().unwrap_or_default();
+    let common = ["--nav", nav, "--allow-unhealthy"];
+    let mut late_args = common.to_vec();
+    late_args.extend_from_slice(&["--ins", ins]);
+    let (late_report, late_fixes) =
+        run_report(&report.data_path, &dir.path().join("late"), &late_args);
+    let (plain_report, plain_fixes) =
+        run_report(&report.data_path, &dir.path().join("plain"), &common);
+    let a = late_report
+        .receiver
+        .ins_aiding
+        .unwrap_or_else(|| panic!("no INS summary"));
+    let (l, p) = (&late_report.receiver, &plain_report.receiver);
+    eprintln!(
+        "INS 1 s late: {a:?}; {} fixes, first {:?}; without --ins: {} fixes, first {:?}",
+        l.fixes, l.first_fix_s, p.fixes, p.first_fix_s
+    );
+    // Admitted while cruising, dropped in the turn, back 5 s after it.
+    assert!(a.rejections >= 1, "the late INS was not rejected: {a:?}");
+    assert!(
+        a.admissions >= 2,
+        "not admitted before the turn and again after it: {a:?}"
+    );
+    let not_aided_s = l.duration_s - a.aided_s;
+    assert!(
+        (4.0..=12.0).contains(&not_aided_s),
+        "unaided for {not_aided_s:.1} s (the turn and the 5 s of re-admission)"
+    );
+
+    // The fixes: as without --ins.
+    let first = |s: &gpsrx_receiver::RunSummary| s.first_fix_s.unwrap_or(f64::INFINITY);
+    assert!(p.fixes > 50, "without --ins: {} fixes", p.fixes);
+    assert!(
+        (first(l) - first(p)).abs() <= 1.0,
+        "first fix {:?} vs {:?}",
+        l.first_fix_s,
+        p.first_fix_s
+    );
+    let truth = truth(dir.path());
+    let (t0, t1) = (538194.0 + turn_at, 538194.0 + turn_at + turn_s + 2.0);
+    let in_turn = |fixes: &[Fix]| -> (usize, f64) {
+        let e: Vec<f64> = fixes
+            .iter()
+            .filter(|f| (t0..=t1).contains(&f.time.tow_s))
+            .map(|f| error_3d_m(f, &truth))
+            .collect();
+        let rms = (e.iter().map(|x| x * x).sum::<f64>() / e.len().max(1) as f64).sqrt();
+        (e.len(), rms)
+    };
+    let ((nl, rl), (np, rp)) = (in_turn(&late_fixes), in_turn(&plain_fixes));
+    eprintln!(
+        "fixes in the turn: INS 1 s late {nl} (3D RMS {rl:.2} m), without --ins {np} ({rp:.2} m)"
+    );
+    assert!(np >= 55, "without --ins, fixes in the turn: {np}");
+    assert!(
+        nl + 3 >= np,
+        "fixes in the turn: {nl} vs {np} without --ins"
+    );
+    assert!(
+        rl < rp + 1.0,
+        "3D RMS in the turn {rl:.2} m vs {rp:.2} m without --ins"
+    );
 }
 
 /// `aided_track`: while the aid is on, the channel runs the narrower aided loops (Doppler noise

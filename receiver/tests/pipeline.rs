@@ -464,3 +464,159 @@ fn two_seconds_of_zeros_give_no_fix() {
         .collect();
     assert!(during.is_empty(), "fixes from zeros at {during:?} s");
 }
+
+/// A receiver like [`receiver`] aided by `ins` (None: unaided).
+fn aided_receiver(fs_hz: f64, ins: Option<gpsrx_ins_aiding::InsTrack>) -> Receiver {
+    let mut config = ReceiverConfig::default();
+    config.run.tropo = gpsrx_receiver::config::TropoModel::None;
+    config.run.week = Some(2190);
+    // The built-in navigation file flags a satellite unhealthy (a flag the simulator copies):
+    // aid it too.
+    config.run.allow_unhealthy = true;
+    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let assistance = Assistance {
+        nav: Some(nav),
+        ins: ins.map(|track| gpsrx_receiver::pipeline::InsAiding {
+            track,
+            band_limit_rad_s: None,
+        }),
+        ..Assistance::default()
+    };
+    Receiver::new(&config, fs_hz, assistance).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The simulator's truth as a 10 Hz INS (GPS time column included) whose velocity is off by
+/// `dv_ecef` m/s (the position is the truth's).
+fn ins_with_velocity_error(sim: &Simulator, dv_ecef: [f64; 3]) -> gpsrx_ins_aiding::InsTrack {
+    let n = (sim.duration_s() * 10.0).floor() as usize;
+    let samples = (0..=n)
+        .map(|k| {
+            let t_s = k as f64 / 10.0;
+            let (tow, s) = sim.receiver_truth(t_s);
+            gpsrx_ins_aiding::InsSample {
+                t_s,
+                gps_tow_s: Some(tow),
+                pos_m: s.pos_m,
+                vel_mps: s.vel_mps + gpsrx_nav::frames::Vector3::from(dv_ecef),
+            }
+        })
+        .collect();
+    gpsrx_ins_aiding::InsTrack::from_samples(samples).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Horizontal and vertical error (m) of every fix against the static truth.
+fn fix_errors(sim: &Simulator, sink: &MemorySink) -> Vec<(f64, f64)> {
+    let (_, truth) = sim.receiver_truth(0.0);
+    sink.fixes
+        .iter()
+        .map(|f| {
+            let r = gpsrx_nav::frames::enu_rotation(&f.fix.llh);
+            let d = gpsrx_nav::frames::Vector3::new(
+                f.fix.ecef_m[0] - truth.pos_m.x,
+                f.fix.ecef_m[1] - truth.pos_m.y,
+                f.fix.ecef_m[2] - truth.pos_m.z,
+            );
+            let enu = r * d;
+            (enu.x.hypot(enu.y), enu.z.abs())
+        })
+        .collect()
+}
+
+/// Issue 13, never a silent wrong fix: an INS whose velocity is 50 m/s off on a static antenna
+/// (250 Hz of feed-forward error at most, different on every satellite) is caught by the
+/// integrity monitor before its aid reaches any loop, and the run gives the fixes of an unaided
+/// run (same first fix, same count, on the truth). A perfect INS is admitted and aids the
+/// loops for nearly all the run, never rejected.
+#[test]
+fn an_ins_50_mps_off_is_rejected_before_it_aids_and_the_fixes_are_the_unaided_ones() {
+    let sim = simulator(14.0);
+    let fs = 2.048e6;
+    let run = |ins: Option<gpsrx_ins_aiding::InsTrack>| {
+        let mut sink = MemorySink::new().with_channel_epochs();
+        let summary = aided_receiver(fs, ins)
+            .run(&mut SimSource::new(&sim), &mut sink)
+            .unwrap_or_else(|e| panic!("{e}"));
+        (summary, sink)
+    };
+    let (plain, plain_sink) = run(None);
+    let (bad, bad_sink) = run(Some(ins_with_velocity_error(&sim, [50.0, 0.0, 0.0])));
+    let (good, good_sink) = run(Some(ins_with_velocity_error(&sim, [0.0; 3])));
+    let aiding =
+        |s: &gpsrx_receiver::RunSummary| s.ins_aiding.unwrap_or_else(|| panic!("no INS summary"));
+    eprintln!(
+        "unaided: {} fixes, first {:?}; INS 50 m/s off: {} fixes, first {:?}, {:?}; perfect INS: {} fixes, first {:?}, {:?}",
+        plain.fixes, plain.first_fix_s, bad.fixes, bad.first_fix_s, aiding(&bad), good.fixes,
+        good.first_fix_s, aiding(&good)
+    );
+    assert!(plain.ins_aiding.is_none(), "no INS, no INS summary");
+
+    // The wrong INS: rejected, and no loop ever got its feed-forward.
+    let b = aiding(&bad);
+    assert!(b.rejections >= 1, "the wrong INS was not rejected: {b:?}");
+    assert_eq!(b.admissions, 0, "the wrong INS was admitted: {b:?}");
+    assert_eq!(b.aided_s, 0.0, "{b:?}");
+    let fed = bad_sink
+        .channel_epochs
+        .iter()
+        .filter(|(_, e)| e.feedforward_hz.is_some())
+        .count();
+    assert_eq!(fed, 0, "{fed} channel epochs fed forward by the wrong INS");
+    // ... and the fixes are those of the unaided run.
+    let first = |s: &gpsrx_receiver::RunSummary| s.first_fix_s.unwrap_or(f64::INFINITY);
+    assert!(plain.fixes > 10, "unaided: {} fixes", plain.fixes);
+    assert!(
+        (first(&bad) - first(&plain)).abs() <= 1.0,
+        "first fix {:?} vs {:?} unaided",
+        bad.first_fix_s,
+        plain.first_fix_s
+    );
+    assert!(
+        bad.fixes + 10 >= plain.fixes,
+        "{} fixes vs {} unaided",
+        bad.fixes,
+        plain.fixes
+    );
+    for (h, v) in fix_errors(&sim, &bad_sink) {
+        assert!(
+            h < 3.0 && v < 6.0,
+            "fix off by {h:.2} m horizontally, {v:.2} m vertically"
+        );
+    }
+
+    // The perfect INS: admitted within 2 s of the start, never rejected, aiding the rest; the
+    // same fixes.
+    let g = aiding(&good);
+    assert_eq!(g.rejections, 0, "a perfect INS was rejected: {g:?}");
+    assert!(g.aided_s > good.duration_s - 2.0, "{g:?}");
+    let fed = good_sink
+        .channel_epochs
+        .iter()
+        .filter(|(_, e)| e.t_rx_s > 3.0 && e.feedforward_hz.is_some())
+        .count();
+    let all = good_sink
+        .channel_epochs
+        .iter()
+        .filter(|(_, e)| e.t_rx_s > 3.0 && e.pll_lock)
+        .count();
+    assert!(
+        fed as f64 > 0.95 * all as f64,
+        "{fed} of {all} locked epochs after 3 s fed forward"
+    );
+    assert!((first(&good) - first(&plain)).abs() <= 1.0);
+    assert!(good.fixes + 10 >= plain.fixes);
+    for (h, v) in fix_errors(&sim, &good_sink) {
+        assert!(
+            h < 3.0 && v < 6.0,
+            "fix off by {h:.2} m horizontally, {v:.2} m vertically"
+        );
+    }
+    let rms = |sink: &MemorySink| {
+        let e = fix_errors(&sim, sink);
+        (e.iter().map(|(h, v)| h * h + v * v).sum::<f64>() / e.len().max(1) as f64).sqrt()
+    };
+    let (rp, rb, rg) = (rms(&plain_sink), rms(&bad_sink), rms(&good_sink));
+    eprintln!(
+        "3D RMS fix error: unaided {rp:.2} m, INS 50 m/s off {rb:.2} m, perfect INS {rg:.2} m"
+    );
+    assert!(rb < rp + 0.5, "{rb} m vs {rp} m unaided");
+}

@@ -2,12 +2,17 @@
 
 use clap::Parser;
 use gpsrx_cli::cli::{Cli, Command};
-use gpsrx_cli::commands::run::run_file;
+use gpsrx_cli::commands::run::{run_file, RunReport};
 use gpsrx_receiver::output::Fix;
 use std::path::Path;
 
 /// `gpsrx run DATA --out OUT EXTRA...` through the command-line parser; returns the fixes.
 pub fn run(data: &Path, out: &Path, extra: &[&str]) -> Vec<Fix> {
+    run_report(data, out, extra).1
+}
+
+/// [`run`], returning the run's report (the summary `gpsrx run` prints) too.
+pub fn run_report(data: &Path, out: &Path, extra: &[&str]) -> (RunReport, Vec<Fix>) {
     let mut argv = vec![
         "gpsrx",
         "run",
@@ -20,7 +25,7 @@ pub fn run(data: &Path, out: &Path, extra: &[&str]) -> Vec<Fix> {
     let Command::Run(args) = cli.command else {
         panic!("not run")
     };
-    run_file(&args, false).unwrap_or_else(|e| panic!("{e:#}")).1
+    run_file(&args, false).unwrap_or_else(|e| panic!("{e:#}"))
 }
 
 /// `truth.csv` rows: (GPS TOW, ECEF position, ECEF velocity).

@@ -35,7 +35,7 @@
 //! once per satellite), and outside the INS file's time span no satellite does.
 
 use gpsrx_core::{los_doppler_hz, PosVel};
-use gpsrx_dsp::constants::SPEED_OF_LIGHT_MPS;
+use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_ins_aiding::{BandLimiter, InsTrack};
 use gpsrx_nav::ephemeris::{select_ephemeris, Ephemeris, HealthPolicy};
 use gpsrx_nav::rinex_nav::NavData;
@@ -184,6 +184,30 @@ impl InsFeedForward {
             .ok()
             .and_then(|k| Some(k.rx_clock_drift_s_s? - k.rx_clock_drift_ref?.0))
             .unwrap_or(0.0)
+    }
+
+    /// The Doppler the loops should measure in common on every satellite if the feed-forward
+    /// were perfect, Hz: the tracked Doppler holds the whole receiver clock drift
+    /// (`-f_L1 d_rx`), the feed-forward only its change since the first estimate
+    /// (`-f_L1 (d_rx - d_ref)`), so `tracked - fed forward = -f_L1 d_ref`. None before the
+    /// first fix with a clock drift.
+    pub fn expected_common_residual_hz(&self) -> Option<f64> {
+        let k = self.know.read().ok()?;
+        let (d_ref, _) = k.rx_clock_drift_ref?;
+        Some(-F_L1_HZ * d_ref)
+    }
+
+    /// The unfiltered feed-forward Doppler (Hz) of `prn` at receive time `t_s`, without
+    /// logging and without the band limiter: what the integrity monitor compares with the
+    /// Doppler of a channel that runs unaided ([`crate::pipeline::aid_monitor`]). None when
+    /// the aid cannot be computed (no GPS time, no ephemeris, outside the INS file).
+    pub fn predicted_doppler_hz(&self, prn: u8, t_s: f64) -> Option<f64> {
+        let (t0, know) = {
+            let k = self.know.read().ok()?;
+            (k.t0?, k.clone_light())
+        };
+        let eph = self.ephemeris(prn, t0.add_seconds(t_s))?;
+        self.doppler_hz(&eph, &know, t0, t_s)
     }
 
     /// Logs `msg` the first time `(prn, what)` happens: why a satellite has no feed-forward at

@@ -6,6 +6,7 @@
 //! - [`navigation`]: LNAV decoders, observables, PVT, clock steering and aiding feedback;
 //! - [`sink`]: what the receiver emits ([`Sink`], [`MemorySink`]);
 //! - [`aiding`]: the INS-velocity Doppler feed-forward for the channels' aiding port;
+//! - [`aid_monitor`]: the integrity check of that feed-forward against the tracked Doppler;
 //! - [`ring`]: the window of recent samples addressed by absolute index;
 //! - [`navdata`]: frame sync, subframes, ephemerides and SV time per satellite;
 //! - [`discontinuity`]: lost samples found by a carrier-phase jump common to the satellites;
@@ -13,6 +14,7 @@
 //! - [`observables`]: pseudoranges, carrier phase, Doppler at common receiver epochs;
 //! - [`tracker`]: channels alone over a stream (loop studies).
 
+pub mod aid_monitor;
 pub mod aiding;
 pub mod channel_manager;
 pub mod discontinuity;
@@ -27,7 +29,8 @@ pub mod tracker;
 
 pub use channel_manager::SearchSettings;
 pub use receiver::{
-    Assistance, AssistanceError, AssistanceFiles, InsAiding, Receiver, ReceiverError, RunSummary,
+    Assistance, AssistanceError, AssistanceFiles, InsAiding, InsAidingSummary, Receiver,
+    ReceiverError, RunSummary,
 };
 pub use sink::{
     FixReport, MemorySink, NavigationEnd, ObservablesReport, Progress, ReceiverEvent, Sink,

@@ -9,6 +9,7 @@
 
 use crate::config::ReceiverConfig;
 use crate::landmarks::LandmarkObservation;
+use crate::pipeline::aid_monitor::{AidMonitor, AidingStats, GatedAid};
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
 use crate::pipeline::navdata::current_gps_week;
@@ -199,6 +200,37 @@ pub struct RunSummary {
     pub mean_llh: Option<(f64, f64, f64)>,
     /// Mean PDOP.
     pub mean_pdop: Option<f64>,
+    /// With `--ins`: how much of the recording was aided, and how often the INS was rejected
+    /// for disagreeing with the tracked Doppler ([`crate::pipeline::aid_monitor`]).
+    pub ins_aiding: Option<InsAidingSummary>,
+}
+
+/// The INS aiding over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct InsAidingSummary {
+    /// Seconds of signal with the INS aid applied.
+    pub aided_s: f64,
+    /// Their share of the recording, 0 to 1.
+    pub aided_fraction: f64,
+    /// Times the INS was rejected (feed-forward against tracked Doppler).
+    pub rejections: usize,
+    /// Times it was admitted (the first admission included).
+    pub admissions: usize,
+}
+
+impl InsAidingSummary {
+    fn new(stats: AidingStats, duration_s: f64) -> Self {
+        Self {
+            aided_s: stats.aided_s,
+            aided_fraction: if duration_s > 0.0 {
+                (stats.aided_s / duration_s).clamp(0.0, 1.0)
+            } else {
+                0.0
+            },
+            rejections: stats.rejections,
+            admissions: stats.admissions,
+        }
+    }
 }
 
 /// The GPS receiver: configuration, channel manager, navigation processor and aiding.
@@ -210,6 +242,8 @@ pub struct Receiver {
     manager: ChannelManager,
     nav: NavigationProcessor,
     aiding: Option<InsFeedForward>,
+    /// The integrity monitor of the aiding (with `aiding`).
+    monitor: AidMonitor,
     /// Samples up to this index have been processed by the channels.
     processed_to: Option<u64>,
     /// Index of the first sample of the stream.
@@ -295,6 +329,7 @@ impl Receiver {
             manager,
             nav,
             aiding,
+            monitor: AidMonitor::new(),
             processed_to: None,
             first_sample: None,
             started: std::time::Instant::now(),
@@ -325,6 +360,11 @@ impl Receiver {
     /// The sampling rate, Hz.
     pub fn fs_hz(&self) -> f64 {
         self.fs_hz
+    }
+
+    /// The integrity monitor of the INS aiding (idle without an INS).
+    pub fn aid_monitor(&self) -> &AidMonitor {
+        &self.monitor
     }
 
     /// The INS feed-forward, when the receiver is aided.
@@ -364,7 +404,8 @@ impl Receiver {
         loop {
             let view = self.window.view();
             let due = self.manager.due_search(view);
-            let aid = self.aiding.as_ref().map(|a| a as &dyn AidingPort);
+            let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
+            let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
             let manager = &mut self.manager;
             let end = self.window.end();
             let (got, found) = self
@@ -441,8 +482,9 @@ impl Receiver {
         }
         let stats = self.nav.stats();
         let samples = self.window.end() - self.first_sample.unwrap_or(0);
+        let duration_s = samples as f64 / self.fs_hz;
         Ok(RunSummary {
-            duration_s: samples as f64 / self.fs_hz,
+            duration_s,
             wall_s: self.started.elapsed().as_secs_f64(),
             tracked_prns: self.nav.tracked_prns(),
             dropped_prns: self.nav.dropped_prns(),
@@ -451,6 +493,10 @@ impl Receiver {
             invalid_fixes: stats.invalid_fixes,
             mean_llh: stats.mean_llh(),
             mean_pdop: stats.mean_pdop(),
+            ins_aiding: self
+                .aiding
+                .as_ref()
+                .map(|_| InsAidingSummary::new(self.monitor.stats(), duration_s)),
         })
     }
 
@@ -488,7 +534,8 @@ impl Receiver {
     fn step(&mut self, limit: u64, sink: &mut dyn Sink) -> Result<(), ReceiverError> {
         let view = self.window.view().until(limit);
         let due = self.manager.due_search(view);
-        let aid = self.aiding.as_ref().map(|a| a as &dyn AidingPort);
+        let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
+        let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
         let found = self.manager.work(view, due, aid);
         self.processed_to = Some(limit);
         self.deliver(found, limit, sink)
@@ -505,9 +552,21 @@ impl Receiver {
     ) -> Result<(), ReceiverError> {
         let nav = &mut self.nav;
         let aiding = self.aiding.as_ref();
+        let monitor = &mut self.monitor;
+        let predict = |prn: u8, t: f64| aiding.and_then(|ff| ff.predicted_doppler_hz(prn, t));
         self.manager
-            .drain_reports(|i, e| nav.on_report(i, e, aiding, sink))
+            .drain_reports(|i, e| {
+                if aiding.is_some() {
+                    monitor.observe(i, e, &predict);
+                }
+                nav.on_report(i, e, aiding, sink)
+            })
             .map_err(ReceiverError::Sink)?;
+        if let (Some(ff), Some(done)) = (aiding, self.processed_to) {
+            let t_first = self.first_sample.unwrap_or(0) as f64 / self.fs_hz;
+            let t_done = done as f64 / self.fs_hz;
+            monitor.evaluate(t_first, t_done, ff.expected_common_residual_hz(), &predict);
+        }
         if nav
             .end_block(end, sink)
             .map_err(ReceiverError::Sink)?
@@ -543,4 +602,16 @@ impl Receiver {
         }
         Ok(())
     }
+}
+
+/// The aiding port for the next round: the INS feed-forward for the satellites the integrity
+/// monitor admits (None without an INS).
+fn gated_aid<'a>(
+    aiding: Option<&'a InsFeedForward>,
+    monitor: &AidMonitor,
+) -> Option<GatedAid<'a, InsFeedForward>> {
+    aiding.map(|port| GatedAid {
+        port,
+        permission: monitor.permission(),
+    })
 }

@@ -175,6 +175,29 @@ fn print_report(out: &mut dyn Write, report: &RunReport, args: &RunArgs) -> std:
             "no fix: the recording ended before 4 satellites had their ephemeris (subframes 1-3 take 18-30 s; give --nav FILE to start sooner)"
         )?,
     }
+    if let Some(a) = &s.ins_aiding {
+        let times = |n: usize| {
+            if n == 1 {
+                "once".to_string()
+            } else {
+                format!("{n} times")
+            }
+        };
+        write!(
+            out,
+            "INS aiding: {:.1} s of {:.1} s aided ({:.0} %)",
+            a.aided_s,
+            s.duration_s,
+            100.0 * a.aided_fraction
+        )?;
+        if a.rejections > 0 {
+            writeln!(out, "; the INS was rejected {} for disagreeing with the tracked Doppler (see the warnings), the loops ran unaided meanwhile", times(a.rejections))?;
+        } else if a.admissions == 0 {
+            writeln!(out, "; the feed-forward was never verified against the tracked Doppler (3 satellites in phase lock and the INS, GPS time and ephemerides needed), the loops ran unaided")?;
+        } else {
+            writeln!(out)?;
+        }
+    }
     if let Some([g, f, d]) = report.fused_rows {
         writeln!(
             out,
