@@ -5,7 +5,7 @@
 //! |---|---|
 //! | 0 | done (also when standard output was closed early, e.g. `gpsrx ... \| head -1`) |
 //! | 1 | an error: bad input, a file that cannot be read or written (the message says which) |
-//! | 2 | `gpsrx run` processed the recording but made no valid fix (the summary says why) |
+//! | 2 | `gpsrx run` (or `gpsrx demo`) processed the recording but made no valid fix (the summary says why) |
 //! | 130 | a second Ctrl-C |
 
 use std::io::{self, Write};

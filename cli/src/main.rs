@@ -1,7 +1,8 @@
 //! `gpsrx`: the command-line GPS L1 C/A receiver.
 //!
 //! Exit status (see [`gpsrx_cli::exit`]): 0 done (also when standard output is closed early, as
-//! by `| head`), 1 an error (one line on standard error), 2 `gpsrx run` made no valid fix.
+//! by `| head`), 1 an error (one line on standard error), 2 `gpsrx run` or `gpsrx demo` made
+//! no valid fix.
 
 use clap::Parser;
 use gpsrx_cli::cli::{Cli, Command};
@@ -24,7 +25,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(args) => done(commands::simulate::run(&args)),
         Command::Info(args) => done(commands::info::run(&args)),
-        Command::Demo(args) => done(commands::demo::run(&args)),
+        Command::Demo(args) => commands::demo::run(&args),
         Command::Acquire(args) => done(commands::acquire::run(&args)),
         Command::Track(args) => done(commands::track::run(&args)),
         Command::Run(args) => commands::run::run(&args),

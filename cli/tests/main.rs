@@ -7,6 +7,7 @@ mod acquisition;
 mod aided_run;
 mod bad_input;
 mod bench;
+mod dating;
 mod dr_run;
 mod ins_simulate;
 mod outputs;

@@ -168,6 +168,7 @@ fn test_fix() -> Fix {
     let east = Vector3::new(-llh.lon_rad.sin(), llh.lon_rad.cos(), 0.0) * 10.0;
     Fix {
         time: GpsTime::from_calendar(2022, 1, 1, 5, 30, 0.0),
+        week_known: true,
         ecef_m: [ecef.x, ecef.y, ecef.z],
         llh,
         vel_ecef_mps: Some([east.x, east.y, east.z]),
@@ -238,6 +239,13 @@ fn gga_known_answer_and_checksums() {
         "10 m/s east"
     );
     assert_eq!(f[12], "A");
+    // The week unknown: the time of day stands, the date is left empty (never invented).
+    let undated = Fix {
+        week_known: false,
+        ..fix.clone()
+    };
+    let f = parse_nmea(&rmc(&undated, &opts));
+    assert_eq!((f[1].as_str(), f[9].as_str()), ("052942.00", ""));
 
     let gsv = gsv(&fix);
     assert_eq!(gsv.len(), 3, "9 satellites, 4 per sentence");
@@ -335,6 +343,12 @@ fn pvt_and_channel_csv_columns() {
     for f in &track() {
         w.write_fix(f).expect("in memory");
     }
+    // A fix whose week is unknown: gps_week empty, the time of week kept.
+    w.write_fix(&Fix {
+        week_known: false,
+        ..track()[0].clone()
+    })
+    .expect("in memory");
     let bytes = w.finish().expect("flush");
     let mut r = csv::Reader::from_reader(bytes.as_slice());
     let header: Vec<String> = r
@@ -346,17 +360,20 @@ fn pvt_and_channel_csv_columns() {
     let leading = "gps_week,tow_s,x_m,y_m,z_m,lat_deg,lon_deg,h_m,vx_mps,vy_mps,vz_mps,clock_bias_m,clock_drift_mps,n_sv,pdop,hdop,vdop,raim";
     assert_eq!(header[..18].join(","), leading);
     let rows: Vec<csv::StringRecord> = r.records().map(|x| x.expect("row")).collect();
-    assert_eq!(rows.len(), 5);
+    assert_eq!(rows.len(), 6);
     assert_eq!(&rows[0][0], "2190");
     assert_eq!(&rows[0][1], "538200.000");
+    assert_eq!((&rows[5][0], &rows[5][1]), ("", "538200.000"));
     assert_eq!(&rows[0][17], "ok, passed", "quoted comma survives");
     assert_eq!(&rows[2][15], "", "NaN HDOP is an empty cell");
     let lat: f64 = rows[0][5].parse().expect("lat");
     assert!((lat - 48.1173).abs() < 1e-9);
 
     let mut w = ChannelCsvWriter::new(Vec::new(), "channels.csv").expect("header");
-    w.write_row(&ChannelRow {
-        time: GpsTime::new(2190, 541_800.0),
+    let row = ChannelRow {
+        time: Some(GpsTime::new(2190, 541_800.0)),
+        week_known: true,
+        t_stream_s: 12.5,
         channel: 3,
         prn: 14,
         state: "tracking".to_string(),
@@ -368,14 +385,35 @@ fn pvt_and_channel_csv_columns() {
         carrier_lock: true,
         bit_sync: true,
         frame_sync: false,
+    };
+    w.write_row(&row).expect("in memory");
+    // The week unknown (never a system-clock week), then the time not yet known at all.
+    w.write_row(&ChannelRow {
+        week_known: false,
+        ..row.clone()
+    })
+    .expect("in memory");
+    w.write_row(&ChannelRow {
+        time: None,
+        week_known: false,
+        t_stream_s: 0.25,
+        ..row
     })
     .expect("in memory");
     let text = String::from_utf8(w.finish().expect("flush")).expect("UTF-8");
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines[0], "gps_week,tow_s,channel,prn,state,cn0_dbhz,doppler_hz,code_phase_chips,pll_lock_indicator,code_lock,carrier_lock,bit_sync,frame_sync");
+    assert_eq!(lines[0], "gps_week,tow_s,channel,prn,state,cn0_dbhz,doppler_hz,code_phase_chips,pll_lock_indicator,code_lock,carrier_lock,bit_sync,frame_sync,t_stream_s");
     assert_eq!(
         lines[1],
-        "2190,541800.000,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0"
+        "2190,541800.000,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,12.500"
+    );
+    assert_eq!(
+        lines[2],
+        ",541800.000,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,12.500"
+    );
+    assert_eq!(
+        lines[3],
+        ",,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,0.250"
     );
 }
 

@@ -258,12 +258,15 @@ fn a_recording_too_short_for_a_fix_ends_with_a_message_not_an_error() {
 #[test]
 fn observables_before_the_first_fix_carry_the_decoded_week() {
     // 16 s: subframe 1 (TOW 538200-538206) is decoded, subframe 3 is not, so no fix. Without
-    // --week the reference week is today's; the epochs before subframe 1 were labelled with it
-    // and must be written with the decoded week 2190, in increasing time.
+    // its metadata the recording has no date and there is no --week: the epochs before
+    // subframe 1 are held back (labelled with today's week, which is never written) and must
+    // be written with the decoded week 2190, in increasing time.
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
     let data = simulate(STATIC_BUSAN, 16.0, dir.path());
+    std::fs::remove_file(gpsrx_samples::sigmf::meta_path_for(&data))
+        .unwrap_or_else(|e| panic!("{e}"));
     let out = dir.path().join("out");
-    let fixes = run(&data, &out, &[]);
+    let fixes = run(&data, &out, &["--format", "ci8", "--fs", "2.048e6"]);
     assert!(fixes.is_empty(), "{} fixes from 16 s", fixes.len());
     let text =
         std::fs::read_to_string(out.join("observables.rnx")).unwrap_or_else(|e| panic!("{e}"));

@@ -55,8 +55,9 @@ pub struct RunSettings {
     pub acq_noncoherent: u32,
     /// Use satellites whose ephemeris says they are unhealthy.
     pub allow_unhealthy: bool,
-    /// Full GPS week near the recording, to resolve the broadcast 10-bit week (default: the
-    /// navigation file's, else the current week).
+    /// Full GPS week of the recording: labels times until subframe 1 gives the week, and
+    /// resolves the broadcast 10-bit week (default: the recording's date, else the navigation
+    /// file's week; else unknown, see [`crate::pipeline::dating`]).
     pub week: Option<u32>,
     /// PRNs to search for (empty: all 32).
     pub prns: Vec<u8>,

@@ -54,7 +54,7 @@ fn has_extension(path: &Path, ext: &str) -> bool {
 }
 
 /// Finds the data file and its metadata file for `path`.
-fn locate(path: &Path) -> Result<(PathBuf, Option<PathBuf>), SampleError> {
+pub(crate) fn locate(path: &Path) -> Result<(PathBuf, Option<PathBuf>), SampleError> {
     if has_extension(path, "sigmf-meta") {
         let data = path.with_extension("sigmf-data");
         if !data.is_file() {

@@ -15,7 +15,8 @@
 //!     "gpsrx:packed_map": [1.0, 3.0, -3.0, -1.0],   // only for ci2/ri2
 //!     "gpsrx:start_gps_week": 2190                  // any `extra` keys
 //!   },
-//!   "captures": [{ "core:sample_start": 0, "core:frequency": 1575420000.0 }],
+//!   "captures": [{ "core:sample_start": 0, "core:frequency": 1575420000.0,
+//!                  "core:datetime": "2022-01-01T05:29:42.000000Z" }],
 //!   "annotations": []
 //! }
 //! ```
@@ -24,6 +25,11 @@
 //! `gpsrx:invert_q` says the Q channel must be negated (x = I - jQ), `gpsrx:packed_map` gives the
 //! value of 2-bit codes 0b00..0b11. The packed datatypes `ci2`, `ri2`, `ci1` are gpsrx names, not
 //! SigMF 1.x ones (see [`crate::format`]).
+//!
+//! `core:datetime` (ISO 8601, UTC) is the time of the capture's first sample
+//! (`core:sample_start`): [`SigmfMeta::start_time`] converts it to GPS time (leap seconds
+//! from [`gpsrx_nav::utc::leap_seconds_on`]), which dates a receiver's outputs before the
+//! broadcast week is decoded. A global `core:datetime` is read too (some tools put it there).
 
 use std::path::{Path, PathBuf};
 
@@ -31,6 +37,8 @@ use serde_json::{json, Map, Value};
 
 use crate::error::SampleError;
 use crate::format::SampleFormat;
+use gpsrx_nav::utc::{gps_from_utc, utc_from_gps};
+use gpsrx_nav::GpsTime;
 
 /// GPS L1 carrier frequency, the default `core:frequency` of a capture (IS-GPS-200 3.3.1.1).
 pub use gpsrx_core::constants::F_L1_HZ as GPS_L1_HZ;
@@ -45,6 +53,7 @@ const KNOWN_GLOBAL_KEYS: &[&str] = &[
     "gpsrx:if_hz",
     "gpsrx:invert_q",
     "gpsrx:packed_map",
+    "core:datetime",
 ];
 
 /// The parts of a SigMF metadata file gpsrx uses.
@@ -64,8 +73,23 @@ pub struct SigmfMeta {
     pub packed_map: Option<[f32; 4]>,
     /// `core:description` ("" when absent).
     pub description: String,
+    /// `core:datetime` of the first capture (else of the global object): ISO 8601 UTC time of
+    /// the capture's first sample, as written (see [`SigmfMeta::start_time`]).
+    pub datetime: Option<String>,
+    /// `captures[0].core:sample_start`: the sample `datetime` refers to (0 when absent).
+    pub capture_sample_start: u64,
     /// Every other global key, e.g. `gpsrx:start_gps_week`, `gpsrx:start_tow_s`, `core:author`.
     pub extra: Map<String, Value>,
+}
+
+/// When a recording started, as its metadata says.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordingStart {
+    /// GPS time of the first sample of the data file.
+    pub time: GpsTime,
+    /// Where it comes from, for messages (e.g. `core:datetime 2022-01-01T05:29:42Z of
+    /// rec.sigmf-meta`).
+    pub origin: String,
 }
 
 impl SigmfMeta {
@@ -79,9 +103,135 @@ impl SigmfMeta {
             invert_q: false,
             packed_map: None,
             description: String::new(),
+            datetime: None,
+            capture_sample_start: 0,
             extra: Map::new(),
         }
     }
+
+    /// GPS time of the data file's first sample: `core:datetime` (UTC, converted with the leap
+    /// seconds) less `core:sample_start` samples, else `gpsrx:start_gps_week` with
+    /// `gpsrx:start_tow_s` (what older gpsrx simulations wrote). `Ok(None)` when neither is
+    /// given; an error (the reason) when `core:datetime` is not an ISO 8601 date and time.
+    pub fn start_time(&self) -> Result<Option<(GpsTime, String)>, String> {
+        if let Some(text) = &self.datetime {
+            let t = parse_datetime_utc(text)?;
+            let before_s = if self.sample_rate_hz > 0.0 {
+                self.capture_sample_start as f64 / self.sample_rate_hz
+            } else {
+                0.0
+            };
+            return Ok(Some((
+                t.add_seconds(-before_s),
+                format!("core:datetime {text}"),
+            )));
+        }
+        let week = self
+            .extra
+            .get("gpsrx:start_gps_week")
+            .and_then(Value::as_u64);
+        let tow = self.extra.get("gpsrx:start_tow_s").and_then(Value::as_f64);
+        Ok(match (week.and_then(|w| u32::try_from(w).ok()), tow) {
+            (Some(w), Some(tow)) if tow.is_finite() => {
+                Some((GpsTime::new(w, tow), format!("gpsrx:start_gps_week {w}")))
+            }
+            _ => None,
+        })
+    }
+}
+
+/// The GPS time of an ISO 8601 date and time in UTC: `YYYY-MM-DDTHH:MM:SS[.fraction]` followed
+/// by `Z` (SigMF's form), or by an offset `+HH:MM`/`-HH:MM` (applied), or by nothing (read as
+/// UTC). The error says what is wrong.
+pub fn parse_datetime_utc(text: &str) -> Result<GpsTime, String> {
+    let bad = |why: &str| {
+        format!("{text:?} is not an ISO 8601 UTC date and time (YYYY-MM-DDTHH:MM:SS[.fff]Z): {why}")
+    };
+    let s = text.trim();
+    if !s.is_ascii() {
+        return Err(bad("non-ASCII characters"));
+    }
+    if s.len() < 19 {
+        return Err(bad("too short"));
+    }
+    let (date, rest) = s.split_at(10);
+    let sep = rest.as_bytes()[0];
+    if !matches!(sep, b'T' | b't' | b' ') {
+        return Err(bad("no `T` between the date and the time"));
+    }
+    let rest = &rest[1..];
+    // The zone: `Z`, `+HH:MM`, `-HH:MM`, `+HHMM` or nothing.
+    let (clock, offset_s) = if let Some(c) = rest.strip_suffix(['Z', 'z']) {
+        (c, 0.0)
+    } else if let Some(i) = rest.rfind(['+', '-']) {
+        let zone = rest[i + 1..].replace(':', "");
+        let (Some(hh), Some(mm)) = (
+            zone.get(..2).and_then(|v| v.parse::<u32>().ok()),
+            zone.get(2..).and_then(|v| v.parse::<u32>().ok()),
+        ) else {
+            return Err(bad("the zone offset is not +HH:MM"));
+        };
+        if zone.len() != 4 || hh > 23 || mm > 59 {
+            return Err(bad("the zone offset is not +HH:MM"));
+        }
+        let sign = if rest.as_bytes()[i] == b'-' {
+            -1.0
+        } else {
+            1.0
+        };
+        (&rest[..i], sign * f64::from(hh * 3600 + mm * 60))
+    } else {
+        (rest, 0.0)
+    };
+    let field = |v: Option<&str>, lo: u32, hi: u32, name: &str| -> Result<u32, String> {
+        v.filter(|v| !v.is_empty() && v.bytes().all(|b| b.is_ascii_digit()))
+            .and_then(|v| v.parse::<u32>().ok())
+            .filter(|n| (lo..=hi).contains(n))
+            .ok_or_else(|| bad(&format!("bad {name}")))
+    };
+    let mut d = date.split('-');
+    let (year, month, day) = (
+        field(d.next(), 1980, 9999, "year")?,
+        field(d.next(), 1, 12, "month")?,
+        field(d.next(), 1, 31, "day")?,
+    );
+    if d.next().is_some() || date.len() != 10 {
+        return Err(bad("the date is not YYYY-MM-DD"));
+    }
+    let mut c = clock.splitn(3, ':');
+    let (hour, min) = (
+        field(c.next(), 0, 23, "hour")?,
+        field(c.next(), 0, 59, "minute")?,
+    );
+    let sec_text = c.next().unwrap_or_default();
+    let (whole, frac) = sec_text.split_once('.').unwrap_or((sec_text, ""));
+    let whole = field(Some(whole), 0, 60, "second")?;
+    if !frac.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(bad("bad fraction of a second"));
+    }
+    let frac: f64 = if frac.is_empty() {
+        0.0
+    } else {
+        format!("0.{frac}")
+            .parse()
+            .map_err(|_| bad("bad fraction of a second"))?
+    };
+    let year = i32::try_from(year).map_err(|_| bad("bad year"))?;
+    Ok(gps_from_utc(year, month, day, hour, min, f64::from(whole) + frac).add_seconds(-offset_s))
+}
+
+/// ISO 8601 UTC text (`YYYY-MM-DDTHH:MM:SS.ffffffZ`, microseconds) of GPS time `t`, as SigMF's
+/// `core:datetime` wants it.
+pub fn format_datetime_utc(t: GpsTime) -> String {
+    // Round on the microsecond first, so the seconds never print as 60.
+    let t = GpsTime::new(t.week, (t.tow_s * 1e6).round() * 1e-6);
+    let (y, mo, d, h, mi, s) = utc_from_gps(t);
+    let micros = ((s * 1e6).round() as u64).min(59_999_999);
+    format!(
+        "{y:04}-{mo:02}-{d:02}T{h:02}:{mi:02}:{:02}.{:06}Z",
+        micros / 1_000_000,
+        micros % 1_000_000
+    )
 }
 
 impl SigmfMeta {
@@ -154,6 +304,9 @@ pub fn write_sigmf_meta(data_path: &Path, meta: &SigmfMeta) -> Result<PathBuf, S
     if let Some(f) = meta.frequency_hz {
         capture.insert("core:frequency".into(), json!(f));
     }
+    if let Some(t) = &meta.datetime {
+        capture.insert("core:datetime".into(), json!(t));
+    }
     let doc = json!({ "global": global, "captures": [capture], "annotations": [] });
     let text = serde_json::to_string_pretty(&doc).map_err(|e| SampleError::SigmfInvalid {
         path: meta_path.clone(),
@@ -211,12 +364,22 @@ pub fn read_sigmf_meta(path: &Path) -> Result<SigmfMeta, SampleError> {
         .and_then(Value::as_str)
         .unwrap_or_default()
         .to_string();
-    let frequency_hz = doc
+    let capture = doc
         .get("captures")
         .and_then(Value::as_array)
-        .and_then(|c| c.first())
+        .and_then(|c| c.first());
+    let frequency_hz = capture
         .and_then(|c| c.get("core:frequency"))
         .and_then(Value::as_f64);
+    let datetime = capture
+        .and_then(|c| c.get("core:datetime"))
+        .or_else(|| global.get("core:datetime"))
+        .and_then(Value::as_str)
+        .map(str::to_string);
+    let capture_sample_start = capture
+        .and_then(|c| c.get("core:sample_start"))
+        .and_then(Value::as_u64)
+        .unwrap_or(0);
     let extra = global
         .iter()
         .filter(|(k, _)| !KNOWN_GLOBAL_KEYS.contains(&k.as_str()))
@@ -230,6 +393,8 @@ pub fn read_sigmf_meta(path: &Path) -> Result<SigmfMeta, SampleError> {
         invert_q,
         packed_map,
         description,
+        datetime,
+        capture_sample_start,
         extra,
     })
 }
@@ -244,4 +409,28 @@ fn parse_map(v: &Value) -> Option<[f32; 4]> {
         *m = x.as_f64()? as f32;
     }
     Some(map)
+}
+
+/// The start of the recording at `path` (a data file or its `.sigmf-meta`), when SigMF
+/// metadata beside it gives one ([`SigmfMeta::start_time`]); `Ok(None)` for standard input,
+/// a recording without metadata, or metadata without a date. An unreadable `core:datetime` is
+/// an error ([`SampleError::SigmfInvalid`]).
+pub fn recording_start(path: &Path) -> Result<Option<RecordingStart>, SampleError> {
+    if crate::stream_source::is_stdin_path(path) || !path.exists() {
+        return Ok(None);
+    }
+    let (_, Some(meta_path)) = crate::resolve::locate(path)? else {
+        return Ok(None);
+    };
+    let meta = read_sigmf_meta(&meta_path)?;
+    let start = meta
+        .start_time()
+        .map_err(|reason| SampleError::SigmfInvalid {
+            path: meta_path.clone(),
+            reason,
+        })?;
+    Ok(start.map(|(time, what)| RecordingStart {
+        time,
+        origin: format!("{what} of {}", meta_path.display()),
+    }))
 }

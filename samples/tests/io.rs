@@ -7,7 +7,10 @@ use std::path::{Path, PathBuf};
 
 use gpsrx_samples::format::DEFAULT_PACKED2_MAP;
 use gpsrx_samples::info::{inspect, Histogram};
-use gpsrx_samples::sigmf::{read_sigmf_meta, write_sigmf_meta, SigmfMeta};
+use gpsrx_samples::sigmf::{
+    format_datetime_utc, parse_datetime_utc, read_sigmf_meta, recording_start, write_sigmf_meta,
+    SigmfMeta,
+};
 use gpsrx_samples::span::{sample_position, samples_in_bytes, Span};
 use gpsrx_samples::{
     create_wav_writer, create_writer, open_source, SampleError, SampleFormat, SampleSource,
@@ -1327,4 +1330,79 @@ mod stream {
         assert_eq!(streamed.len(), 600_002 - 5);
         assert!(bits(&streamed) == bits(&expected), "pipe and file differ");
     }
+}
+
+#[test]
+fn sigmf_datetime_is_read_as_utc_and_round_trips() {
+    use gpsrx_nav::GpsTime;
+    // 2022-01-01 05:29:42 UTC = 05:30:00 GPS time = week 2190, TOW 538200.
+    let t = parse_datetime_utc("2022-01-01T05:29:42Z").expect("SigMF form");
+    assert_eq!((t.week, t.tow_s), (2190, 538_200.0));
+    for (text, tow) in [
+        ("2022-01-01T05:29:42.250Z", 538_200.25),
+        ("2022-01-01T14:29:42+09:00", 538_200.0),
+        ("2022-01-01T00:29:42-0500", 538_200.0),
+        ("2022-01-01 05:29:42", 538_200.0),
+    ] {
+        let t = parse_datetime_utc(text).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(t.week, 2190, "{text}");
+        assert!((t.tow_s - tow).abs() < 1e-9, "{text}: {}", t.tow_s);
+    }
+    for bad in [
+        "",
+        "2022-01-01",
+        "2022-13-01T00:00:00Z",
+        "2022-01-01T25:00:00Z",
+        "2022-01-01T00:00:00+9",
+        "01/01/2022 00:00:00",
+        "2022-01-01T00:00:0xZ",
+        "2022-01-01T00:00:00.1e3Z",
+        "2022-01-01T\u{e9}0:00:00Z",
+    ] {
+        let e = parse_datetime_utc(bad).expect_err(bad);
+        assert!(e.contains("ISO 8601"), "{e}");
+    }
+    let t = GpsTime::new(2190, 538_200.123_456_7);
+    assert_eq!(format_datetime_utc(t), "2022-01-01T05:29:42.123457Z");
+    let back = parse_datetime_utc(&format_datetime_utc(t)).expect("round trip");
+    assert!(back.diff_s(t).abs() < 1e-6);
+
+    // Written in the first capture, read back; the date of a later sample_start is moved back
+    // to the first sample; an unreadable date is an error naming the file.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let raw = dir.path().join("cap.ci8");
+    write_file(&raw, &SampleFormat::Ci8, &[c(1.0, 2.0); 10]);
+    write_sigmf_meta(
+        &raw,
+        &SigmfMeta {
+            datetime: Some("2022-01-01T05:29:42Z".into()),
+            ..SigmfMeta::new("ci8", FS)
+        },
+    )
+    .expect("meta");
+    let meta = read_sigmf_meta(&raw.with_extension("sigmf-meta")).expect("read");
+    assert_eq!(meta.datetime.as_deref(), Some("2022-01-01T05:29:42Z"));
+    let start = recording_start(&raw).expect("readable").expect("dated");
+    assert_eq!((start.time.week, start.time.tow_s), (2190, 538_200.0));
+    assert!(start.origin.contains("core:datetime"), "{}", start.origin);
+    let later = SigmfMeta {
+        capture_sample_start: (2.0 * FS) as u64,
+        ..meta.clone()
+    };
+    let (t, _) = later.start_time().expect("readable").expect("dated");
+    assert!((t.tow_s - 538_198.0).abs() < 1e-9, "{}", t.tow_s);
+    write_sigmf_meta(
+        &raw,
+        &SigmfMeta {
+            datetime: Some("yesterday".into()),
+            ..SigmfMeta::new("ci8", FS)
+        },
+    )
+    .expect("meta");
+    let e = recording_start(&raw).expect_err("not a date").to_string();
+    assert!(
+        e.contains("cap.sigmf-meta") && e.contains("yesterday"),
+        "{e}"
+    );
+    assert!(recording_start(Path::new("-")).expect("stdin").is_none());
 }

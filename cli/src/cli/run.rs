@@ -50,8 +50,9 @@ pub struct RunArgs {
     /// Observable and fix rate, Hz, 1 to 50 [default: 10].
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
-    /// Full GPS week near the recording, to resolve the broadcast 10-bit week (default: from
-    /// SigMF metadata, else the current week).
+    /// Full GPS week of the recording: labels times until subframe 1 gives the week, and
+    /// resolves the broadcast 10-bit week (default: from the SigMF core:datetime, else the
+    /// navigation file; else unknown, and no output is dated until subframe 1 is decoded).
     #[arg(long, value_name = "WEEK")]
     pub week: Option<u32>,
     /// Doppler search half-width of the acquisition, Hz [default: 5000; 15000 or more for a

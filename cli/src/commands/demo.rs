@@ -3,14 +3,16 @@
 use crate::cli::{DemoArgs, LoopArgs, SourceArgs};
 use crate::commands::run::{run_file, IonoModel, RunArgs, TropoModel};
 use crate::commands::simulate::{print_report, simulate};
+use crate::exit::Completion;
 use anyhow::Context;
 use gpsrx_nav::frames::{enu_rotation, Vector3};
 use gpsrx_samples::sim::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
 
-/// Runs `gpsrx demo`.
-pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
+/// Runs `gpsrx demo`: [`Completion::NoValidFix`] (exit status 2, as `gpsrx run`) when the
+/// receiver made no valid fix on the simulated recording.
+pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
     let mut scenario = Scenario::default_scenario()?;
     if let Some(d) = args.duration {
         scenario.duration_s = d;
@@ -52,7 +54,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         tropo: Some(TropoModel::Saastamoinen),
         elevation_mask: None,
         rate: None,
-        week: Some(scenario.start_time()?.week),
+        // Dated by the recording's SigMF core:datetime, as a user's recording would be.
+        week: None,
         doppler_max: None,
         doppler_center: None,
         acq_coherent_ms: None,
@@ -115,9 +118,16 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
                 (v2 / n).sqrt()
             )?;
         }
-        _ => writeln!(
+        (Some(_), None) => writeln!(out, "{} fixes (no truth position to compare)", fixes.len())?,
+        (None, _) if summary.invalid_fixes > 0 => writeln!(
             out,
-            "no fix (the recording is too short: subframes 1-3 need about 24 s here)"
+            "no valid fix: all {} solutions failed the RAIM test (exit status 2)",
+            summary.invalid_fixes
+        )?,
+        (None, _) => writeln!(
+            out,
+            "no valid fix (exit status 2): the recording ended before 4 satellites had their ephemeris (subframes 1-3 need about 24 s here; --duration {:.0} s)",
+            scenario.duration_s
         )?,
     }
     if args.keep.is_none() {
@@ -127,7 +137,11 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         )?;
     }
     out.flush()?;
-    Ok(())
+    Ok(if summary.fixes == 0 {
+        Completion::NoValidFix
+    } else {
+        Completion::Done
+    })
 }
 
 /// Prints what a receiver should find at the first sample: the truth of every satellite.

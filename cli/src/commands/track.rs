@@ -128,7 +128,11 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
         prns,
         cold_targets: Some(targets),
     };
-    let mut receiver = Receiver::with_search(&config, src.fs_hz(), Assistance::default(), search)?;
+    let assistance = Assistance {
+        recording_start: crate::commands::run::recording_start(&src_cfg),
+        ..Assistance::default()
+    };
+    let mut receiver = Receiver::with_search(&config, src.fs_hz(), assistance, search)?;
     let writer = match &args.out {
         Some(p) => {
             let f = std::fs::File::create(p)

@@ -156,3 +156,33 @@ fn gps_minus_utc_from_brdc() {
         18.0 + 0.279396772385e-08 + 0.799360577730e-14 * (-(604_800.0 - 538_200.0) - 147_456.0);
     assert!((utc.gps_minus_utc_s(t) - expected).abs() < 1e-15);
 }
+
+#[test]
+fn utc_and_gps_time_differ_by_the_leap_seconds_of_the_date() {
+    use gpsrx_nav::utc::{gps_from_utc, leap_seconds_on, utc_from_gps};
+    assert_eq!(leap_seconds_on(1980, 1), 0);
+    assert_eq!(leap_seconds_on(1998, 12), 12);
+    assert_eq!(leap_seconds_on(1999, 1), 13);
+    assert_eq!(leap_seconds_on(2016, 12), 17);
+    assert_eq!(leap_seconds_on(2017, 1), 18);
+    assert_eq!(leap_seconds_on(2026, 11), 18);
+    // 2022-01-01 05:29:42 UTC is week 2190, TOW 538200 (05:30:00 GPS time).
+    let t = gps_from_utc(2022, 1, 1, 5, 29, 42.0);
+    assert_eq!((t.week, t.tow_s), (2190, 538_200.0));
+    let (y, mo, d, h, mi, s) = utc_from_gps(t);
+    assert_eq!((y, mo, d, h, mi), (2022, 1, 1, 5, 29));
+    assert!((s - 42.0).abs() < 1e-9);
+    // Either side of the leap second at the end of 2016 (17 s, then 18 s).
+    let before = gps_from_utc(2016, 12, 31, 23, 59, 59.0);
+    let after = gps_from_utc(2017, 1, 1, 0, 0, 0.0);
+    assert!(
+        (after.diff_s(before) - 2.0).abs() < 1e-9,
+        "the inserted second"
+    );
+    let (y, mo, d, h, mi, s) = utc_from_gps(before);
+    assert_eq!((y, mo, d, h, mi), (2016, 12, 31, 23, 59));
+    assert!((s - 59.0).abs() < 1e-9);
+    let (y, mo, d, h, mi, s) = utc_from_gps(after);
+    assert_eq!((y, mo, d, h, mi), (2017, 1, 1, 0, 0));
+    assert!(s.abs() < 1e-9);
+}

@@ -78,6 +78,8 @@ pub fn fused_as_fixes(fixes: &[FusedFix]) -> Vec<Fix> {
             let vel = [v.x, v.y, v.z];
             Fix {
                 time: f.time,
+                // Fused rows start at the first GNSS fix, which has the week.
+                week_known: true,
                 ecef_m: [f.ecef_m.x, f.ecef_m.y, f.ecef_m.z],
                 llh: f.llh,
                 vel_ecef_mps: Some(vel),

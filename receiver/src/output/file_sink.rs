@@ -2,7 +2,8 @@
 //!
 //! `pvt.csv` and `pvt.nmea` (flushed at every fix, so a live stream can be followed),
 //! `channels.csv`, `observables.rnx` (RINEX 3; held back until the first fix gives the
-//! header's approximate position, or 300 s of observables with the week decoded, or the end),
+//! header's approximate position, or 300 s of observables with the week known, or the end;
+//! never written while the GPS week is unknown, see [`crate::pipeline::dating`]),
 //! `ephemeris.rnx` (the decoded ephemerides, at the end), `track.geojson` and `track.kml` (the
 //! fixes, at the end).
 
@@ -30,6 +31,10 @@ pub struct FileSink {
     channels_csv: ChannelCsvWriter<BufWriter<File>>,
     obs_writer: Option<RinexObsWriter<BufWriter<File>>>,
     obs_backlog: Vec<ObsEpoch>,
+    /// Whether the week of the latest observables was known.
+    obs_week_known: bool,
+    /// Epochs dropped from the backlog while the week was unknown (memory bound).
+    obs_dropped: usize,
     fixes: Vec<Fix>,
 }
 
@@ -38,6 +43,15 @@ impl FileSink {
     /// (the RINEX interval).
     pub fn create(dir: &Path, rate_hz: f64) -> Result<Self, OutputError> {
         std::fs::create_dir_all(dir).map_err(OutputError::io(&dir.display().to_string()))?;
+        // observables.rnx is written later, or not at all (week unknown): a previous run's
+        // must not pass for this run's.
+        let obs = dir.join("observables.rnx");
+        match std::fs::remove_file(&obs) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(OutputError::io(&obs.display().to_string())(e))
+            }
+            _ => {}
+        }
         Ok(Self {
             dir: dir.to_path_buf(),
             rate_hz,
@@ -46,6 +60,8 @@ impl FileSink {
             channels_csv: ChannelCsvWriter::create(&dir.join("channels.csv"))?,
             obs_writer: None,
             obs_backlog: Vec::new(),
+            obs_week_known: false,
+            obs_dropped: 0,
             fixes: Vec::new(),
         })
     }
@@ -73,6 +89,13 @@ impl FileSink {
             interval_s: Some(1.0 / self.rate_hz),
             ..ObsHeader::default()
         };
+        if self.obs_dropped > 0 {
+            tracing::warn!(
+                "observables.rnx starts {:.1} s late: the observables of the first {} epochs came while the GPS week was unknown and were dropped (at most {OBS_BACKLOG_MAX_S} s are held back)",
+                self.obs_dropped as f64 / self.rate_hz,
+                self.obs_dropped
+            );
+        }
         let mut w = RinexObsWriter::create(&self.dir.join("observables.rnx"), header)?;
         let mut last_tow_s = f64::NEG_INFINITY;
         for mut o in self.obs_backlog.drain(..) {
@@ -99,6 +122,19 @@ impl Sink for FileSink {
 
     fn observables(&mut self, report: &ObservablesReport) -> Result<(), SinkError> {
         let week = report.epoch.time.week;
+        self.obs_week_known = report.week_known;
+        if !report.week_known && self.obs_writer.is_none() {
+            // No date from the system clock: held back until the week is known, the latest
+            // 300 s at most.
+            self.obs_backlog.push(report.epoch.clone());
+            let max = (OBS_BACKLOG_MAX_S * self.rate_hz).ceil() as usize;
+            if self.obs_backlog.len() > max {
+                let n = self.obs_backlog.len() - max;
+                self.obs_backlog.drain(..n);
+                self.obs_dropped += n;
+            }
+            return Ok(());
+        }
         match (&mut self.obs_writer, report.fix_position_m) {
             (Some(w), _) => w.write_epoch(&report.epoch)?,
             (None, Some(position)) => {
@@ -111,7 +147,7 @@ impl Sink for FileSink {
                 self.obs_backlog.push(report.epoch.clone());
                 // Bounded memory: without a fix for this long (but with the week decoded, so
                 // the labels will not change), the observables go out with an unknown position.
-                if report.week_decoded
+                if report.week_known
                     && self.obs_backlog.len() as f64 > OBS_BACKLOG_MAX_S * self.rate_hz
                 {
                     self.open_observables(None, week)?;
@@ -135,6 +171,12 @@ impl Sink for FileSink {
         match self.obs_writer.take() {
             Some(w) => {
                 w.finish()?;
+            }
+            None if !self.obs_backlog.is_empty() && !self.obs_week_known => {
+                tracing::warn!(
+                    "observables.rnx not written: the GPS week was never known (no subframe 1 decoded, no SigMF core:datetime, --week or --nav) and RINEX epochs need a date; give --week WEEK or --nav FILE ({} epochs of observables left out)",
+                    self.obs_backlog.len() + self.obs_dropped
+                );
             }
             None if !self.obs_backlog.is_empty() => {
                 // No fix: the observables still go out, with an unknown approximate position,

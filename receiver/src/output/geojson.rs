@@ -69,9 +69,9 @@ pub fn track_feature_collection(fixes: &[Fix]) -> Value {
             "type": "Feature",
             "geometry": { "type": "Point", "coordinates": position(f) },
             "properties": {
-                "gps_week": f.time.week,
+                "gps_week": if f.week_known { json!(f.time.week) } else { Value::Null },
                 "tow_s": num(f.time.tow_s, 3),
-                "time_gpst": gps_iso(f),
+                "time_gpst": if f.week_known { json!(gps_iso(f)) } else { Value::Null },
                 "h_m": num(f.llh.h_m, 3),
                 "quality": f.quality.name(),
                 "n_sv": f.n_sv,

@@ -180,6 +180,10 @@ pub struct SatView {
 pub struct Fix {
     /// GPS time of the solution (receiver time corrected by the clock bias).
     pub time: GpsTime,
+    /// Whether `time.week` is known (decoded, configured, or from the recording's date):
+    /// when not, the writers leave the week and the date out (the time of week and of day
+    /// stand).
+    pub week_known: bool,
     /// ECEF position, m.
     pub ecef_m: [f64; 3],
     /// Geodetic position (WGS-84, height above the ellipsoid).
@@ -211,8 +215,12 @@ pub struct Fix {
 /// Per-channel tracking state at one epoch, one row of `channels.csv`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChannelRow {
-    /// Receiver time of the epoch.
-    pub time: GpsTime,
+    /// Receiver time of the epoch; `None` before the time origin is known (frame sync).
+    pub time: Option<GpsTime>,
+    /// Whether `time.week` is known (see [`Fix::week_known`]).
+    pub week_known: bool,
+    /// Seconds from the first sample of the stream (always known).
+    pub t_stream_s: f64,
     /// Channel number.
     pub channel: u32,
     /// GPS PRN tracked.

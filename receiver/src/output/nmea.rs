@@ -2,7 +2,8 @@
 //!
 //! Each sentence is `$<body>*hh\r\n` where `hh` is the XOR of every byte between `$` and `*`
 //! as two upper-case hexadecimal digits. Times are UTC = GPS time - leap seconds
-//! ([`NmeaOptions::leap_seconds`], 18 s since 2017-01-01).
+//! ([`NmeaOptions::leap_seconds`], 18 s since 2017-01-01). While the GPS week is unknown
+//! ([`Fix::week_known`]) the RMC date is left empty.
 //!
 //! **Altitude.** GGA field 9 is meant to be the altitude above mean sea level (the geoid) and
 //! field 11 the geoid separation N (ellipsoid - geoid). We carry no geoid model: unless the
@@ -156,7 +157,11 @@ pub fn speed_course(fix: &Fix) -> Option<(f64, f64)> {
 /// RMC: time, status (A valid / V invalid), position, speed (knots), course (deg true), date,
 /// magnetic variation (empty), mode (A autonomous, E estimated/dead reckoning, N invalid).
 pub fn rmc(fix: &Fix, opts: &NmeaOptions) -> String {
-    let (time, date) = utc_fields(fix.time, opts.leap_seconds);
+    let (time, mut date) = utc_fields(fix.time, opts.leap_seconds);
+    if !fix.week_known {
+        // The time of day is known, the date is not (never one from the system clock).
+        date.clear();
+    }
     let valid = position_valid(fix);
     let (status, mode) = match fix.quality {
         _ if !valid => ('V', 'N'),

@@ -1,7 +1,9 @@
 //! CSV logs: `pvt.csv` (one row per fix) and `channels.csv` (one row per channel and epoch).
 //!
 //! Missing or non-finite values are empty cells. The leading columns of `pvt.csv` are fixed
-//! ([`PVT_COLUMNS`]); later columns may be added at the end, so read by name.
+//! ([`PVT_COLUMNS`]); later columns may be added at the end, so read by name. `gps_week` is
+//! empty while the week is unknown ([`crate::pipeline::dating`]): never a week from the
+//! system clock.
 
 use super::{create_file, ChannelRow, Fix, OutputError};
 use std::fs::File;
@@ -33,8 +35,10 @@ pub const PVT_COLUMNS: [&str; 20] = [
     "used_prns",
 ];
 
-/// Columns of `channels.csv`.
-pub const CHANNEL_COLUMNS: [&str; 13] = [
+/// Columns of `channels.csv`. `gps_week` and `tow_s` are the receiver time of the row, empty
+/// until it is known (the time of week from frame sync; the week is empty while unknown, see
+/// [`crate::pipeline::dating`]); `t_stream_s` is the time from the first sample, always given.
+pub const CHANNEL_COLUMNS: [&str; 14] = [
     "gps_week",
     "tow_s",
     "channel",
@@ -48,12 +52,22 @@ pub const CHANNEL_COLUMNS: [&str; 13] = [
     "carrier_lock",
     "bit_sync",
     "frame_sync",
+    "t_stream_s",
 ];
 
 /// `v` with `decimals` decimals, or empty when not finite.
 fn cell(v: f64, decimals: usize) -> String {
     if v.is_finite() {
         format!("{v:.decimals$}")
+    } else {
+        String::new()
+    }
+}
+
+/// The GPS week, or empty when it is not known (never a week from the system clock).
+fn week_cell(week: u32, known: bool) -> String {
+    if known {
+        week.to_string()
     } else {
         String::new()
     }
@@ -98,7 +112,7 @@ impl<W: Write> PvtCsvWriter<W> {
         let vel = fix.vel_ecef_mps;
         let prns: Vec<String> = fix.used_prns.iter().map(u8::to_string).collect();
         let row = [
-            fix.time.week.to_string(),
+            week_cell(fix.time.week, fix.week_known),
             cell(fix.time.tow_s, 3),
             cell(fix.ecef_m[0], 3),
             cell(fix.ecef_m[1], 3),
@@ -164,8 +178,9 @@ impl<W: Write> ChannelCsvWriter<W> {
     pub fn write_row(&mut self, row: &ChannelRow) -> Result<(), OutputError> {
         let flag = |b: bool| u8::from(b).to_string();
         let record = [
-            row.time.week.to_string(),
-            cell(row.time.tow_s, 3),
+            row.time
+                .map_or_else(String::new, |t| week_cell(t.week, row.week_known)),
+            row.time.map_or_else(String::new, |t| cell(t.tow_s, 3)),
             row.channel.to_string(),
             row.prn.to_string(),
             row.state.clone(),
@@ -177,6 +192,7 @@ impl<W: Write> ChannelCsvWriter<W> {
             flag(row.carrier_lock),
             flag(row.bit_sync),
             flag(row.frame_sync),
+            cell(row.t_stream_s, 3),
         ];
         self.out.write_record(&record).map_err(csv_err(&self.file))
     }

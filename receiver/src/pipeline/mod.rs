@@ -8,6 +8,7 @@
 //! - [`aiding`]: the INS-velocity Doppler feed-forward for the channels' aiding port;
 //! - [`aid_monitor`]: the integrity check of that feed-forward against the tracked Doppler;
 //! - [`ring`]: the window of recent samples addressed by absolute index;
+//! - [`dating`]: which GPS week labels receiver time before subframe 1 is decoded;
 //! - [`navdata`]: frame sync, subframes, ephemerides and SV time per satellite;
 //! - [`discontinuity`]: lost samples found by a carrier-phase jump common to the satellites;
 //! - [`gap_length`]: the length of lost time from the bit edges and carrier-phase steps;
@@ -17,6 +18,7 @@
 pub mod aid_monitor;
 pub mod aiding;
 pub mod channel_manager;
+pub mod dating;
 pub mod discontinuity;
 pub mod gap_length;
 pub mod navdata;
@@ -28,6 +30,7 @@ pub mod sink;
 pub mod tracker;
 
 pub use channel_manager::SearchSettings;
+pub use dating::{WeekReference, WeekSource};
 pub use receiver::{
     Assistance, AssistanceError, AssistanceFiles, InsAiding, InsAidingSummary, Receiver,
     ReceiverError, RunSummary,

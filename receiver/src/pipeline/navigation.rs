@@ -22,7 +22,6 @@ use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::frames::azimuth_elevation;
 use gpsrx_nav::pvt::{solve, Landmark, PvtOptions, PvtSolution, RaimStatus, SatMeasurement};
 use gpsrx_nav::rinex_nav::NavData;
-use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -69,6 +68,8 @@ pub struct NavigationProcessor {
     fs_hz: f64,
     settings: RunSettings,
     reference_week: u32,
+    /// Whether `reference_week` may date outputs (it is not from the system clock).
+    reference_week_known: bool,
     nav_assist: Option<NavData>,
     landmarks: Vec<LandmarkObservation>,
     decoders: BTreeMap<u8, NavDecoder>,
@@ -254,6 +255,7 @@ impl NavigationProcessor {
             fs_hz,
             settings,
             reference_week,
+            reference_week_known: true,
             nav_assist,
             landmarks,
             decoders: BTreeMap::new(),
@@ -299,6 +301,20 @@ impl NavigationProcessor {
         self.forget_time(t_s, steps);
         sink.event(&ReceiverEvent::SampleGap { t_s })?;
         Ok(Some(d))
+    }
+
+    /// Says whether the reference week may date the outputs (true unless set here): when
+    /// not, times before subframe 1 is decoded carry [`Fix::week_known`] and
+    /// [`ObservablesReport::week_known`] false ([`crate::pipeline::dating`]).
+    pub fn with_reference_week_known(mut self, known: bool) -> Self {
+        self.reference_week_known = known;
+        self
+    }
+
+    /// Whether the week of the times is known: decoded from a subframe 1, or a reference
+    /// week that does not come from the system clock.
+    fn week_known(&self) -> bool {
+        self.reference_week_known || self.decoders.values().any(|d| d.decoded_week().is_some())
     }
 
     /// The fixes so far, summarised.
@@ -671,11 +687,9 @@ impl NavigationProcessor {
             time: self
                 .builder
                 .rx_time_origin()
-                .map(|t0| t0.add_seconds(e.t_rx_s))
-                .unwrap_or(GpsTime {
-                    week: 0,
-                    tow_s: e.t_rx_s,
-                }),
+                .map(|t0| t0.add_seconds(e.t_rx_s)),
+            week_known: self.week_known(),
+            t_stream_s: e.t_rx_s,
             channel: channel as u32,
             prn: e.prn,
             state: format!("{:?}", e.state).to_lowercase(),
@@ -833,6 +847,7 @@ impl NavigationProcessor {
                 .filter(|_| valid)
                 .map(|s| [s.pos_ecef_m.x, s.pos_ecef_m.y, s.pos_ecef_m.z]),
             week_decoded: self.decoders.values().any(|d| d.decoded_week().is_some()),
+            week_known: self.week_known(),
         })?;
         let Some(sol) = solution else {
             return Ok(());
@@ -861,7 +876,7 @@ impl NavigationProcessor {
             // Written for the record, flagged: quality `none` in pvt.csv, GGA quality 0, absent
             // from the GeoJSON and KML tracks; it steers nothing.
             self.stats.invalid_fixes += 1;
-            let mut fix = fix_of(&sol, &epoch, &ephs);
+            let mut fix = fix_of(&sol, &epoch, &ephs, self.week_known());
             fix.quality = FixQuality::None;
             return sink.fix(&FixReport {
                 fix,
@@ -910,7 +925,7 @@ impl NavigationProcessor {
                 sol.dop.pdop
             );
         }
-        let fix = fix_of(&sol, &epoch, &ephs);
+        let fix = fix_of(&sol, &epoch, &ephs, self.week_known());
         if let Some(ff) = aiding {
             ff.set_fix(t_stream_s, sol.pos_ecef_m, sol.clock_drift_mps);
         }
@@ -955,7 +970,12 @@ fn obs_epoch(epoch: &ObservableEpoch) -> ObsEpoch {
 }
 
 /// The fix of a solution, with the satellites in view (azimuth, elevation, C/N0).
-fn fix_of(sol: &PvtSolution, epoch: &ObservableEpoch, ephs: &[(u8, Ephemeris)]) -> Fix {
+fn fix_of(
+    sol: &PvtSolution,
+    epoch: &ObservableEpoch,
+    ephs: &[(u8, Ephemeris)],
+    week_known: bool,
+) -> Fix {
     let sats_in_view = ephs
         .iter()
         .map(|(prn, eph)| {
@@ -977,6 +997,7 @@ fn fix_of(sol: &PvtSolution, epoch: &ObservableEpoch, ephs: &[(u8, Ephemeris)]) 
         .collect();
     Fix {
         time: sol.time,
+        week_known,
         ecef_m: [sol.pos_ecef_m.x, sol.pos_ecef_m.y, sol.pos_ecef_m.z],
         llh: sol.llh,
         vel_ecef_mps: sol.vel_ecef_mps.map(|v| [v.x, v.y, v.z]),

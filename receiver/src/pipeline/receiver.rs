@@ -12,7 +12,7 @@ use crate::landmarks::LandmarkObservation;
 use crate::pipeline::aid_monitor::{AidMonitor, AidingStats, GatedAid};
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
-use crate::pipeline::navdata::current_gps_week;
+use crate::pipeline::dating::WeekReference;
 use crate::pipeline::navigation::NavigationProcessor;
 use crate::pipeline::ring::{block_samples, SampleWindow};
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
@@ -20,6 +20,7 @@ use gpsrx_dsp::acquisition::{AcqConfig, AcqResult};
 use gpsrx_dsp::Prn;
 use gpsrx_ins_aiding::InsTrack;
 use gpsrx_nav::rinex_nav::NavData;
+use gpsrx_samples::sigmf::RecordingStart;
 use gpsrx_samples::{SampleError, SampleSource};
 use gpsrx_tracking::AidingPort;
 use num_complex::Complex32;
@@ -71,6 +72,9 @@ pub struct Assistance {
     pub ins: Option<InsAiding>,
     /// Landmark range observations (seed 001).
     pub landmarks: Vec<LandmarkObservation>,
+    /// When the recording started, from its metadata (SigMF `core:datetime`): dates the
+    /// outputs until subframe 1 gives the week ([`WeekReference`]).
+    pub recording_start: Option<RecordingStart>,
 }
 
 /// The files [`Assistance::read`] takes: each is optional.
@@ -164,6 +168,7 @@ impl Assistance {
             nav,
             ins,
             landmarks,
+            recording_start: None,
         })
     }
 }
@@ -293,18 +298,16 @@ impl Receiver {
         config.validate()?;
         let run = &config.run;
         let manager = ChannelManager::new(fs_hz, config.tracking, search)?;
-        // The week that resolves the broadcast 10-bit week: the configured one, else the
-        // navigation file's, else today's.
-        let reference_week = run
-            .week
-            .or_else(|| {
-                assistance
-                    .nav
-                    .as_ref()
-                    .and_then(|n| n.ephemerides.first())
-                    .map(|e| e.toe.week)
-            })
-            .unwrap_or_else(current_gps_week);
+        // The week that labels receiver time until subframe 1 is decoded, and resolves the
+        // broadcast 10-bit week: configured, else the recording's, else the navigation
+        // file's; else unknown (today's, which resolves the 10-bit week but dates no output).
+        let reference = WeekReference::resolve(
+            run.week,
+            assistance.recording_start.as_ref(),
+            assistance.nav.as_ref(),
+        );
+        reference.log(assistance.recording_start.as_ref());
+        let reference_week = reference.week;
         let aiding = match assistance.ins {
             Some(ins) => Some(Self::feedforward(
                 ins,
@@ -321,7 +324,8 @@ impl Receiver {
             reference_week,
             assistance.nav,
             assistance.landmarks,
-        );
+        )
+        .with_reference_week_known(reference.known());
         Ok(Self {
             fs_hz,
             block: block_samples(fs_hz),

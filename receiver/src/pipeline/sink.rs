@@ -38,6 +38,9 @@ pub struct ObservablesReport {
     /// Whether the GPS week has been decoded (else `epoch.time.week` is the reference week,
     /// which may be 1024 weeks off).
     pub week_decoded: bool,
+    /// Whether `epoch.time.week` is known: decoded, or a reference week that does not come
+    /// from the system clock ([`crate::pipeline::dating`]).
+    pub week_known: bool,
 }
 
 /// Something that happened, for logs and user interfaces.

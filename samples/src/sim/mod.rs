@@ -515,6 +515,10 @@ impl Simulator {
                 _ => None,
             },
             description: format!("gpsrx simulate: {}", self.scenario.description),
+            // The scenario's start (GPS time of the first sample) in UTC, so a receiver dates
+            // the recording as the simulation did.
+            datetime: Some(crate::sigmf::format_datetime_utc(start)),
+            capture_sample_start: 0,
             extra,
         }
     }

@@ -6,14 +6,15 @@
 //! `ephemeris.rnx`, `track.geojson`, `track.kml`, `channels.csv`); with `--dr`/`--accel` the
 //! fixes are then fused with the DR logs (`dr_inputs`).
 
-use crate::commands::source::open_interruptible;
+use crate::commands::source::{interrupted, open_interruptible};
 use crate::exit::Completion;
 use gpsrx_ins_aiding::DrParams;
 use gpsrx_receiver::fusion::gnss::GnssFix;
 use gpsrx_receiver::output::{FileSink, Fix, FixQuality};
 use gpsrx_receiver::pipeline::{AssistanceFiles, FixReport, Progress, Sink, SinkError, Tee};
 use gpsrx_receiver::{Assistance, Receiver, RunSummary};
-use gpsrx_samples::SampleSource;
+use gpsrx_samples::sigmf::RecordingStart;
+use gpsrx_samples::{SampleSource, SourceConfig};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 
@@ -72,6 +73,21 @@ fn assistance(args: &RunArgs) -> anyhow::Result<Assistance> {
     })?)
 }
 
+/// When the recording's first processed sample was taken, from its SigMF `core:datetime`
+/// (moved by the skip); a date that cannot be read is a warning, not an error.
+pub(crate) fn recording_start(cfg: &SourceConfig) -> Option<RecordingStart> {
+    match gpsrx_samples::sigmf::recording_start(&cfg.path) {
+        Ok(start) => start.map(|mut s| {
+            s.time = s.time.add_seconds(cfg.skip_s);
+            s
+        }),
+        Err(e) => {
+            tracing::warn!("{e}: the recording's date is ignored");
+            None
+        }
+    }
+}
+
 /// Logs what the source had to fix up while reading (NaN values read as 0, trailing bytes
 /// dropped, a duration cut at the end of the file).
 pub(crate) fn warn_source(src: &dyn SampleSource) {
@@ -86,7 +102,9 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunRepor
     let src_cfg = args.source.to_config()?;
     let mut src = open_interruptible(&src_cfg)?;
     let dr_inputs = DrInputs::load(args, &config)?;
-    let mut receiver = Receiver::new(&config, src.fs_hz(), assistance(args)?)?;
+    let mut assistance = assistance(args)?;
+    assistance.recording_start = recording_start(&src_cfg);
+    let mut receiver = Receiver::new(&config, src.fs_hz(), assistance)?;
     let bar = if show_progress {
         src.total_samples()
             .map(ProgressBar::new)
@@ -107,7 +125,13 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunRepor
     let run = receiver.run(src.as_mut(), &mut sink);
     bar.finish_and_clear();
     warn_source(src.as_ref());
-    let summary = run?;
+    let summary = match run {
+        // E.g. Ctrl-C on a stream that sent too little for the cold start.
+        Err(e) if interrupted() => {
+            return Err(anyhow::Error::new(e).context("interrupted (Ctrl-C)"))
+        }
+        r => r?,
+    };
     let Tee(files, extra) = sink;
     let mut report = RunReport {
         receiver: summary,
