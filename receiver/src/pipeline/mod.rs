@@ -12,6 +12,7 @@
 //! - [`navdata`]: frame sync, subframes, ephemerides and SV time per satellite;
 //! - [`discontinuity`]: lost samples found by a carrier-phase jump common to the satellites;
 //! - [`gap_length`]: the length of lost time from the bit edges and carrier-phase steps;
+//! - [`sv_time`]: SV times kept across losses of the signal and lost samples;
 //! - [`observables`]: pseudoranges, carrier phase, Doppler at common receiver epochs;
 //! - [`tracker`]: channels alone over a stream (loop studies).
 
@@ -27,6 +28,7 @@ pub mod observables;
 pub mod receiver;
 pub mod ring;
 pub mod sink;
+pub mod sv_time;
 pub mod tracker;
 
 pub use channel_manager::SearchSettings;

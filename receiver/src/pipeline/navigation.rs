@@ -16,6 +16,7 @@ use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
 use crate::pipeline::sink::{
     FixReport, NavigationEnd, ObservablesReport, Progress, ReceiverEvent, Sink, SinkError,
 };
+use crate::pipeline::sv_time::{CarryNote, GapRecovery, SvTimeKeeper};
 use gpsrx_nav::atmosphere::KlobucharParams;
 use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
 use gpsrx_nav::ephemeris::Ephemeris;
@@ -89,154 +90,22 @@ pub struct NavigationProcessor {
     searched: BTreeSet<u8>,
     /// PRNs whose channel reached bit sync or carrier lock in tracking.
     locked: BTreeSet<u8>,
-    /// Per PRN: its SV time, kept over a loss of the signal (see [`SvClock`]).
-    sv_clocks: BTreeMap<u8, SvClock>,
+    /// The satellites' SV times kept over losses and gaps.
+    sv_time: SvTimeKeeper,
     /// Watches for lost samples.
     monitor: DiscontinuityMonitor,
-    /// A gap being recovered from: its stream time (s), and the clock bias (m) and drift (m/s)
-    /// of the last fix before it with that fix's stream time (s).
-    gap: Option<GapRecovery>,
     /// The last valid fix: stream time (s), clock bias after any clock step (m), clock drift
     /// (m/s).
     last_clock: Option<(f64, f64, f64)>,
-    /// Carried SV times refused at the new bit edge: `(stream time s, PRN, offset ms)`.
-    refused: Vec<(f64, u8, f64)>,
     /// Consecutive solutions that failed the integrity test.
     failed_in_row: u32,
     /// A valid fix came since the receiver time was last forgotten.
     time_trusted: bool,
 }
 
-/// What [`NavigationProcessor::track_sv_clock`] found that must be reported.
-#[derive(Debug, Clone, Copy)]
-enum CarryNote {
-    /// A carried SV time fell this far (ms) off the new bit edge.
-    Refused(f64),
-    /// The length of lost samples was resolved.
-    GapResolved {
-        /// Stream time of the gap, s.
-        t_s: f64,
-        /// Its length, ms.
-        length_ms: f64,
-    },
-}
-
-/// What is kept over a sample gap to measure it once the time is re-established.
-#[derive(Debug, Clone)]
-struct GapRecovery {
-    t_s: f64,
-    before: Option<(f64, f64, f64)>,
-    /// The carrier-phase steps at the gap `(step rad, carrier Hz)`: with them, the SV times
-    /// are kept and carried over the gap once its length is resolved
-    /// ([`crate::pipeline::gap_length`]); without, the time comes from frame sync.
-    steps: Vec<(f64, f64)>,
-    /// Per PRN: how far the SV time kept falls off the channel's new bit edge, ms.
-    edge_offsets: BTreeMap<u8, f64>,
-    /// The length resolved, ms.
-    length_ms: Option<f64>,
-    /// The length cannot be resolved: the time comes from frame sync.
-    unresolved: bool,
-    /// Receiver clock steps made while re-establishing the time, ms.
-    stepped_ms: i64,
-}
-
-impl GapRecovery {
-    fn new(t_s: f64, before: Option<(f64, f64, f64)>, steps: Vec<(f64, f64)>) -> Self {
-        let unresolved = steps.len() < crate::pipeline::gap_length::MIN_STEPS;
-        Self {
-            t_s,
-            before,
-            steps,
-            edge_offsets: BTreeMap::new(),
-            length_ms: None,
-            unresolved,
-            stepped_ms: 0,
-        }
-    }
-
-    /// Takes the offset `off_ms` of `prn`'s kept SV time from its new bit edge; once
-    /// [`crate::pipeline::discontinuity::MIN_SATELLITES`] offsets agree (0.1 ms), resolves the
-    /// length with the phase steps (or gives up). Returns whether the length was just resolved.
-    fn add_edge_offset(&mut self, prn: u8, off_ms: f64) -> bool {
-        self.edge_offsets.insert(prn, off_ms);
-        let agreeing: Vec<f64> = self
-            .edge_offsets
-            .values()
-            .filter(|o| (*o - off_ms).abs() < 0.1)
-            .copied()
-            .collect();
-        if agreeing.len() < crate::pipeline::discontinuity::MIN_SATELLITES {
-            return false;
-        }
-        let mean = agreeing.iter().sum::<f64>() / agreeing.len() as f64;
-        // The kept time is g late: it falls -g (mod 20 ms) off the true bit edge.
-        let offset = (-mean).rem_euclid(20.0);
-        self.length_ms = crate::pipeline::gap_length::resolve_gap_ms(offset, &self.steps, 1000.0);
-        self.unresolved = self.length_ms.is_none();
-        self.length_ms.is_some()
-    }
-}
-
-impl GapRecovery {
-    /// The gap's length (ms) from the clock bias `bias_m` of the first fix after it, at stream
-    /// time `t_s`: the receiver counts samples, so lost samples make its time run late by the
-    /// gap and the clock bias (receiver minus GPS time) drops by `c g` from its prediction
-    /// `b0 + d (t - t0)`.
-    fn length_from_bias_ms(&self, t_s: f64, bias_m: f64) -> Option<f64> {
-        let (t0, b0, d) = self.before?;
-        let predicted = b0 + d * (t_s - t0);
-        Some(-(bias_m - predicted) / SPEED_OF_LIGHT_MPS * 1e3 + self.stepped_ms as f64)
-    }
-}
-
-/// The longest outage an SV time is carried over, s. The carried time is a prediction with
-/// the code rate at the loss; it must be right to well within 10 ms (half a data bit), which
-/// holds for minutes (a Doppler change of 1 Hz/s costs 0.3 us over 30 s; a receiver moving
-/// 300 m/s off the prediction costs 1 us per second).
-const SV_CLOCK_CARRY_S: f64 = 120.0;
-
-/// The longest a rough SV time serves as a frame-sync hint, s, and its tolerance, s (lost
-/// samples of up to that much are then re-established 1.2 s after the next subframe starts).
-const SV_CLOCK_HINT_S: f64 = 600.0;
-const SV_CLOCK_HINT_TOLERANCE_S: f64 = 3.0;
-
 /// Solutions failing the integrity test in a row, after a valid one, that make the receiver
 /// time suspect.
 const FAILURES_TO_DISTRUST_TIME: u32 = 5;
-
-/// A satellite's SV time at a sample, with its rate: where the code of the last usable report
-/// stood. After the channel has lost the signal, the SV time of a new channel's bit edge is
-/// predicted from it, `sv(k) = sv_ref + (k - k_ref) / fs * r / 1.023 MHz` for the code rate `r`,
-/// and rounded to the 20 ms data bit (the bit edge the channel found): the satellite's time is
-/// known again as soon as its new channel has bit sync, without waiting 6-12 s for frame sync.
-#[derive(Debug, Clone, Copy)]
-struct SvClock {
-    /// Sample index of the reference point.
-    sample: u64,
-    /// SV time at it (TOW, s).
-    sv_tow_s: f64,
-    /// SV seconds per receiver second (code rate / 1.023 MHz).
-    rate: f64,
-    /// Known only roughly (samples may have been lost since): not carried over, only a hint
-    /// for frame sync ([`NavDecoder::hint_time`]).
-    rough: bool,
-}
-
-/// Marks the SV time of `prn` (all with `None`) as rough: samples may have been lost.
-fn make_rough(clocks: &mut BTreeMap<u8, SvClock>, prn: Option<u8>) {
-    for (p, c) in clocks.iter_mut() {
-        if prn.is_none_or(|q| q == *p) {
-            c.rough = true;
-        }
-    }
-}
-
-impl SvClock {
-    /// The predicted SV time at sample `k` for samples at `fs_hz`.
-    fn at(&self, k: u64, fs_hz: f64) -> f64 {
-        self.sv_tow_s + (k as f64 - self.sample as f64) / fs_hz * self.rate
-    }
-}
 
 impl NavigationProcessor {
     /// A processor for samples at `fs_hz`. `cn0_lost_dbhz`: reports below it give no
@@ -269,11 +138,9 @@ impl NavigationProcessor {
             cn0_lost_dbhz,
             searched: BTreeSet::new(),
             locked: BTreeSet::new(),
-            sv_clocks: BTreeMap::new(),
+            sv_time: SvTimeKeeper::default(),
             monitor: DiscontinuityMonitor::new(fs_hz),
-            gap: None,
             last_clock: None,
-            refused: Vec::new(),
             failed_in_row: 0,
             time_trusted: false,
         }
@@ -367,7 +234,13 @@ impl NavigationProcessor {
             self.locked.insert(e.prn);
         }
         self.decode(e, aiding, sink)?;
-        match self.track_sv_clock(e) {
+        let usable =
+            e.pll_lock && e.state != ChannelState::Lost && e.cn0_dbhz >= self.cn0_lost_dbhz;
+        let note = match self.decoders.get_mut(&e.prn) {
+            Some(dec) => self.sv_time.observe(e, dec, self.fs_hz, usable),
+            None => None,
+        };
+        match note {
             Some(CarryNote::Refused(off_ms)) => self.on_refused(e.t_rx_s, e.prn, off_ms, sink)?,
             Some(CarryNote::GapResolved { t_s, length_ms }) => {
                 tracing::warn!(
@@ -451,7 +324,7 @@ impl NavigationProcessor {
                             "G{:02}: the bit edges found disagree with the SV time carried over the outage by {offset_ms:.3} ms (samples lost?): waiting for frame sync",
                             e.prn
                         );
-                        make_rough(&mut self.sv_clocks, Some(e.prn));
+                        self.sv_time.make_rough(Some(e.prn));
                     }
                     _ => {}
                 }
@@ -478,10 +351,10 @@ impl NavigationProcessor {
             dec.reset_sync();
         }
         if steps.is_empty() {
-            make_rough(&mut self.sv_clocks, None);
+            self.sv_time.make_rough(None);
         }
         self.builder.restart();
-        self.gap = Some(GapRecovery::new(t_s, self.last_clock, steps));
+        self.sv_time.gap = Some(GapRecovery::new(t_s, self.last_clock, steps));
         self.prior = None;
     }
 
@@ -496,15 +369,18 @@ impl NavigationProcessor {
         off_ms: f64,
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
-        self.refused.retain(|r| t_s - r.0 < 2.0 && r.1 != prn);
-        self.refused.push((t_s, prn, off_ms));
+        self.sv_time
+            .refused
+            .retain(|r| t_s - r.0 < 2.0 && r.1 != prn);
+        self.sv_time.refused.push((t_s, prn, off_ms));
         let agreeing = self
+            .sv_time
             .refused
             .iter()
             .filter(|r| (r.2 - off_ms).abs() < 0.1)
             .count();
         if agreeing >= crate::pipeline::discontinuity::MIN_SATELLITES {
-            self.refused.clear();
+            self.sv_time.refused.clear();
             tracing::warn!(
                 "{t_s:.3} s: samples lost during the outage: the SV times carried over it are {:.3} ms (modulo 20 ms) off the new bit edges of {agreeing} satellites; waiting for frame sync",
                 -off_ms
@@ -536,12 +412,13 @@ impl NavigationProcessor {
             if let Some(d) = self.decoders.get_mut(&p) {
                 d.reset_sync();
             }
-            make_rough(&mut self.sv_clocks, Some(p));
+            self.sv_time.make_rough(Some(p));
         }
         self.builder.restart();
         self.failed_in_row = 0;
         let before = self.last_clock;
-        self.gap
+        self.sv_time
+            .gap
             .get_or_insert_with(|| GapRecovery::new(t_s, before, Vec::new()));
     }
 
@@ -551,7 +428,8 @@ impl NavigationProcessor {
     /// of a second leave the receiver time a second late, which the least squares cannot take
     /// up as a clock bias from a cold start.
     fn realign_clock(&mut self, e: &ChannelEpoch, sink: &mut dyn Sink) -> Result<(), SinkError> {
-        let (Some(gap), Some(t0)) = (self.gap.as_mut(), self.builder.rx_time_origin()) else {
+        let (Some(gap), Some(t0)) = (self.sv_time.gap.as_mut(), self.builder.rx_time_origin())
+        else {
             return Ok(());
         };
         let Some(dec) = self.decoders.get(&e.prn) else {
@@ -573,98 +451,6 @@ impl NavigationProcessor {
         self.builder.step_clock_ms(step);
         tracing::info!("receiver clock stepped by {step} ms to re-establish the time");
         sink.event(&ReceiverEvent::ClockStep { ms: step })
-    }
-
-    /// Keeps the satellite's SV time from every usable report, and carries it over to a new
-    /// channel of the same satellite after a loss ([`SvClock`]): at the new channel's first
-    /// bit edge in phase lock, the predicted SV time is rounded to the 20 ms bit; a prediction
-    /// more than 1 ms off a bit boundary (samples lost, or a wrong bit edge) is not used.
-    /// Returns what the caller must report: a refused carried time, or the length of lost
-    /// samples just resolved.
-    fn track_sv_clock(&mut self, e: &ChannelEpoch) -> Option<CarryNote> {
-        let usable =
-            e.pll_lock && e.state != ChannelState::Lost && e.cn0_dbhz >= self.cn0_lost_dbhz;
-        let dec = self.decoders.get_mut(&e.prn)?;
-        if !usable {
-            return None;
-        }
-        if let Some(sv) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) {
-            self.sv_clocks.insert(
-                e.prn,
-                SvClock {
-                    sample: e.sample_index,
-                    sv_tow_s: sv,
-                    rate: e.code_rate_chips_s / gpsrx_dsp::constants::CA_CHIP_RATE_HZ,
-                    rough: false,
-                },
-            );
-            return None;
-        }
-        let clock = self.sv_clocks.get(&e.prn)?;
-        let elapsed_s = (e.sample_index as f64 - clock.sample as f64) / self.fs_hz;
-        let unresolved_gap = self.gap.as_ref().is_some_and(|g| g.unresolved);
-        if clock.rough || unresolved_gap {
-            // Known roughly (samples may have been lost): frame sync from the first TLM and
-            // HOW whose time agrees with it.
-            if !dec.has_hint() && elapsed_s <= SV_CLOCK_HINT_S {
-                let sv = clock.at(e.sample_index, self.fs_hz)
-                    - e.code_phase_chips / gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
-                dec.hint_time(e.ms_count, sv, SV_CLOCK_HINT_TOLERANCE_S);
-            }
-            return None;
-        }
-        if !e.bit_edge || !(0.0..=SV_CLOCK_CARRY_S).contains(&elapsed_s) {
-            return None;
-        }
-        // SV time at the start of the code period that opens this interval (a bit edge).
-        let mut edge_ms = (clock.at(e.sample_index, self.fs_hz)
-            - e.code_phase_chips / gpsrx_dsp::constants::CA_CHIP_RATE_HZ)
-            * 1e3;
-        let mut note = None;
-        match self.gap.as_mut() {
-            Some(gap) if !gap.unresolved && gap.length_ms.is_none() => {
-                // Across lost samples: first their length, from the offsets of the kept time
-                // from the new bit edges and the carrier-phase steps.
-                let off = edge_ms - (edge_ms / 20.0).round() * 20.0;
-                if gap.add_edge_offset(e.prn, off) {
-                    let length_ms = gap.length_ms.unwrap_or(0.0);
-                    note = Some(CarryNote::GapResolved {
-                        t_s: gap.t_s,
-                        length_ms,
-                    });
-                    // Every kept SV time moves over the gap, once.
-                    for c in self.sv_clocks.values_mut() {
-                        c.sv_tow_s += length_ms * 1e-3;
-                    }
-                    edge_ms += length_ms;
-                } else if gap.unresolved {
-                    tracing::warn!(
-                        "the length of the samples lost at {:.3} s cannot be resolved from the carrier-phase steps: waiting for frame sync",
-                        gap.t_s
-                    );
-                    make_rough(&mut self.sv_clocks, None);
-                }
-                note?;
-            }
-            Some(gap) if gap.length_ms.is_none() => return None,
-            _ => {}
-        }
-        let bit_ms = (edge_ms / 20.0).round() * 20.0;
-        let off_ms = edge_ms - bit_ms;
-        if off_ms.abs() > 1.0 {
-            tracing::info!(
-                "G{:02}: the SV time carried over {elapsed_s:.1} s falls {off_ms:+.3} ms off the new bit edge (samples lost?): waiting for frame sync",
-                e.prn
-            );
-            make_rough(&mut self.sv_clocks, Some(e.prn));
-            return self.gap.is_none().then_some(CarryNote::Refused(off_ms));
-        }
-        dec.carry_time(e.ms_count, bit_ms * 1e-3);
-        tracing::info!(
-            "G{:02}: SV time carried over {elapsed_s:.1} s (bit edge {off_ms:+.3} ms from the prediction)",
-            e.prn
-        );
-        note
     }
 
     /// The channel's row, at most once per fix interval.
@@ -884,7 +670,7 @@ impl NavigationProcessor {
                 t_stream_s,
             });
         }
-        if let Some(gap) = self.gap.take().filter(|g| g.length_ms.is_none()) {
+        if let Some(gap) = self.sv_time.gap.take().filter(|g| g.length_ms.is_none()) {
             let length = gap.length_from_bias_ms(t_stream_s, sol.clock_bias_m);
             match length {
                 Some(ms) => tracing::warn!(

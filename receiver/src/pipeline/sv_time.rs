@@ -1,0 +1,250 @@
+//! SV time kept across a loss of the signal and across lost samples.
+//!
+//! Per satellite an [`SvClock`] (where its code stood at the last usable report) predicts its
+//! SV time at any later sample. After an outage (time intact) a new channel's first bit edge
+//! takes the predicted time rounded to the 20 ms bit, so fixes resume without waiting for
+//! frame sync. After lost samples ([`GapRecovery`]) the prediction is off by the gap: its
+//! length is resolved from the new bit edges and the carrier-phase steps
+//! ([`crate::pipeline::gap_length`]) and every time moved over it, or, when that cannot be
+//! done, the times become rough hints for a fast frame sync ([`NavDecoder::hint_time`]).
+
+use crate::pipeline::navdata::NavDecoder;
+use gpsrx_dsp::constants::SPEED_OF_LIGHT_MPS;
+use gpsrx_tracking::ChannelEpoch;
+use std::collections::BTreeMap;
+
+/// What [`SvTimeKeeper::observe`] found that must be reported.
+#[derive(Debug, Clone, Copy)]
+pub enum CarryNote {
+    /// A carried SV time fell this far (ms) off the new bit edge.
+    Refused(f64),
+    /// The length of lost samples was resolved.
+    GapResolved {
+        /// Stream time of the gap, s.
+        t_s: f64,
+        /// Its length, ms.
+        length_ms: f64,
+    },
+}
+
+/// What is kept over a sample gap to measure it once the time is re-established.
+#[derive(Debug, Clone)]
+pub struct GapRecovery {
+    pub t_s: f64,
+    pub before: Option<(f64, f64, f64)>,
+    /// The carrier-phase steps at the gap `(step rad, carrier Hz)`: with them, the SV times
+    /// are kept and carried over the gap once its length is resolved
+    /// ([`crate::pipeline::gap_length`]); without, the time comes from frame sync.
+    pub steps: Vec<(f64, f64)>,
+    /// Per PRN: how far the SV time kept falls off the channel's new bit edge, ms.
+    pub edge_offsets: BTreeMap<u8, f64>,
+    /// The length resolved, ms.
+    pub length_ms: Option<f64>,
+    /// The length cannot be resolved: the time comes from frame sync.
+    pub unresolved: bool,
+    /// Receiver clock steps made while re-establishing the time, ms.
+    pub stepped_ms: i64,
+}
+
+impl GapRecovery {
+    pub fn new(t_s: f64, before: Option<(f64, f64, f64)>, steps: Vec<(f64, f64)>) -> Self {
+        let unresolved = steps.len() < crate::pipeline::gap_length::MIN_STEPS;
+        Self {
+            t_s,
+            before,
+            steps,
+            edge_offsets: BTreeMap::new(),
+            length_ms: None,
+            unresolved,
+            stepped_ms: 0,
+        }
+    }
+
+    /// Takes the offset `off_ms` of `prn`'s kept SV time from its new bit edge; once
+    /// [`crate::pipeline::discontinuity::MIN_SATELLITES`] offsets agree (0.1 ms), resolves the
+    /// length with the phase steps (or gives up). Returns whether the length was just resolved.
+    fn add_edge_offset(&mut self, prn: u8, off_ms: f64) -> bool {
+        self.edge_offsets.insert(prn, off_ms);
+        let agreeing: Vec<f64> = self
+            .edge_offsets
+            .values()
+            .filter(|o| (*o - off_ms).abs() < 0.1)
+            .copied()
+            .collect();
+        if agreeing.len() < crate::pipeline::discontinuity::MIN_SATELLITES {
+            return false;
+        }
+        let mean = agreeing.iter().sum::<f64>() / agreeing.len() as f64;
+        // The kept time is g late: it falls -g (mod 20 ms) off the true bit edge.
+        let offset = (-mean).rem_euclid(20.0);
+        self.length_ms = crate::pipeline::gap_length::resolve_gap_ms(offset, &self.steps, 1000.0);
+        self.unresolved = self.length_ms.is_none();
+        self.length_ms.is_some()
+    }
+}
+
+impl GapRecovery {
+    /// The gap's length (ms) from the clock bias `bias_m` of the first fix after it, at stream
+    /// time `t_s`: the receiver counts samples, so lost samples make its time run late by the
+    /// gap and the clock bias (receiver minus GPS time) drops by `c g` from its prediction
+    /// `b0 + d (t - t0)`.
+    pub fn length_from_bias_ms(&self, t_s: f64, bias_m: f64) -> Option<f64> {
+        let (t0, b0, d) = self.before?;
+        let predicted = b0 + d * (t_s - t0);
+        Some(-(bias_m - predicted) / SPEED_OF_LIGHT_MPS * 1e3 + self.stepped_ms as f64)
+    }
+}
+
+/// The longest outage an SV time is carried over, s. The carried time is a prediction with
+/// the code rate at the loss; it must be right to well within 10 ms (half a data bit), which
+/// holds for minutes (a Doppler change of 1 Hz/s costs 0.3 us over 30 s; a receiver moving
+/// 300 m/s off the prediction costs 1 us per second).
+const SV_CLOCK_CARRY_S: f64 = 120.0;
+
+/// The longest a rough SV time serves as a frame-sync hint, s, and its tolerance, s (lost
+/// samples of up to that much are then re-established 1.2 s after the next subframe starts).
+const SV_CLOCK_HINT_S: f64 = 600.0;
+const SV_CLOCK_HINT_TOLERANCE_S: f64 = 3.0;
+
+/// A satellite's SV time at a sample, with its rate: where the code of the last usable report
+/// stood. After the channel has lost the signal, the SV time of a new channel's bit edge is
+/// predicted from it, `sv(k) = sv_ref + (k - k_ref) / fs * r / 1.023 MHz` for the code rate `r`,
+/// and rounded to the 20 ms data bit (the bit edge the channel found): the satellite's time is
+/// known again as soon as its new channel has bit sync, without waiting 6-12 s for frame sync.
+#[derive(Debug, Clone, Copy)]
+pub struct SvClock {
+    /// Sample index of the reference point.
+    sample: u64,
+    /// SV time at it (TOW, s).
+    sv_tow_s: f64,
+    /// SV seconds per receiver second (code rate / 1.023 MHz).
+    rate: f64,
+    /// Known only roughly (samples may have been lost since): not carried over, only a hint
+    /// for frame sync ([`NavDecoder::hint_time`]).
+    rough: bool,
+}
+
+impl SvClock {
+    /// The predicted SV time at sample `k` for samples at `fs_hz`.
+    fn at(&self, k: u64, fs_hz: f64) -> f64 {
+        self.sv_tow_s + (k as f64 - self.sample as f64) / fs_hz * self.rate
+    }
+}
+
+/// The satellites' SV times and the gap being recovered from.
+#[derive(Debug, Default)]
+pub struct SvTimeKeeper {
+    /// Per PRN: its SV time, kept over a loss of the signal.
+    pub clocks: BTreeMap<u8, SvClock>,
+    /// A gap being recovered from.
+    pub gap: Option<GapRecovery>,
+    /// Carried SV times refused at the new bit edge: `(stream time s, PRN, offset ms)`.
+    pub refused: Vec<(f64, u8, f64)>,
+}
+
+impl SvTimeKeeper {
+    /// Marks the SV time of `prn` (all with `None`) as rough: samples may have been lost.
+    pub fn make_rough(&mut self, prn: Option<u8>) {
+        for (p, c) in self.clocks.iter_mut() {
+            if prn.is_none_or(|q| q == *p) {
+                c.rough = true;
+            }
+        }
+    }
+
+    /// Keeps the satellite's SV time from every usable report, and carries it over to a new
+    /// channel of the same satellite after a loss ([`SvClock`]): at the new channel's first
+    /// bit edge in phase lock, the predicted SV time is rounded to the 20 ms bit; a prediction
+    /// more than 1 ms off a bit boundary (samples lost, or a wrong bit edge) is not used.
+    /// Returns what the caller must report: a refused carried time, or the length of lost
+    /// samples just resolved. `dec` is the satellite's decoder, `usable` whether the report is
+    /// in phase lock with signal.
+    pub fn observe(
+        &mut self,
+        e: &ChannelEpoch,
+        dec: &mut NavDecoder,
+        fs_hz: f64,
+        usable: bool,
+    ) -> Option<CarryNote> {
+        if !usable {
+            return None;
+        }
+        if let Some(sv) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) {
+            self.clocks.insert(
+                e.prn,
+                SvClock {
+                    sample: e.sample_index,
+                    sv_tow_s: sv,
+                    rate: e.code_rate_chips_s / gpsrx_dsp::constants::CA_CHIP_RATE_HZ,
+                    rough: false,
+                },
+            );
+            return None;
+        }
+        let clock = self.clocks.get(&e.prn)?;
+        let elapsed_s = (e.sample_index as f64 - clock.sample as f64) / fs_hz;
+        let unresolved_gap = self.gap.as_ref().is_some_and(|g| g.unresolved);
+        if clock.rough || unresolved_gap {
+            // Known roughly (samples may have been lost): frame sync from the first TLM and
+            // HOW whose time agrees with it.
+            if !dec.has_hint() && elapsed_s <= SV_CLOCK_HINT_S {
+                let sv = clock.at(e.sample_index, fs_hz)
+                    - e.code_phase_chips / gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
+                dec.hint_time(e.ms_count, sv, SV_CLOCK_HINT_TOLERANCE_S);
+            }
+            return None;
+        }
+        if !e.bit_edge || !(0.0..=SV_CLOCK_CARRY_S).contains(&elapsed_s) {
+            return None;
+        }
+        // SV time at the start of the code period that opens this interval (a bit edge).
+        let mut edge_ms = (clock.at(e.sample_index, fs_hz)
+            - e.code_phase_chips / gpsrx_dsp::constants::CA_CHIP_RATE_HZ)
+            * 1e3;
+        let mut note = None;
+        match self.gap.as_mut() {
+            Some(gap) if !gap.unresolved && gap.length_ms.is_none() => {
+                // Across lost samples: first their length, from the offsets of the kept time
+                // from the new bit edges and the carrier-phase steps.
+                let off = edge_ms - (edge_ms / 20.0).round() * 20.0;
+                if gap.add_edge_offset(e.prn, off) {
+                    let length_ms = gap.length_ms.unwrap_or(0.0);
+                    note = Some(CarryNote::GapResolved {
+                        t_s: gap.t_s,
+                        length_ms,
+                    });
+                    // Every kept SV time moves over the gap, once.
+                    for c in self.clocks.values_mut() {
+                        c.sv_tow_s += length_ms * 1e-3;
+                    }
+                    edge_ms += length_ms;
+                } else if gap.unresolved {
+                    tracing::warn!(
+                        "the length of the samples lost at {:.3} s cannot be resolved from the carrier-phase steps: waiting for frame sync",
+                        gap.t_s
+                    );
+                    self.make_rough(None);
+                }
+                note?;
+            }
+            Some(gap) if gap.length_ms.is_none() => return None,
+            _ => {}
+        }
+        let bit_ms = (edge_ms / 20.0).round() * 20.0;
+        let off_ms = edge_ms - bit_ms;
+        if off_ms.abs() > 1.0 {
+            tracing::info!(
+                "G{:02}: the SV time carried over {elapsed_s:.1} s falls {off_ms:+.3} ms off the new bit edge (samples lost?): waiting for frame sync",
+                e.prn
+            );
+            self.make_rough(Some(e.prn));
+            return self.gap.is_none().then_some(CarryNote::Refused(off_ms));
+        }
+        dec.carry_time(e.ms_count, bit_ms * 1e-3);
+        tracing::info!(
+            "G{:02}: SV time carried over {elapsed_s:.1} s (bit edge {off_ms:+.3} ms from the prediction)",
+            e.prn
+        );
+        note
+    }
+}
