@@ -40,6 +40,8 @@ const MIN_CN0_DBHZ: f64 = 30.0;
 /// Reports before a jump that give the carrier's phase and frequency there (the frequency
 /// to about 0.2 Hz at 40 dB-Hz with 1 ms reports).
 const PRE_REPORTS: usize = 80;
+/// Reports left out on each side of a jump when its step is measured.
+const GUARD: usize = 5;
 /// Longest integration watched, s (a 20 ms integration smears a jump over a bit).
 const MAX_T_COH_S: f64 = 0.005;
 
@@ -233,8 +235,9 @@ impl DiscontinuityMonitor {
     }
 
     /// Per satellite of `best`: the carrier-phase step over the jump at sample `jump` (the
-    /// same instant for every satellite), from up to [`PRE_REPORTS`] reports before it to up to 8 after it,
-    /// leaving out the report that straddles it and one more on each side.
+    /// same instant for every satellite), from up to [`PRE_REPORTS`] reports before it to up
+    /// to 8 after it, leaving out [`GUARD`] reports on each side (the instant is known to a few
+    /// reports: at 37-44 dB-Hz the best splits of the satellites scatter by +-2 ms).
     fn phase_steps(&self, best: &BTreeMap<u8, (f64, u64)>, jump: u64) -> Vec<(u8, f64, f64)> {
         best.keys()
             .filter_map(|prn| {
@@ -242,8 +245,8 @@ impl DiscontinuityMonitor {
                 let pts: Vec<NcoPoint> = w.nco.iter().copied().collect();
                 // The first report that starts after the jump; the one before straddles it.
                 let k = pts.iter().position(|p| p.sample > jump)?;
-                let pre = &pts[k.saturating_sub(PRE_REPORTS + 2)..k.saturating_sub(2)];
-                let post = &pts[(k + 1).min(pts.len())..(k + 9).min(pts.len())];
+                let pre = &pts[k.saturating_sub(PRE_REPORTS + GUARD)..k.saturating_sub(GUARD)];
+                let post = &pts[(k + GUARD).min(pts.len())..(k + GUARD + 8).min(pts.len())];
                 let (step, freq_hz) = NcoPoint::phase_step(pre, post, self.fs_hz)?;
                 // The two halves of `post` must agree (a loop slipping right after the jump
                 // gives no clean step): within 0.3 rad, modulo pi.

@@ -9,11 +9,16 @@
 //!   the Costas ambiguity) for its carrier frequency `f_i`.
 //!
 //! The candidates `o + 20 k` are scored by how well they explain the phase steps `d_i`:
-//! `S(g) = mean_i cos(2 (2 pi f_i g - d_i))`. The right `g` scores near 1 (measured: 0.73 for
-//! a 31 ms gap at 40-45 dB-Hz, the next candidate 0.25); a wrong one is a random mean of
-//! cosines (standard deviation `1 / sqrt(2 n)`, 0.25 for eight satellites). A length is returned only with at least [`MIN_STEPS`] steps, a
+//! `S(g) = mean_i exp(-e_i^2 / (2 s^2))` with `e_i = 2 pi f_i g - d_i` folded into
+//! (-pi/2, pi/2] and `s` = [`STEP_SIGMA_RAD`]. The right `g` scores near 1; a wrong one makes
+//! the `e_i` uniform, each term about 0.2 on average. (Measured on the GPS-SDR-SIM recording
+//! at 37-44 dB-Hz, six satellites: 31 ms lost scores 0.88, the best wrong candidate 0.50; with
+//! `cos 2 e` instead the margin was 0.23, too small.) A length is returned only with at least [`MIN_STEPS`] steps, a
 //! best score of at least [`MIN_SCORE`] and every other candidate [`MIN_MARGIN`] below it:
 //! otherwise the length is unknown and the time must come from the navigation message.
+
+/// Spread of a measured phase step, rad.
+pub const STEP_SIGMA_RAD: f64 = 0.25;
 
 /// Fewest phase steps that can resolve a length.
 pub const MIN_STEPS: usize = 4;
@@ -32,7 +37,11 @@ pub fn resolve_gap_ms(offset_ms: f64, steps: &[(f64, f64)], max_ms: f64) -> Opti
         let g = g_ms * 1e-3;
         steps
             .iter()
-            .map(|&(d, f)| (2.0 * (std::f64::consts::TAU * f * g - d)).cos())
+            .map(|&(d, f)| {
+                let e = std::f64::consts::TAU * f * g - d;
+                let e = e - (e / std::f64::consts::PI).round() * std::f64::consts::PI;
+                (-e * e / (2.0 * STEP_SIGMA_RAD * STEP_SIGMA_RAD)).exp()
+            })
             .sum::<f64>()
             / steps.len() as f64
     };

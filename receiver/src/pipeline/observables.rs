@@ -19,6 +19,12 @@ use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use std::collections::BTreeMap;
 
+/// Code periods a channel must have run before its pseudorange is used: five time constants
+/// `1 / (4 Bn)` of the 2 Hz pull-in DLL, so that the acquisition's code error (up to half a
+/// sample: 58 m at 2.6 MHz) has decayed below a metre (`e^-4.8`). It matters only when the
+/// SV time is known at once (carried over an outage); otherwise frame sync takes longer.
+pub const CODE_SETTLE_MS: u64 = 600;
+
 /// One satellite's observables at an epoch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SatObservable {
@@ -150,8 +156,12 @@ impl ObservableBuilder {
     /// are complete (no channel can add to them any more).
     pub fn push(&mut self, e: &ChannelEpoch, dec: &NavDecoder) -> Vec<ObservableEpoch> {
         // Only phase-locked channels with signal give observables (a channel that has just
-        // lost its signal still reports until its C/N0 test releases it).
-        let usable = e.pll_lock && e.state != ChannelState::Lost && e.cn0_dbhz >= self.min_cn0_dbhz;
+        // lost its signal still reports until its C/N0 test releases it), once their code loop
+        // has settled.
+        let usable = e.pll_lock
+            && e.state != ChannelState::Lost
+            && e.cn0_dbhz >= self.min_cn0_dbhz
+            && e.ms_count >= CODE_SETTLE_MS;
         let lost = self.lli.entry(e.prn).or_insert(true);
         *lost |= !usable;
         if !usable {

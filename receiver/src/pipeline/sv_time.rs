@@ -78,6 +78,12 @@ impl GapRecovery {
         // The kept time is g late: it falls -g (mod 20 ms) off the true bit edge.
         let offset = (-mean).rem_euclid(20.0);
         self.length_ms = crate::pipeline::gap_length::resolve_gap_ms(offset, &self.steps, 1000.0);
+        tracing::debug!(
+            "gap length: {offset:.3} ms modulo 20 ms from {} bit edges, carrier-phase steps (rad, Hz) {:?}: {:?}",
+            agreeing.len(),
+            self.steps,
+            self.length_ms
+        );
         self.unresolved = self.length_ms.is_none();
         self.length_ms.is_some()
     }
