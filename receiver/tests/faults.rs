@@ -374,4 +374,6 @@ fn measure_faults() {
     }
     let blocked = simulator(26.0, "[[outages]]\nstart_s = 16.0\nend_s = 18.0\n");
     describe("blocked 2 s", &run(&blocked, Fault::None), at);
+    let long = simulator(46.0, "[[outages]]\nstart_s = 12.0\nend_s = 42.0\n");
+    describe("blocked 30 s (12-42 s)", &run(&long, Fault::None), 42.0);
 }
