@@ -8,6 +8,11 @@
 //! - the carrier phase: each channel's residual carrier phase steps by `2 pi f_i g` (modulo pi,
 //!   the Costas ambiguity) for its carrier frequency `f_i`.
 //!
+//! - the code: SV time runs at `r_i = 1 - rho_dot_i / c` of receiver time (the code rate over
+//!   1.023 MHz), so the kept time falls `g r_i` short, and the offsets of the satellites differ
+//!   by `g (r_i - r_j)`: tens of nanoseconds for `g` = 20 ms, measured by the code loops to a
+//!   few nanoseconds ([`estimate_from_code`]).
+//!
 //! The candidates `o + 20 k` are scored by how well they explain the phase steps `d_i`:
 //! `S(g) = mean_i exp(-e_i^2 / (2 s^2))` with `e_i = 2 pi f_i g - d_i` folded into
 //! (-pi/2, pi/2] and `s` = [`STEP_SIGMA_RAD`]. The right `g` scores near 1; a wrong one makes
@@ -22,6 +27,9 @@ pub const STEP_SIGMA_RAD: f64 = 0.25;
 
 /// Fewest phase steps that can resolve a length.
 pub const MIN_STEPS: usize = 4;
+/// Fewest satellites whose code offsets can measure a length.
+pub const MIN_CODE_OFFSETS: usize = 6;
+
 /// Lowest score accepted.
 pub const MIN_SCORE: f64 = 0.6;
 /// Least margin of the best score over any other candidate.
@@ -67,6 +75,61 @@ pub fn resolve_gap_ms(offset_ms: f64, steps: &[(f64, f64)], max_ms: f64) -> Opti
     (best >= MIN_SCORE && best - runner_up >= MIN_MARGIN).then_some(g)
 }
 
+/// The lost time (ms) and its standard deviation from the code: each satellite's offset of
+/// the kept SV time from its new bit edge (`off_i`, ms, all equal modulo 20 ms to within
+/// microseconds) with its SV time rate `r_i`. Since `-off_i = g r_i` modulo 20 ms, the
+/// differences `d_i = -(off_i - off_0)` against `y_i = r_i - r_0` give `g` by least squares
+/// through the origin after removing the means. `None` with fewer than [`MIN_CODE_OFFSETS`]
+/// satellites (the scatter that gives the standard deviation needs a few degrees of freedom)
+/// or rates too alike.
+pub fn estimate_from_code(offsets: &[(f64, f64)]) -> Option<(f64, f64)> {
+    if offsets.len() < MIN_CODE_OFFSETS {
+        return None;
+    }
+    let (o0, r0) = offsets[0];
+    let pts: Vec<(f64, f64)> = offsets
+        .iter()
+        .map(|&(o, r)| {
+            let d = -(o - o0);
+            (r - r0, d - (d / 20.0).round() * 20.0)
+        })
+        .collect();
+    let n = pts.len() as f64;
+    let (my, md) = pts
+        .iter()
+        .fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
+    let syy: f64 = pts.iter().map(|p| (p.0 - my).powi(2)).sum();
+    let syd: f64 = pts.iter().map(|p| (p.0 - my) * (p.1 - md)).sum();
+    if syy <= 0.0 {
+        return None;
+    }
+    let g = syd / syy;
+    // Scatter of the offsets about the fit, with a floor of 3 ns (1 m of code).
+    let rss: f64 = pts
+        .iter()
+        .map(|p| (p.1 - md - g * (p.0 - my)).powi(2))
+        .sum();
+    let sigma_d = (rss / (n - 2.0).max(1.0)).sqrt().max(3e-6);
+    Some((g, sigma_d / syy.sqrt()))
+}
+
+/// The lost time (ms) from the offset modulo 20 ms and the two estimates: the code's
+/// `(g, sigma)` must single out one candidate `o + 20 k` (within 3 sigma, every other one
+/// beyond 6 sigma); the phase steps' must agree with it when both are there.
+pub fn choose(offset_ms: f64, by_phase: Option<f64>, by_code: Option<(f64, f64)>) -> Option<f64> {
+    let from_code = by_code.and_then(|(g, sigma)| {
+        let k = ((g - offset_ms) / 20.0).round();
+        let candidate = offset_ms + 20.0 * k;
+        let clear =
+            (candidate - g).abs() < 3.0 * sigma && 20.0 - (candidate - g).abs() > 6.0 * sigma;
+        (clear && candidate > 0.25).then_some(candidate)
+    });
+    match (by_phase, from_code) {
+        (Some(p), Some(c)) => ((p - c).abs() < 1e-6).then_some(p),
+        (p, c) => p.or(c),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -95,6 +158,35 @@ mod tests {
             let steps = steps_for(g, &FREQS, &NOISE);
             let offset = g % 20.0;
             assert_eq!(resolve_gap_ms(offset, &steps, 1000.0), Some(g), "{g} ms");
+        }
+    }
+
+    #[test]
+    fn the_code_offsets_give_the_length_from_the_satellites_code_rates() {
+        // Rates 1 + f_D / f_L1 for Dopplers of -3.1 to +3.4 kHz; offsets -g r_i modulo 20 ms
+        // with 2 ns of noise.
+        for g in [1.25, 20.0, 31.0, 500.0] {
+            let noise = [2e-6, -1e-6, 0.0, 1.5e-6, -2e-6, 1e-6, -0.5e-6, 0.5e-6];
+            let offsets: Vec<(f64, f64)> = FREQS
+                .iter()
+                .zip(noise)
+                .map(|(&f, n)| {
+                    let r = 1.0 + f / 1.57542e9;
+                    let o = -g * r;
+                    (o - (o / 20.0).round() * 20.0 + n, r)
+                })
+                .collect();
+            let (est, sigma) = estimate_from_code(&offsets).expect("estimate");
+            assert!(
+                (est - g).abs() < 4.0 * sigma && sigma < 2.0,
+                "{g}: {est} +- {sigma}"
+            );
+            let offset = (-offsets[0].0).rem_euclid(20.0);
+            let chosen = choose(offset, None, Some((est, sigma)));
+            assert!(
+                chosen.is_some_and(|c| (c - g).abs() < 1e-3),
+                "{g}: {chosen:?}"
+            );
         }
     }
 

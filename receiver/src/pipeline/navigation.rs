@@ -103,6 +103,10 @@ pub struct NavigationProcessor {
     time_trusted: bool,
 }
 
+/// Time the code loops of channels that kept their satellites over lost samples need before
+/// their offsets measure the gap, s (four time constants of a 1 Hz DLL).
+const CODE_SETTLE_AFTER_GAP_S: f64 = 1.0;
+
 /// Solutions failing the integrity test in a row, after a valid one, that make the receiver
 /// time suspect.
 const FAILURES_TO_DISTRUST_TIME: u32 = 5;
@@ -165,7 +169,9 @@ impl NavigationProcessor {
             d.watched
         );
         let steps = d.steps.iter().map(|&(_, step, f)| (step, f)).collect();
-        self.forget_time(t_s, steps);
+        // The code loops of the channels that kept their satellites take a second to follow
+        // the code's step over the gap before their offsets measure it.
+        self.forget_time(t_s, steps, Some(t_s + CODE_SETTLE_AFTER_GAP_S));
         sink.event(&ReceiverEvent::SampleGap { t_s })?;
         Ok(Some(d))
     }
@@ -331,6 +337,15 @@ impl NavigationProcessor {
             }
         }
         if e.state == ChannelState::Lost {
+            let reason = if e.cn0_dbhz.is_finite() && e.cn0_dbhz < self.cn0_lost_dbhz {
+                format!(
+                    "C/N0 estimate {:.1} dB-Hz, below the {:.0} dB-Hz loss threshold",
+                    e.cn0_dbhz, self.cn0_lost_dbhz
+                )
+            } else {
+                "no data-bit edges found (no usable signal)".to_string()
+            };
+            tracing::info!("G{:02}: signal lost at {:.2} s: {reason}", e.prn, e.t_rx_s);
             dec.reset_sync();
             sink.event(&ReceiverEvent::Lost {
                 prn: e.prn,
@@ -346,15 +361,17 @@ impl NavigationProcessor {
     ///
     /// With the carrier-phase steps of the gap (`steps`), the SV times are kept, to be carried
     /// over it once its length is resolved from them and the new bit edges.
-    fn forget_time(&mut self, t_s: f64, steps: Vec<(f64, f64)>) {
+    /// `code_from_s`: from when the code offsets may measure the gap (`None`: not used).
+    fn forget_time(&mut self, t_s: f64, steps: Vec<(f64, f64)>, code_from_s: Option<f64>) {
         for dec in self.decoders.values_mut() {
             dec.reset_sync();
         }
-        if steps.is_empty() {
+        let gap = GapRecovery::new(t_s, self.last_clock, steps, code_from_s);
+        if gap.unresolved {
             self.sv_time.make_rough(None);
         }
         self.builder.restart();
-        self.sv_time.gap = Some(GapRecovery::new(t_s, self.last_clock, steps));
+        self.sv_time.gap = Some(gap);
         self.prior = None;
     }
 
@@ -380,13 +397,37 @@ impl NavigationProcessor {
             .filter(|r| (r.2 - off_ms).abs() < 0.1)
             .count();
         if agreeing >= crate::pipeline::discontinuity::MIN_SATELLITES {
+            let offsets: Vec<(u8, f64, f64)> = self
+                .sv_time
+                .refused
+                .iter()
+                .filter(|r| (r.2 - off_ms).abs() < 0.1)
+                .filter_map(|r| self.sv_time.clocks.get(&r.1).map(|c| (r.1, r.2, c.rate)))
+                .collect();
             self.sv_time.refused.clear();
             tracing::warn!(
-                "{t_s:.3} s: samples lost during the outage: the SV times carried over it are {:.3} ms (modulo 20 ms) off the new bit edges of {agreeing} satellites; waiting for frame sync",
+                "{t_s:.3} s: samples lost during the outage: the SV times carried over it are {:.3} ms (modulo 20 ms) off the new bit edges of {agreeing} satellites",
                 -off_ms
             );
-            self.forget_time(t_s, Vec::new());
+            // The new channels' code has settled by their bit edges: the code offsets measure
+            // the gap at once.
+            self.forget_time(t_s, Vec::new(), Some(t_s));
             sink.event(&ReceiverEvent::SampleGap { t_s })?;
+            let mut resolved = None;
+            if let Some(gap) = self.sv_time.gap.as_mut() {
+                for (p, o, r) in offsets {
+                    if gap.add_edge_offset(p, o, r, t_s) {
+                        resolved = gap.length_ms;
+                    }
+                }
+            }
+            if let Some(length_ms) = resolved {
+                tracing::warn!(
+                    "{t_s:.3} s: the samples lost were {length_ms:.3} ms of signal (from the code of the new channels): SV times carried over the gap"
+                );
+                self.sv_time.move_over_gap(length_ms);
+                sink.event(&ReceiverEvent::GapMeasured { t_s, length_ms })?;
+            }
         }
         Ok(())
     }
@@ -419,7 +460,7 @@ impl NavigationProcessor {
         let before = self.last_clock;
         self.sv_time
             .gap
-            .get_or_insert_with(|| GapRecovery::new(t_s, before, Vec::new()));
+            .get_or_insert_with(|| GapRecovery::new(t_s, before, Vec::new(), None));
     }
 
     /// While the receiver time is re-established after lost samples, the first satellite
@@ -652,7 +693,7 @@ impl NavigationProcessor {
                 self.failed_in_row
             );
             self.time_trusted = false;
-            self.forget_time(t_stream_s, Vec::new());
+            self.forget_time(t_stream_s, Vec::new(), None);
             sink.event(&ReceiverEvent::SampleGap { t_s: t_stream_s })?;
         }
         if valid {

@@ -9,9 +9,12 @@
 //! done, the times become rough hints for a fast frame sync ([`NavDecoder::hint_time`]).
 
 use crate::pipeline::navdata::NavDecoder;
-use gpsrx_dsp::constants::SPEED_OF_LIGHT_MPS;
+use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_tracking::ChannelEpoch;
 use std::collections::BTreeMap;
+
+/// How long the length of lost samples is sought after the code offsets may be used, s.
+pub const GAP_RESOLVE_S: f64 = 1.0;
 
 /// What [`SvTimeKeeper::observe`] found that must be reported.
 #[derive(Debug, Clone, Copy)]
@@ -36,8 +39,15 @@ pub struct GapRecovery {
     /// are kept and carried over the gap once its length is resolved
     /// ([`crate::pipeline::gap_length`]); without, the time comes from frame sync.
     pub steps: Vec<(f64, f64)>,
-    /// Per PRN: how far the SV time kept falls off the channel's new bit edge, ms.
-    pub edge_offsets: BTreeMap<u8, f64>,
+    /// Per PRN: how far the SV time kept falls off the channel's new bit edge (ms), and the
+    /// satellite's SV time rate.
+    pub edge_offsets: BTreeMap<u8, (f64, f64)>,
+    /// Stream time from which the code offsets are settled enough to measure the length, s
+    /// (`None`: they are not used).
+    pub code_from_s: Option<f64>,
+    /// Stream time after which an unresolved length is given up (the time then comes from
+    /// frame sync), s.
+    pub give_up_s: f64,
     /// The length resolved, ms.
     pub length_ms: Option<f64>,
     /// The length cannot be resolved: the time comes from frame sync.
@@ -47,44 +57,65 @@ pub struct GapRecovery {
 }
 
 impl GapRecovery {
-    pub fn new(t_s: f64, before: Option<(f64, f64, f64)>, steps: Vec<(f64, f64)>) -> Self {
-        let unresolved = steps.len() < crate::pipeline::gap_length::MIN_STEPS;
+    /// A gap at stream time `t_s`; `before`: the clock of the last fix; `steps`: the
+    /// carrier-phase steps; `code_from_s`: from when the code offsets may be used.
+    pub fn new(
+        t_s: f64,
+        before: Option<(f64, f64, f64)>,
+        steps: Vec<(f64, f64)>,
+        code_from_s: Option<f64>,
+    ) -> Self {
+        let unresolved =
+            steps.len() < crate::pipeline::gap_length::MIN_STEPS && code_from_s.is_none();
         Self {
             t_s,
             before,
             steps,
             edge_offsets: BTreeMap::new(),
+            code_from_s,
+            give_up_s: code_from_s.unwrap_or(t_s) + GAP_RESOLVE_S,
             length_ms: None,
             unresolved,
             stepped_ms: 0,
         }
     }
 
-    /// Takes the offset `off_ms` of `prn`'s kept SV time from its new bit edge; once
+    /// Takes the offset `off_ms` of `prn`'s kept SV time from its new bit edge and the
+    /// satellite's SV time rate at stream time `now_s`; once
     /// [`crate::pipeline::discontinuity::MIN_SATELLITES`] offsets agree (0.1 ms), resolves the
-    /// length with the phase steps (or gives up). Returns whether the length was just resolved.
-    fn add_edge_offset(&mut self, prn: u8, off_ms: f64) -> bool {
-        self.edge_offsets.insert(prn, off_ms);
-        let agreeing: Vec<f64> = self
+    /// length from the carrier-phase steps and, once settled, the code offsets
+    /// ([`crate::pipeline::gap_length::choose`]), or gives up after [`GAP_RESOLVE_S`].
+    /// Returns whether the length was just resolved.
+    pub fn add_edge_offset(&mut self, prn: u8, off_ms: f64, rate: f64, now_s: f64) -> bool {
+        use crate::pipeline::gap_length::{choose, estimate_from_code, resolve_gap_ms, MIN_STEPS};
+        self.edge_offsets.insert(prn, (off_ms, rate));
+        let agreeing: Vec<(f64, f64)> = self
             .edge_offsets
             .values()
-            .filter(|o| (*o - off_ms).abs() < 0.1)
+            .filter(|o| (o.0 - off_ms).abs() < 0.1)
             .copied()
             .collect();
-        if agreeing.len() < crate::pipeline::discontinuity::MIN_SATELLITES {
-            return false;
+        if agreeing.len() >= crate::pipeline::discontinuity::MIN_SATELLITES {
+            let mean = agreeing.iter().map(|o| o.0).sum::<f64>() / agreeing.len() as f64;
+            // The kept time is g late: it falls -g (mod 20 ms) off the true bit edge.
+            let offset = (-mean).rem_euclid(20.0);
+            let by_phase = (self.steps.len() >= MIN_STEPS)
+                .then(|| resolve_gap_ms(offset, &self.steps, 1000.0))
+                .flatten();
+            let by_code = self
+                .code_from_s
+                .filter(|&t| now_s >= t)
+                .and_then(|_| estimate_from_code(&agreeing));
+            self.length_ms = choose(offset, by_phase, by_code);
+            tracing::debug!(
+                "gap length: {offset:.3} ms modulo 20 ms from {} bit edges; by the carrier-phase steps {by_phase:?}, by the code {by_code:?}: {:?}",
+                agreeing.len(),
+                self.length_ms
+            );
         }
-        let mean = agreeing.iter().sum::<f64>() / agreeing.len() as f64;
-        // The kept time is g late: it falls -g (mod 20 ms) off the true bit edge.
-        let offset = (-mean).rem_euclid(20.0);
-        self.length_ms = crate::pipeline::gap_length::resolve_gap_ms(offset, &self.steps, 1000.0);
-        tracing::debug!(
-            "gap length: {offset:.3} ms modulo 20 ms from {} bit edges, carrier-phase steps (rad, Hz) {:?}: {:?}",
-            agreeing.len(),
-            self.steps,
-            self.length_ms
-        );
-        self.unresolved = self.length_ms.is_none();
+        if self.length_ms.is_none() && now_s >= self.give_up_s {
+            self.unresolved = true;
+        }
         self.length_ms.is_some()
     }
 }
@@ -123,8 +154,8 @@ pub struct SvClock {
     sample: u64,
     /// SV time at it (TOW, s).
     sv_tow_s: f64,
-    /// SV seconds per receiver second (code rate / 1.023 MHz).
-    rate: f64,
+    /// SV seconds per receiver second (`1 + f_D / f_L1`, averaged).
+    pub rate: f64,
     /// Known only roughly (samples may have been lost since): not carried over, only a hint
     /// for frame sync ([`NavDecoder::hint_time`]).
     rough: bool,
@@ -149,6 +180,15 @@ pub struct SvTimeKeeper {
 }
 
 impl SvTimeKeeper {
+    /// Moves every kept SV time over a gap of `length_ms` (once its length is known): they
+    /// are exact again.
+    pub fn move_over_gap(&mut self, length_ms: f64) {
+        for c in self.clocks.values_mut() {
+            c.sv_tow_s += length_ms * 1e-3;
+            c.rough = false;
+        }
+    }
+
     /// Marks the SV time of `prn` (all with `None`) as rough: samples may have been lost.
     pub fn make_rough(&mut self, prn: Option<u8>) {
         for (p, c) in self.clocks.iter_mut() {
@@ -176,12 +216,20 @@ impl SvTimeKeeper {
             return None;
         }
         if let Some(sv) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) {
+            // The rate from the carrier (the code NCO's rate carries the DLL's corrections,
+            // tenths of a chip per second, which would grow to a tenth of a microsecond over a
+            // second), averaged over about 50 reports against the PLL's jitter.
+            let rate = 1.0 + e.doppler_hz / F_L1_HZ;
+            let rate = match self.clocks.get(&e.prn) {
+                Some(c) if !c.rough && e.sample_index > c.sample => c.rate + 0.02 * (rate - c.rate),
+                _ => rate,
+            };
             self.clocks.insert(
                 e.prn,
                 SvClock {
                     sample: e.sample_index,
                     sv_tow_s: sv,
-                    rate: e.code_rate_chips_s / gpsrx_dsp::constants::CA_CHIP_RATE_HZ,
+                    rate,
                     rough: false,
                 },
             );
@@ -213,20 +261,17 @@ impl SvTimeKeeper {
                 // Across lost samples: first their length, from the offsets of the kept time
                 // from the new bit edges and the carrier-phase steps.
                 let off = edge_ms - (edge_ms / 20.0).round() * 20.0;
-                if gap.add_edge_offset(e.prn, off) {
+                if gap.add_edge_offset(e.prn, off, clock.rate, e.t_rx_s) {
                     let length_ms = gap.length_ms.unwrap_or(0.0);
                     note = Some(CarryNote::GapResolved {
                         t_s: gap.t_s,
                         length_ms,
                     });
-                    // Every kept SV time moves over the gap, once.
-                    for c in self.clocks.values_mut() {
-                        c.sv_tow_s += length_ms * 1e-3;
-                    }
+                    self.move_over_gap(length_ms);
                     edge_ms += length_ms;
                 } else if gap.unresolved {
                     tracing::warn!(
-                        "the length of the samples lost at {:.3} s cannot be resolved from the carrier-phase steps: waiting for frame sync",
+                        "the length of the samples lost at {:.3} s cannot be resolved from the carrier-phase steps or the code: waiting for frame sync",
                         gap.t_s
                     );
                     self.make_rough(None);
