@@ -4,11 +4,9 @@
 //! as a valid one, the gap is reported with its length, and fixes come back quickly.
 
 use gpsrx_core::frames::Llh;
-use gpsrx_nav::rinex_nav::parse_rinex_nav;
 use gpsrx_receiver::output::FixQuality;
 use gpsrx_receiver::pipeline::{MemorySink, ReceiverEvent};
-use gpsrx_receiver::{Assistance, Receiver, ReceiverConfig};
-use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
+use gpsrx_receiver::Receiver;
 use gpsrx_samples::sim::{Scenario, Simulator};
 use num_complex::Complex32;
 use std::path::Path;
@@ -45,15 +43,7 @@ drift_s_s = 4.0e-8
 }
 
 fn receiver() -> Receiver {
-    let mut config = ReceiverConfig::default();
-    config.run.tropo = gpsrx_receiver::config::TropoModel::None;
-    config.run.week = Some(2190);
-    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
-    let assistance = Assistance {
-        nav: Some(nav),
-        ..Assistance::default()
-    };
-    Receiver::new(&config, FS_HZ, assistance).unwrap_or_else(|e| panic!("{e}"))
+    crate::pipeline::receiver(FS_HZ)
 }
 
 /// What happens to the stream.
