@@ -63,7 +63,7 @@ use std::collections::BTreeMap;
 pub const WINDOW_S: f64 = 0.1;
 /// A window ends this long before the end of the samples processed before it is evaluated
 /// (every channel has reported it: its longest integration is 20 ms), s.
-const WINDOW_LAG_S: f64 = 0.05;
+pub const WINDOW_LAG_S: f64 = 0.05;
 /// Fewest satellites that make a decision.
 pub const MIN_SATELLITES: usize = 3;
 /// Spread (rms over the satellites, Hz) above which a window is bad: about 4 m/s of velocity

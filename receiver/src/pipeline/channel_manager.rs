@@ -38,14 +38,14 @@ const WEAK_SEARCH_BELOW: usize = 4;
 const MAX_BACKOFF_INTERVALS: u32 = 8;
 
 /// How long after a loss a satellite is searched in the narrow hot window, s.
-const HOT_FOR_S: f64 = 60.0;
+pub const HOT_FOR_S: f64 = 60.0;
 /// Seconds of signal between two hot searches.
-const HOT_INTERVAL_S: f64 = 0.2;
+pub const HOT_INTERVAL_S: f64 = 0.2;
 /// Half width of the hot Doppler window: this much, Hz, plus [`HOT_DOPPLER_RATE_HZ_S`] per
 /// second since the loss (the full search at every interval covers faster changes).
-const HOT_DOPPLER_HZ: f64 = 250.0;
+pub const HOT_DOPPLER_HZ: f64 = 250.0;
 /// See [`HOT_DOPPLER_HZ`], Hz/s.
-const HOT_DOPPLER_RATE_HZ_S: f64 = 25.0;
+pub const HOT_DOPPLER_RATE_HZ_S: f64 = 25.0;
 
 /// How the manager searches.
 #[derive(Debug, Clone)]

@@ -25,25 +25,26 @@ use std::collections::{BTreeMap, VecDeque};
 /// Reports averaged on each side of a step.
 pub const WINDOW: usize = 4;
 /// Floor of the step's standard deviation, rad (the loop's own transients).
-const MIN_SIGMA_RAD: f64 = 0.06;
+pub const MIN_SIGMA_RAD: f64 = 0.06;
 /// Threshold of the summed normalised steps: per satellite watched, and in all.
-const MIN_SUM_PER_SAT: f64 = 8.0;
-const MIN_SUM: f64 = 60.0;
+pub const MIN_SUM_PER_SAT: f64 = 8.0;
+/// See [`MIN_SUM_PER_SAT`].
+pub const MIN_SUM: f64 = 60.0;
 /// Satellites that must jump together.
 pub const MIN_SATELLITES: usize = 3;
 /// Jumps this close in time are one event, s.
-const CLUSTER_S: f64 = 0.006;
+pub const CLUSTER_S: f64 = 0.006;
 /// Reports in lock before a satellite is watched.
-const STEADY_REPORTS: u32 = 50;
+pub const STEADY_REPORTS: u32 = 50;
 /// Weakest C/N0 watched, dB-Hz (below it the phase noise hides the jumps).
-const MIN_CN0_DBHZ: f64 = 30.0;
+pub const MIN_CN0_DBHZ: f64 = 30.0;
 /// Reports before a jump that give the carrier's phase and frequency there (the frequency
 /// to about 0.2 Hz at 40 dB-Hz with 1 ms reports).
-const PRE_REPORTS: usize = 80;
+pub const PRE_REPORTS: usize = 80;
 /// Reports left out on each side of a jump when its step is measured.
-const GUARD: usize = 5;
+pub const GUARD: usize = 5;
 /// Longest integration watched, s (a 20 ms integration smears a jump over a bit).
-const MAX_T_COH_S: f64 = 0.005;
+pub const MAX_T_COH_S: f64 = 0.005;
 
 /// A discontinuity found.
 #[derive(Debug, Clone, PartialEq)]

@@ -33,7 +33,9 @@ pub enum CarryNote {
 /// What is kept over a sample gap to measure it once the time is re-established.
 #[derive(Debug, Clone)]
 pub struct GapRecovery {
+    /// Stream time of the gap, s.
     pub t_s: f64,
+    /// The last fix before it: stream time (s), clock bias after any step (m), drift (m/s).
     pub before: Option<(f64, f64, f64)>,
     /// The carrier-phase steps at the gap `(step rad, carrier Hz)`: with them, the SV times
     /// are kept and carried over the gap once its length is resolved
