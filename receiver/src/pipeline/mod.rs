@@ -4,6 +4,7 @@
 //!   (`run`) or by sample blocks (`push`), writing to a [`Sink`];
 //! - [`channel_manager`]: the cold start, re-acquisition, and the channels' work per block;
 //! - [`navigation`]: LNAV decoders, observables, PVT, clock steering and aiding feedback;
+//! - [`fix_output`]: the fix, observables and integrity verdict of an epoch, fix statistics;
 //! - [`sink`]: what the receiver emits ([`Sink`], [`MemorySink`]);
 //! - [`aiding`]: the INS-velocity Doppler feed-forward for the channels' aiding port;
 //! - [`aid_monitor`]: the integrity check of that feed-forward against the tracked Doppler;
@@ -21,6 +22,7 @@ pub mod aiding;
 pub mod channel_manager;
 pub mod dating;
 pub mod discontinuity;
+pub mod fix_output;
 pub mod gap_length;
 pub mod navdata;
 pub mod navigation;
