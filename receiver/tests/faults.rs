@@ -307,6 +307,51 @@ fn a_thirty_second_blockage_ends_in_fixes_within_two_seconds() {
 }
 
 #[test]
+fn no_gap_is_reported_through_a_10_g_turn() {
+    // Every channel's phase error moves at once when a 10 g turn starts (a 0.5 s jerk ramp at
+    // 100 m/s): dynamics, not lost samples.
+    let text = format!(
+        r#"
+duration_s = 22.0
+seed = 5
+nav = "builtin:brdc0010.22n"
+[start]
+week = 2190
+tow_s = 538198.0
+[output]
+format = "cf32_le"
+fs_hz = {FS_HZ}
+[receiver]
+kind = "motion"
+start_llh_deg = [{}, {}, {}]
+heading_deg = 90.0
+speed_mps = 100.0
+transition_s = 0.5
+segments = [
+  {{ type = "cruise", duration_s = 11.0 }},
+  {{ type = "turn", duration_s = 5.0, accel_g = 10.0, direction = "left" }},
+  {{ type = "cruise", duration_s = 6.0 }},
+]
+"#,
+        LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
+    );
+    let sc = Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let sink = run(&sim, Fault::None);
+    assert!(
+        gaps(&sink).is_empty(),
+        "gaps reported at {:?} s",
+        gaps(&sink)
+    );
+    let in_turn = sink
+        .fixes
+        .iter()
+        .filter(|f| f.fix.quality != FixQuality::None && (11.0..16.0).contains(&f.t_stream_s))
+        .count();
+    assert!(in_turn >= 45, "{in_turn} valid fixes in the 5 s turn");
+}
+
+#[test]
 #[ignore]
 fn measure_faults() {
     let sim = simulator(26.0, "");
