@@ -30,6 +30,9 @@ pub const MIN_SIGMA_RAD: f64 = 0.06;
 pub const MIN_SUM_PER_SAT: f64 = 8.0;
 /// See [`MIN_SUM_PER_SAT`].
 pub const MIN_SUM: f64 = 60.0;
+/// Normalised squared step `(step / sigma_d)^2` of a satellite that shows a jump clearly
+/// (a 5 sigma step).
+pub const STRONG_Z2: f64 = 25.0;
 /// Satellites that must jump together.
 pub const MIN_SATELLITES: usize = 3;
 /// Jumps this close in time are one event, s.
@@ -239,8 +242,8 @@ impl DiscontinuityMonitor {
     /// same instant for every satellite), from up to [`PRE_REPORTS`] reports before it to up
     /// to 8 after it, leaving out [`GUARD`] reports on each side (the instant is known to a few
     /// reports: at 37-44 dB-Hz the best splits of the satellites scatter by +-2 ms).
-    fn phase_steps(&self, best: &BTreeMap<u8, (f64, u64)>, jump: u64) -> Vec<(u8, f64, f64)> {
-        best.keys()
+    fn phase_steps(&self, prns: &[u8], jump: u64) -> Vec<(u8, f64, f64)> {
+        prns.iter()
             .filter_map(|prn| {
                 let w = self.watches.get(prn)?;
                 let pts: Vec<NcoPoint> = w.nco.iter().copied().collect();
@@ -262,46 +265,57 @@ impl DiscontinuityMonitor {
     }
 
     /// After all channels have reported up to sample `end`: the discontinuity among the steps
-    /// old enough to be complete, if any. At each step's time `t`, every satellite's largest
+    /// old enough to be complete, if any. At each strong step's time `t`, every satellite's largest
     /// normalised step within [`CLUSTER_S`] after it is summed: `S = sum_i max z_i^2`. Without
     /// a jump `S` is a sum of maxima of a few `chi^2_1` (about 3 per satellite); a common jump
     /// uniform in +-90 deg adds `(pi/2)^2 / 3 / sigma_d^2` per satellite (about 50 at 45
     /// dB-Hz). A discontinuity needs `S > MIN_SUM_PER_SAT n + MIN_SUM` over the `n` satellites
-    /// watched and [`MIN_SATELLITES`] of them with `z^2 > 25`.
+    /// watched and [`MIN_SATELLITES`] of them with `z^2 >` [`STRONG_Z2`].
     pub fn evaluate(&mut self, end: u64) -> Option<Discontinuity> {
         let settle = (0.02 * self.fs_hz) as u64;
         let cluster = (CLUSTER_S * self.fs_hz) as u64;
         let ready = end.saturating_sub(settle);
         self.steps.sort_unstable_by_key(|s| s.0);
         let mut found = None;
-        for (i, &(t0, ..)) in self.steps.iter().enumerate() {
+        // A discontinuity needs strong steps, so windows start only at those (the others
+        // cannot open one that passes): linear in the steps, not quadratic.
+        for (i, &(t0, _, z2)) in self.steps.iter().enumerate() {
             if t0 + cluster > ready {
                 break;
             }
+            if z2 <= STRONG_Z2 {
+                continue;
+            }
             // Per PRN: the largest normalised step, and where.
-            let mut best: BTreeMap<u8, (f64, u64)> = BTreeMap::new();
+            let mut best: Vec<(u8, f64, u64)> = Vec::with_capacity(16);
             for &(at, prn, z2) in self.steps[i..].iter().take_while(|s| s.0 < t0 + cluster) {
-                let b = best.entry(prn).or_insert((0.0, at));
-                if z2 > b.0 {
-                    *b = (z2, at);
+                match best.iter_mut().find(|b| b.0 == prn) {
+                    Some(b) if z2 > b.1 => *b = (prn, z2, at),
+                    Some(_) => {}
+                    None => best.push((prn, z2, at)),
                 }
             }
             let n = best.len();
-            let sum: f64 = best.values().map(|b| b.0).sum();
-            let strong = best.values().filter(|b| b.0 > 25.0).count();
+            let sum: f64 = best.iter().map(|b| b.1).sum();
+            let strong: Vec<u64> = best
+                .iter()
+                .filter(|b| b.1 > STRONG_Z2)
+                .map(|b| b.2)
+                .collect();
             if n >= MIN_SATELLITES
-                && strong >= MIN_SATELLITES
+                && strong.len() >= MIN_SATELLITES
                 && sum > MIN_SUM_PER_SAT * n as f64 + MIN_SUM
             {
                 tracing::debug!("carrier phase steps at sample {t0}: {best:?}");
                 // The jump's instant: the median split of the satellites that show it clearly.
-                let mut ats: Vec<u64> = best.values().filter(|b| b.0 > 25.0).map(|b| b.1).collect();
+                let mut ats = strong;
                 ats.sort_unstable();
                 let jump = ats.get(ats.len() / 2).copied().unwrap_or(t0);
-                let steps = self.phase_steps(&best, jump);
+                let prns: Vec<u8> = best.iter().map(|b| b.0).collect();
+                let steps = self.phase_steps(&prns, jump);
                 found = Some(Discontinuity {
                     sample: jump,
-                    jumped: strong,
+                    jumped: ats.len(),
                     watched: n,
                     steps,
                 });
