@@ -67,6 +67,13 @@ impl GpsTime {
         dweek as f64 * SECONDS_PER_WEEK + (self.tow_s - earlier.tow_s)
     }
 
+    /// A difference of two times of week (s, e.g. a receive TOW minus a transmit TOW) whose
+    /// week is not known, folded into +-half a week: across a week crossover `0.07 - 604799.93`
+    /// is the 0.14 s it means.
+    pub fn fold_tow_difference_s(d_s: f64) -> f64 {
+        d_s - (d_s / SECONDS_PER_WEEK).round() * SECONDS_PER_WEEK
+    }
+
     /// Converts a calendar date and time *in the GPS time scale* (no leap seconds applied) into
     /// week and TOW. Out-of-range fields roll over arithmetically (month 13 is January of the
     /// next year, day 0 is the last day of the previous month, hour 24 is the next day).

@@ -186,3 +186,12 @@ fn utc_and_gps_time_differ_by_the_leap_seconds_of_the_date() {
     assert_eq!((y, mo, d, h, mi), (2017, 1, 1, 0, 0));
     assert!(s.abs() < 1e-9);
 }
+
+#[test]
+fn tow_differences_fold_across_the_week_crossover() {
+    // Received 0.07 s into a week, sent 0.07 s before its end: 0.14 s of travel, not -604800 s.
+    let d = GpsTime::fold_tow_difference_s(0.07 - 604_799.93);
+    assert!((d - 0.14).abs() < 1e-9, "{d}");
+    assert!((GpsTime::fold_tow_difference_s(-0.075) + 0.075).abs() < 1e-12);
+    assert!((GpsTime::fold_tow_difference_s(604_799.5 - 0.5) + 1.0).abs() < 1e-9);
+}

@@ -18,6 +18,7 @@
 //! instant are summed and tested ([`DiscontinuityMonitor::evaluate`]); a satellite whose prompt
 //! power collapsed is not counted (a blockage, not lost samples).
 
+use crate::pipeline::gap_length::nearest_remainder;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use num_complex::Complex64;
 use std::collections::{BTreeMap, VecDeque};
@@ -122,7 +123,7 @@ impl NcoPoint {
             let d = p.signal_phase_rad()
                 - r.signal_phase_rad()
                 - std::f64::consts::TAU * r.freq_hz * t(p);
-            d - (d / std::f64::consts::PI).round() * std::f64::consts::PI
+            nearest_remainder(d, std::f64::consts::PI)
         };
         // Least-squares line psi = a + b t over `pre`.
         let n = pre.len() as f64;
@@ -258,7 +259,7 @@ impl DiscontinuityMonitor {
                 let (a, _) = NcoPoint::phase_step(pre, &post[..half], self.fs_hz)?;
                 let (b, _) = NcoPoint::phase_step(pre, &post[half..], self.fs_hz)?;
                 let d = a - b;
-                let d = d - (d / std::f64::consts::PI).round() * std::f64::consts::PI;
+                let d = nearest_remainder(d, std::f64::consts::PI);
                 (d.abs() < 0.3).then_some((*prn, step, freq_hz))
             })
             .collect()
@@ -430,7 +431,7 @@ mod tests {
         let g = 0.031;
         let step = |i: usize| {
             let x = TAU * FREQS[i] * g;
-            x - (x / PI).round() * PI
+            nearest_remainder(x, PI)
         };
         let d = run(200, step, |_| 1.0).expect("found");
         assert!(
@@ -443,7 +444,7 @@ mod tests {
         for &(prn, s, f) in &d.steps {
             let i = usize::from(prn) - 1;
             let err = s - step(i);
-            let err = err - (err / PI).round() * PI;
+            let err = nearest_remainder(err, PI);
             assert!(
                 err.abs() < 0.15,
                 "G{prn}: step {s:.3} against {:.3}",

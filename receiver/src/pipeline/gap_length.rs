@@ -22,6 +22,12 @@
 //! best score of at least [`MIN_SCORE`] and every other candidate [`MIN_MARGIN`] below it:
 //! otherwise the length is unknown and the time must come from the navigation message.
 
+/// `x` less the nearest multiple of `period`: in [-period/2, period/2] (a phase modulo half a
+/// cycle with `period = pi`, a time within a data bit with `period = 20` ms).
+pub fn nearest_remainder(x: f64, period: f64) -> f64 {
+    x - (x / period).round() * period
+}
+
 /// Spread of a measured phase step, rad.
 pub const STEP_SIGMA_RAD: f64 = 0.25;
 
@@ -47,7 +53,7 @@ pub fn resolve_gap_ms(offset_ms: f64, steps: &[(f64, f64)], max_ms: f64) -> Opti
             .iter()
             .map(|&(d, f)| {
                 let e = std::f64::consts::TAU * f * g - d;
-                let e = e - (e / std::f64::consts::PI).round() * std::f64::consts::PI;
+                let e = nearest_remainder(e, std::f64::consts::PI);
                 (-e * e / (2.0 * STEP_SIGMA_RAD * STEP_SIGMA_RAD)).exp()
             })
             .sum::<f64>()
@@ -91,7 +97,7 @@ pub fn estimate_from_code(offsets: &[(f64, f64)]) -> Option<(f64, f64)> {
         .iter()
         .map(|&(o, r)| {
             let d = -(o - o0);
-            (r - r0, d - (d / 20.0).round() * 20.0)
+            (r - r0, nearest_remainder(d, 20.0))
         })
         .collect();
     let n = pts.len() as f64;
@@ -141,7 +147,7 @@ mod tests {
             .zip(noise.iter().cycle())
             .map(|(&f, &n)| {
                 let phi = std::f64::consts::TAU * f * g_ms * 1e-3 + n;
-                let folded = phi - (phi / std::f64::consts::PI).round() * std::f64::consts::PI;
+                let folded = nearest_remainder(phi, std::f64::consts::PI);
                 (folded, f)
             })
             .collect()
@@ -173,7 +179,7 @@ mod tests {
                 .map(|(&f, n)| {
                     let r = 1.0 + f / 1.57542e9;
                     let o = -g * r;
-                    (o - (o / 20.0).round() * 20.0 + n, r)
+                    (nearest_remainder(o, 20.0) + n, r)
                 })
                 .collect();
             let (est, sigma) = estimate_from_code(&offsets).expect("estimate");

@@ -20,6 +20,7 @@ use gpsrx_nav::lnav::{
     decode_subframe_any_polarity, decode_tlm_how, preamble_polarity, DecodedSubframe,
     EphemerisAssembler, Polarity, SubframePayload,
 };
+use gpsrx_nav::time::GpsTime;
 use std::collections::VecDeque;
 
 const SUBFRAME_BITS: usize = 300;
@@ -198,8 +199,9 @@ impl NavDecoder {
         };
         let first_ms = self.bits[n - 60].1;
         let tow = how.subframe_start_tow_s();
-        let mut err = f64::from(tow) - (sv0 + (first_ms as f64 - m0 as f64) * 1e-3);
-        err -= (err / 604_800.0).round() * 604_800.0;
+        let err = GpsTime::fold_tow_difference_s(
+            f64::from(tow) - (sv0 + (first_ms as f64 - m0 as f64) * 1e-3),
+        );
         if err.abs() > tol {
             return false;
         }
@@ -224,7 +226,7 @@ impl NavDecoder {
             return;
         };
         let sv_ms = sv * 1e3;
-        let off = sv_ms - (sv_ms / 20.0).round() * 20.0;
+        let off = crate::pipeline::gap_length::nearest_remainder(sv_ms, 20.0);
         if off.abs() > 0.5 {
             events.push(NavEvent::BitEdgeMismatch { offset_ms: off });
             self.reset_sync();
@@ -357,8 +359,7 @@ impl NavDecoder {
         let tow_s = sf.how.subframe_start_tow_s();
         if let Some(kept) = self.sv_tow_s(first_ms, 0.0) {
             // The HOW against the time kept (week roll-over folded).
-            let mut err = f64::from(tow_s) - kept;
-            err -= (err / 604_800.0).round() * 604_800.0;
+            let err = GpsTime::fold_tow_difference_s(f64::from(tow_s) - kept);
             if err.abs() > 1e-4 {
                 events.push(NavEvent::TowMismatch {
                     error_ms: err * 1e3,
@@ -372,7 +373,7 @@ impl NavDecoder {
             tow_s,
         });
         if let SubframePayload::Subframe1(s1) = &sf.payload {
-            self.week = Some(gpsrx_nav::time::GpsTime::resolve_week_10bit(
+            self.week = Some(GpsTime::resolve_week_10bit(
                 s1.week_mod_1024,
                 self.reference_week,
             ));

@@ -446,8 +446,7 @@ impl NavigationProcessor {
         let Some(sv) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) else {
             return Ok(());
         };
-        let mut tau = t0.tow_s + e.t_rx_s - sv;
-        tau -= (tau / 604_800.0).round() * 604_800.0;
+        let tau = gpsrx_nav::time::GpsTime::fold_tow_difference_s(t0.tow_s + e.t_rx_s - sv);
         if (0.06..=0.095).contains(&tau) {
             return Ok(());
         }

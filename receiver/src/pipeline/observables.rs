@@ -198,8 +198,7 @@ impl ObservableBuilder {
             let dt = t_epoch - start_rx;
             let sv_tow = sv_tow0 + dt * e.code_rate_chips_s / CA_CHIP_RATE_HZ;
             // Week-boundary safe difference of two TOWs.
-            let mut tau = t_epoch - sv_tow;
-            tau -= (tau / 604_800.0).round() * 604_800.0;
+            let tau = GpsTime::fold_tow_difference_s(t_epoch - sv_tow);
             let carrier = e.carrier_phase_cycles + dt * e.doppler_hz;
             let lost_flag = std::mem::replace(self.lli.entry(e.prn).or_insert(false), false);
             let pseudorange_m = tau * SPEED_OF_LIGHT_MPS;

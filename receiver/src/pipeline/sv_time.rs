@@ -8,6 +8,7 @@
 //! ([`crate::pipeline::gap_length`]) and every time moved over it, or, when that cannot be
 //! done, the times become rough hints for a fast frame sync ([`NavDecoder::hint_time`]).
 
+use crate::pipeline::gap_length::nearest_remainder;
 use crate::pipeline::navdata::NavDecoder;
 use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_tracking::ChannelEpoch;
@@ -262,7 +263,7 @@ impl SvTimeKeeper {
             Some(gap) if !gap.unresolved && gap.length_ms.is_none() => {
                 // Across lost samples: first their length, from the offsets of the kept time
                 // from the new bit edges and the carrier-phase steps.
-                let off = edge_ms - (edge_ms / 20.0).round() * 20.0;
+                let off = nearest_remainder(edge_ms, 20.0);
                 if gap.add_edge_offset(e.prn, off, clock.rate, e.t_rx_s) {
                     let length_ms = gap.length_ms.unwrap_or(0.0);
                     note = Some(CarryNote::GapResolved {
@@ -283,8 +284,8 @@ impl SvTimeKeeper {
             Some(gap) if gap.length_ms.is_none() => return None,
             _ => {}
         }
-        let bit_ms = (edge_ms / 20.0).round() * 20.0;
-        let off_ms = edge_ms - bit_ms;
+        let off_ms = nearest_remainder(edge_ms, 20.0);
+        let bit_ms = edge_ms - off_ms;
         if off_ms.abs() > 1.0 {
             tracing::info!(
                 "G{:02}: the SV time carried over {elapsed_s:.1} s falls {off_ms:+.3} ms off the new bit edge (samples lost?): waiting for frame sync",
