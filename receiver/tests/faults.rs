@@ -14,13 +14,13 @@ use std::path::Path;
 const FS_HZ: f64 = 2.048e6;
 const LLH_DEG: [f64; 3] = [36.3721, 127.3604, 80.0];
 
-/// A static receiver, 2.048 MHz, the built-in broadcast ephemerides, with `outages` (TOML
-/// `[[outages]]` tables) blocking the signals.
-fn simulator(duration_s: f64, outages: &str) -> Simulator {
+/// A scenario at 2.048 MHz with the built-in broadcast ephemerides: `receiver` is the body of
+/// its `[receiver]` table, `rest` any further tables.
+fn scenario(duration_s: f64, seed: u64, receiver: &str, rest: &str) -> Simulator {
     let text = format!(
         r#"
 duration_s = {duration_s}
-seed = 11
+seed = {seed}
 nav = "builtin:brdc0010.22n"
 [start]
 week = 2190
@@ -29,17 +29,23 @@ tow_s = 538198.0
 format = "cf32_le"
 fs_hz = {FS_HZ}
 [receiver]
-kind = "static"
-llh_deg = [{}, {}, {}]
-[clock]
-bias_s = 3.0e-4
-drift_s_s = 4.0e-8
-{outages}
-"#,
-        LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
+{receiver}
+{rest}
+"#
     );
     let sc = Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
     Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A static receiver with a receiver clock bias and drift, with `outages` (TOML
+/// `[[outages]]` tables) blocking the signals.
+fn simulator(duration_s: f64, outages: &str) -> Simulator {
+    let receiver = format!(
+        "kind = \"static\"\nllh_deg = [{}, {}, {}]",
+        LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
+    );
+    let rest = format!("[clock]\nbias_s = 3.0e-4\ndrift_s_s = 4.0e-8\n{outages}");
+    scenario(duration_s, 11, &receiver, &rest)
 }
 
 fn receiver() -> Receiver {
@@ -310,19 +316,8 @@ fn a_thirty_second_blockage_ends_in_fixes_within_two_seconds() {
 fn no_gap_is_reported_through_a_10_g_turn() {
     // Every channel's phase error moves at once when a 10 g turn starts (a 0.5 s jerk ramp at
     // 100 m/s): dynamics, not lost samples.
-    let text = format!(
-        r#"
-duration_s = 22.0
-seed = 5
-nav = "builtin:brdc0010.22n"
-[start]
-week = 2190
-tow_s = 538198.0
-[output]
-format = "cf32_le"
-fs_hz = {FS_HZ}
-[receiver]
-kind = "motion"
+    let receiver = format!(
+        r#"kind = "motion"
 start_llh_deg = [{}, {}, {}]
 heading_deg = 90.0
 speed_mps = 100.0
@@ -331,12 +326,10 @@ segments = [
   {{ type = "cruise", duration_s = 11.0 }},
   {{ type = "turn", duration_s = 5.0, accel_g = 10.0, direction = "left" }},
   {{ type = "cruise", duration_s = 6.0 }},
-]
-"#,
+]"#,
         LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
     );
-    let sc = Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
-    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let sim = scenario(22.0, 5, &receiver, "");
     let sink = run(&sim, Fault::None);
     assert!(
         gaps(&sink).is_empty(),
