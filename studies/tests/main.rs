@@ -12,6 +12,17 @@ enum Command {
     Study(gpsrx_studies::StudyArgs),
 }
 
+/// Runs `gpsrx study ARGS... --out OUT` as the command line would, panicking with the error
+/// (the tests then check the files in `out`).
+fn run_study(args: &[&str], out: &std::path::Path) {
+    use clap::Parser;
+    let tail = ["--out", out.to_str().unwrap_or_default()];
+    let argv = ["gpsrx", "study"].iter().chain(args).chain(&tail).copied();
+    let cli = Cli::try_parse_from(argv).unwrap_or_else(|e| panic!("{e}"));
+    let Command::Study(args) = cli.command;
+    gpsrx_studies::run(&args).unwrap_or_else(|e| panic!("{e:#}"));
+}
+
 mod study_bandwidth;
 mod study_dr;
 mod study_dynamics;

@@ -1,8 +1,6 @@
 //! `gpsrx study bandwidth --quick`: simulated IF, tracked by the real channels, against the
 //! thermal-noise formulas (oracles.md "Noise") and seed 004 Table 2's trend.
 
-use crate::{Cli, Command};
-use clap::Parser;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -32,19 +30,9 @@ fn num(row: &HashMap<String, String>, col: &str) -> f64 {
 fn quick_bandwidth_study_matches_the_thermal_formulas_and_seed_004_trend() {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
     let out = dir.path().join("bw");
-    let cli = Cli::try_parse_from([
-        "gpsrx",
-        "study",
-        "bandwidth",
-        "--quick",
-        "--out",
-        out.to_str().unwrap_or_default(),
-    ])
-    .unwrap_or_else(|e| panic!("{e}"));
-    let Command::Study(args) = cli.command;
     // (Its run time, 6 s in release on 2 cores, is reported in the study, not asserted here:
     // speed is checked by benchmarks.)
-    gpsrx_studies::run(&args).unwrap_or_else(|e| panic!("{e:#}"));
+    crate::run_study(&["bandwidth", "--quick"], &out);
 
     // Every file, and plots with content.
     for f in ["study.md", "study.csv", "study.json"] {

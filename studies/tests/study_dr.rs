@@ -5,8 +5,6 @@
 //! seconds after a satellite-set change) and the speed filter through 20-60 s gaps, one noise
 //! seed. The assertions read `study.json` and check the files.
 
-use crate::{Cli, Command};
-use clap::Parser;
 use serde_json::Value;
 use std::time::Instant;
 
@@ -20,20 +18,8 @@ fn num(v: &Value, key: &str) -> f64 {
 fn quick_dr_study_reproduces_seeds_000_and_002() {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
     let out = dir.path().join("dr");
-    let cli = Cli::try_parse_from([
-        "gpsrx",
-        "study",
-        "dr",
-        "--quick",
-        "--seed",
-        "3",
-        "--out",
-        out.to_str().unwrap_or_default(),
-    ])
-    .unwrap_or_else(|e| panic!("{e}"));
-    let Command::Study(args) = cli.command;
     let started = Instant::now();
-    gpsrx_studies::run(&args).unwrap_or_else(|e| panic!("{e:#}"));
+    crate::run_study(&["dr", "--quick", "--seed", "3"], &out);
     eprintln!("quick dr study: {:.1} s", started.elapsed().as_secs_f64());
     for f in [
         "study.md",

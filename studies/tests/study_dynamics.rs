@@ -4,8 +4,6 @@
 //! 2nd-order PLL at 3 Hz unaided and aided by INS 1 (accelerometer bias B) and INS 2 (2B), and
 //! by a 1st-order PLL at 18 Hz aided by each INS. The assertions read `study.json`.
 
-use crate::{Cli, Command};
-use clap::Parser;
 use serde_json::Value;
 use std::time::Instant;
 
@@ -22,20 +20,8 @@ fn num(v: &Value, path: &[&str]) -> f64 {
 fn quick_dynamics_study_reproduces_seed_004() {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
     let out = dir.path().join("dyn");
-    let cli = Cli::try_parse_from([
-        "gpsrx",
-        "study",
-        "dynamics",
-        "--quick",
-        "--seed",
-        "4",
-        "--out",
-        out.to_str().unwrap_or_default(),
-    ])
-    .unwrap_or_else(|e| panic!("{e}"));
-    let Command::Study(args) = cli.command;
     let started = Instant::now();
-    gpsrx_studies::run(&args).unwrap_or_else(|e| panic!("{e:#}"));
+    crate::run_study(&["dynamics", "--quick", "--seed", "4"], &out);
     eprintln!(
         "quick dynamics study: {:.1} s",
         started.elapsed().as_secs_f64()
