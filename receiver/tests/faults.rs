@@ -135,6 +135,14 @@ fn describe(name: &str, sink: &MemorySink, fault_s: f64) {
         .count();
     eprintln!("{name}: {invalid} invalid after");
     eprintln!(
+        "{name}: first errors after {:?}",
+        after
+            .iter()
+            .take(12)
+            .map(|x| format!("{:.1}@{:.1}", x.1, x.0))
+            .collect::<Vec<_>>()
+    );
+    eprintln!(
         "{name}: {} fixes, p95 {:.2} m, after the fault: {} fixes, worst {worst:.1} m, first after {resumed:?} s\n  events: {}",
         errs.len(),
         p95(&errs),
@@ -209,7 +217,7 @@ fn whole_millisecond_gaps_are_reported_measured_and_bridged_within_a_second() {
         );
         let m = measured(&sink);
         assert!(
-            m.len() == 1 && (m[0] - ms).abs() < 0.01,
+            m.len() == 1 && (m[0] - ms).abs() < 1e-3,
             "{name}: measured {m:?} ms"
         );
         let back = back_after(&sink, FAULT_AT_S);
@@ -221,11 +229,12 @@ fn whole_millisecond_gaps_are_reported_measured_and_bridged_within_a_second() {
 }
 
 #[test]
-fn a_fractional_millisecond_gap_and_a_half_second_gap_are_bridged_within_a_subframe() {
-    // 1.25 ms: the code jumps, every channel loses its satellite; the SV times carried to the
-    // new channels fall 1.25 ms off their bit edges, which reports the gap. 0.5 s: a whole
-    // number of bits, caught by the integrity test. Both: the time comes back from the first
-    // TLM and HOW that agree with the SV times kept, within a subframe (6 s).
+fn fractional_millisecond_and_half_second_gaps_are_measured_and_bridged_within_a_second() {
+    // The code jumps: by a quarter of a period for 1.25 ms, by up to a chip (g f_D / f_L1) for
+    // 0.5 s. The prompt power collapses on several satellites at once, every tracked satellite
+    // is searched at its Doppler, and the channels are moved onto the code that one gap length
+    // explains; the length is resolved from the new bit edges, the carrier-phase steps and the
+    // code, the SV times carried over it and the receiver clock stepped by it.
     let sim = simulator(DURATION_S, "");
     for len_s in [1.25e-3, 0.5] {
         let name = format!("{len_s} s cut");
@@ -239,17 +248,18 @@ fn a_fractional_millisecond_gap_and_a_half_second_gap_are_bridged_within_a_subfr
         assert_no_wrong_fix(&name, &sink);
         let g = gaps(&sink);
         assert!(
-            !g.is_empty() && g[0] >= FAULT_AT_S - 0.01 && g[0] < FAULT_AT_S + 3.0,
+            g.len() == 1 && (g[0] - FAULT_AT_S).abs() < 0.05,
             "{name}: gaps reported at {g:?} s"
         );
+        // The receiver time lost, to a microsecond (the SV times ran g (1 + f_D / f_L1)).
         let m = measured(&sink);
         assert!(
-            m.len() == 1 && (m[0] - len_s * 1e3).abs() < 0.01,
+            m.len() == 1 && (m[0] - len_s * 1e3).abs() < 1e-3,
             "{name}: measured {m:?} ms"
         );
         let back = back_after(&sink, FAULT_AT_S);
         assert!(
-            back.is_some_and(|b| b <= 6.0),
+            back.is_some_and(|b| b <= 1.0),
             "{name}: fixes back {back:?} s after the gap"
         );
     }

@@ -29,6 +29,9 @@ use gpsrx_dsp::correlator::{Correlator, PackedCode, ReplicaState, SampleSlice};
 use num_complex::{Complex32, Complex64};
 use serde::{Deserialize, Serialize};
 
+mod realign;
+pub use realign::CodeShift;
+
 /// Channel settings: the pull-in and tracking loops and the lock thresholds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

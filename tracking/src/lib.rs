@@ -37,7 +37,7 @@ pub mod phase_sim;
 pub use aiding::{AidingPort, DopplerAid};
 pub use bit_sync::{Bit, BitSync, BitSyncConfig, BitSyncState};
 pub use carrier_loop::{CarrierLoop, CarrierOutput};
-pub use channel::{Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState};
+pub use channel::{Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState, CodeShift};
 pub use cn0::{M2m4Estimator, NwprEstimator};
 pub use code_loop::{CodeLoop, CodeOutput};
 pub use config::{ConfigError, DllDiscriminator, FllDiscriminator, LoopConfig, PllDiscriminator};

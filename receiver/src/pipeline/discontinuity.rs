@@ -18,6 +18,7 @@
 //! instant are summed and tested ([`DiscontinuityMonitor::evaluate`]); a satellite whose prompt
 //! power collapsed is not counted (a blockage, not lost samples).
 
+use crate::pipeline::carrier_step::{phase_step, NcoPoint, PhaseStep};
 use crate::pipeline::gap_length::nearest_remainder;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use num_complex::Complex64;
@@ -42,11 +43,16 @@ pub const CLUSTER_S: f64 = 0.006;
 pub const STEADY_REPORTS: u32 = 50;
 /// Weakest C/N0 watched, dB-Hz (below it the phase noise hides the jumps).
 pub const MIN_CN0_DBHZ: f64 = 30.0;
-/// Reports before a jump that give the carrier's phase and frequency there (the frequency
-/// to about 0.2 Hz at 40 dB-Hz with 1 ms reports).
-pub const PRE_REPORTS: usize = 80;
+/// Reports before a jump that give the carrier's phase, frequency and rate there
+/// ([`crate::pipeline::carrier_step`]: up to a second).
+pub const PRE_REPORTS: usize = 1000;
+/// Reports after a jump over which its step is averaged.
+pub const POST_REPORTS: usize = 32;
 /// Reports left out on each side of a jump when its step is measured.
 pub const GUARD: usize = 5;
+/// Reports of carrier NCO history kept per satellite: enough for the steps over a code jump,
+/// measured once the channels moved onto the new code hold the phase again.
+pub const NCO_HISTORY: usize = PRE_REPORTS + 500;
 /// Longest integration watched, s (a 20 ms integration smears a jump over a bit).
 pub const MAX_T_COH_S: f64 = 0.005;
 
@@ -59,90 +65,9 @@ pub struct Discontinuity {
     pub jumped: usize,
     /// Satellites watched at the time.
     pub watched: usize,
-    /// Per satellite: PRN, the step of its carrier phase over the jump (rad, modulo pi:
-    /// Costas) and its carrier frequency, Hz ([`NcoPoint::phase_step`]).
-    pub steps: Vec<(u8, f64, f64)>,
-}
-
-/// A channel's carrier at one report: NCO and residual phase.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NcoPoint {
-    /// Sample index of the report's start.
-    pub sample: u64,
-    /// Accumulated NCO phase at it, cycles.
-    pub phase_cycles: f64,
-    /// NCO frequency over the report, Hz.
-    pub freq_hz: f64,
-    /// Integration time, s.
-    pub t_coh_s: f64,
-    /// Residual phase of the prompt, `atan(Q / I)`, rad.
-    pub residual_rad: f64,
-}
-
-impl NcoPoint {
-    /// The carrier of report `e`.
-    pub fn of(e: &ChannelEpoch) -> Self {
-        Self {
-            sample: e.sample_index,
-            phase_cycles: e.carrier_phase_cycles,
-            freq_hz: e.doppler_hz,
-            t_coh_s: e.t_coh_s,
-            residual_rad: if e.prompt.re != 0.0 {
-                (e.prompt.im / e.prompt.re).atan()
-            } else {
-                0.0
-            },
-        }
-    }
-
-    /// The signal's carrier phase at the middle of the report, rad: the NCO phase there plus
-    /// the prompt's residual.
-    fn signal_phase_rad(&self) -> f64 {
-        std::f64::consts::TAU * (self.phase_cycles + 0.5 * self.freq_hz * self.t_coh_s)
-            + self.residual_rad
-    }
-
-    /// The step of the signal's carrier phase (rad, modulo pi) between the reports `pre`
-    /// (before a jump) and `post` (after it). Each report's signal phase is taken relative to
-    /// the NCO line `phi_ref + 2 pi f_ref (t - t_ref)` of the last report before (`psi`, small
-    /// in lock); a straight line fitted to `psi` over `pre` (the NCO frequency of one report
-    /// is as noisy as the loop) is extrapolated over the few milliseconds to each report of
-    /// `post`, and the differences are averaged as `e^{2 i d}`. The loops' reaction does not
-    /// enter: the signal phase is NCO plus residual.
-    ///
-    /// Returns the step and the carrier frequency before the jump from the same fit
-    /// (`f_ref + b / 2 pi`: one report's NCO frequency is as noisy as the loop, several Hz,
-    /// while the step to explain is `2 pi f g`).
-    pub fn phase_step(pre: &[NcoPoint], post: &[NcoPoint], fs_hz: f64) -> Option<(f64, f64)> {
-        let r = pre.last()?;
-        if pre.len() < 4 || post.is_empty() {
-            return None;
-        }
-        let t = |p: &NcoPoint| (p.sample as f64 - r.sample as f64) / fs_hz;
-        let psi = |p: &NcoPoint| {
-            let d = p.signal_phase_rad()
-                - r.signal_phase_rad()
-                - std::f64::consts::TAU * r.freq_hz * t(p);
-            nearest_remainder(d, std::f64::consts::PI)
-        };
-        // Least-squares line psi = a + b t over `pre`.
-        let n = pre.len() as f64;
-        let (st, sp, stt, stp) = pre.iter().fold((0.0, 0.0, 0.0, 0.0), |acc, p| {
-            let (ti, pi) = (t(p), psi(p));
-            (acc.0 + ti, acc.1 + pi, acc.2 + ti * ti, acc.3 + ti * pi)
-        });
-        let den = n * stt - st * st;
-        if den <= 0.0 {
-            return None;
-        }
-        let b = (n * stp - st * sp) / den;
-        let a = (sp - b * st) / n;
-        let z: num_complex::Complex64 = post
-            .iter()
-            .map(|p| num_complex::Complex64::from_polar(1.0, 2.0 * (psi(p) - a - b * t(p))))
-            .sum();
-        Some((0.5 * z.arg(), r.freq_hz + b / std::f64::consts::TAU))
-    }
+    /// Per satellite: the step of its carrier phase over the jump
+    /// ([`crate::pipeline::carrier_step`]).
+    pub steps: Vec<PhaseStep>,
 }
 
 #[derive(Debug, Default)]
@@ -162,6 +87,8 @@ struct Watch {
 #[derive(Debug)]
 pub struct DiscontinuityMonitor {
     fs_hz: f64,
+    /// Steps before this sample are not judged (channels just moved onto a new code).
+    hold_until: u64,
     watches: BTreeMap<u8, Watch>,
     /// Normalised phase steps not yet judged: `(sample index, PRN, (step / sigma_d)^2)`.
     steps: Vec<(u64, u8, f64)>,
@@ -172,6 +99,7 @@ impl DiscontinuityMonitor {
     pub fn new(fs_hz: f64) -> Self {
         Self {
             fs_hz,
+            hold_until: 0,
             watches: BTreeMap::new(),
             steps: Vec::new(),
         }
@@ -190,7 +118,7 @@ impl DiscontinuityMonitor {
             && gap <= 2.5 * e.t_coh_s;
         // The NCO history is kept whatever the lock (a jump unlocks the phase detector).
         w.nco.push_back(NcoPoint::of(e));
-        if w.nco.len() > PRE_REPORTS + 40 {
+        if w.nco.len() > NCO_HISTORY {
             w.nco.pop_front();
         }
         if !watched {
@@ -217,6 +145,9 @@ impl DiscontinuityMonitor {
             }
         }
         w.steady += 1;
+        if e.sample_index < self.hold_until {
+            w.steady = 0;
+        }
         if w.steady < STEADY_REPORTS || w.recent.len() < 2 * WINDOW {
             return;
         }
@@ -239,28 +170,39 @@ impl DiscontinuityMonitor {
             .push((w.recent[WINDOW].0, e.prn, (step / sigma_d).powi(2)));
     }
 
-    /// Per satellite of `best`: the carrier-phase step over the jump at sample `jump` (the
-    /// same instant for every satellite), from up to [`PRE_REPORTS`] reports before it to up
-    /// to 8 after it, leaving out [`GUARD`] reports on each side (the instant is known to a few
-    /// reports: at 37-44 dB-Hz the best splits of the satellites scatter by +-2 ms).
-    fn phase_steps(&self, prns: &[u8], jump: u64) -> Vec<(u8, f64, f64)> {
+    /// No step before sample `sample` is judged (the phase loops of channels just moved onto
+    /// a new code are pulling in).
+    pub fn hold_until(&mut self, sample: u64) {
+        self.hold_until = sample;
+    }
+
+    /// Per satellite of `prns`: the carrier-phase step over the jump at sample `jump` (the
+    /// same instant for every satellite), from up to [`PRE_REPORTS`] reports before it to
+    /// [`POST_REPORTS`] after it, leaving out [`GUARD`] reports on each side (the instant is
+    /// known to a few reports: at 37-44 dB-Hz the best splits of the satellites scatter by
+    /// +-2 ms), or, with `post_from`, the reports from that sample on (after a code jump the
+    /// phase loop holds the signal again only later).
+    pub fn phase_steps(&self, prns: &[u8], jump: u64, post_from: Option<u64>) -> Vec<PhaseStep> {
         prns.iter()
-            .filter_map(|prn| {
-                let w = self.watches.get(prn)?;
+            .filter_map(|&prn| {
+                let w = self.watches.get(&prn)?;
                 let pts: Vec<NcoPoint> = w.nco.iter().copied().collect();
                 // The first report that starts after the jump; the one before straddles it.
                 let k = pts.iter().position(|p| p.sample > jump)?;
                 let pre = &pts[k.saturating_sub(PRE_REPORTS + GUARD)..k.saturating_sub(GUARD)];
-                let post = &pts[(k + GUARD).min(pts.len())..(k + GUARD + 8).min(pts.len())];
-                let (step, freq_hz) = NcoPoint::phase_step(pre, post, self.fs_hz)?;
+                let k_post = match post_from {
+                    Some(from) => pts.iter().position(|p| p.sample >= from)?,
+                    None => k + GUARD,
+                };
+                let post = &pts[k_post.min(pts.len())..(k_post + POST_REPORTS).min(pts.len())];
+                let step = phase_step(prn, pre, post, self.fs_hz)?;
                 // The two halves of `post` must agree (a loop slipping right after the jump
                 // gives no clean step): within 0.3 rad, modulo pi.
                 let half = post.len() / 2;
-                let (a, _) = NcoPoint::phase_step(pre, &post[..half], self.fs_hz)?;
-                let (b, _) = NcoPoint::phase_step(pre, &post[half..], self.fs_hz)?;
-                let d = a - b;
-                let d = nearest_remainder(d, std::f64::consts::PI);
-                (d.abs() < 0.3).then_some((*prn, step, freq_hz))
+                let a = phase_step(prn, pre, &post[..half], self.fs_hz)?;
+                let b = phase_step(prn, pre, &post[half..], self.fs_hz)?;
+                let d = nearest_remainder(a.step_rad - b.step_rad, std::f64::consts::PI);
+                (d.abs() < 0.3).then_some(step)
             })
             .collect()
     }
@@ -313,7 +255,7 @@ impl DiscontinuityMonitor {
                 ats.sort_unstable();
                 let jump = ats.get(ats.len() / 2).copied().unwrap_or(t0);
                 let prns: Vec<u8> = best.iter().map(|b| b.0).collect();
-                let steps = self.phase_steps(&prns, jump);
+                let steps = self.phase_steps(&prns, jump, None);
                 found = Some(Discontinuity {
                     sample: jump,
                     jumped: ats.len(),
@@ -441,7 +383,13 @@ mod tests {
         );
         assert!(d.jumped >= MIN_SATELLITES);
         assert!(d.steps.len() >= 6, "{:?}", d.steps);
-        for &(prn, s, f) in &d.steps {
+        for &PhaseStep {
+            prn,
+            step_rad: s,
+            freq_hz: f,
+            ..
+        } in &d.steps
+        {
             let i = usize::from(prn) - 1;
             let err = s - step(i);
             let err = nearest_remainder(err, PI);

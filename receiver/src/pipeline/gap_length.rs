@@ -28,6 +28,8 @@ pub fn nearest_remainder(x: f64, period: f64) -> f64 {
     x - (x / period).round() * period
 }
 
+use crate::pipeline::carrier_step::PhaseStep;
+
 /// Spread of a measured phase step, rad.
 pub const STEP_SIGMA_RAD: f64 = 0.25;
 
@@ -41,24 +43,30 @@ pub const MIN_SCORE: f64 = 0.6;
 /// Least margin of the best score over any other candidate.
 pub const MIN_MARGIN: f64 = 0.3;
 
+/// How well a lost time of `g_ms` explains the phase steps: the mean of
+/// `exp(-e^2 / 2 sigma^2)` over the steps, `e` each step's error modulo pi (1: all explained).
+pub fn phase_score(g_ms: f64, steps: &[PhaseStep]) -> f64 {
+    if steps.is_empty() {
+        return 0.0;
+    }
+    let g = g_ms * 1e-3;
+    steps
+        .iter()
+        .map(|s| {
+            let e = nearest_remainder(s.predicted_rad(g) - s.step_rad, std::f64::consts::PI);
+            (-e * e / (2.0 * STEP_SIGMA_RAD * STEP_SIGMA_RAD)).exp()
+        })
+        .sum::<f64>()
+        / steps.len() as f64
+}
+
 /// The lost time (ms) given its value modulo 20 ms (`offset_ms`, in [0, 20)) and the phase
-/// steps `(step rad, carrier frequency Hz)`, searched up to `max_ms`; `None` when not resolved.
-pub fn resolve_gap_ms(offset_ms: f64, steps: &[(f64, f64)], max_ms: f64) -> Option<f64> {
+/// steps, searched up to `max_ms`; `None` when not resolved.
+pub fn resolve_gap_ms(offset_ms: f64, steps: &[PhaseStep], max_ms: f64) -> Option<f64> {
     if steps.len() < MIN_STEPS || !offset_ms.is_finite() || !max_ms.is_finite() {
         return None;
     }
-    let score = |g_ms: f64| {
-        let g = g_ms * 1e-3;
-        steps
-            .iter()
-            .map(|&(d, f)| {
-                let e = std::f64::consts::TAU * f * g - d;
-                let e = nearest_remainder(e, std::f64::consts::PI);
-                (-e * e / (2.0 * STEP_SIGMA_RAD * STEP_SIGMA_RAD)).exp()
-            })
-            .sum::<f64>()
-            / steps.len() as f64
-    };
+    let score = |g_ms: f64| phase_score(g_ms, steps);
     // A length of (almost) zero is not a gap.
     let first_k = if offset_ms < 0.5 { 1 } else { 0 };
     let mut scored: Vec<(f64, f64)> = Vec::new();
@@ -119,20 +127,40 @@ pub fn estimate_from_code(offsets: &[(f64, f64)]) -> Option<(f64, f64)> {
     Some((g, sigma_d / syy.sqrt()))
 }
 
-/// The lost time (ms) from the offset modulo 20 ms and the two estimates: the code's
-/// `(g, sigma)` must single out one candidate `o + 20 k` (within 3 sigma, every other one
-/// beyond 6 sigma); the phase steps' must agree with it when both are there.
-pub fn choose(offset_ms: f64, by_phase: Option<f64>, by_code: Option<(f64, f64)>) -> Option<f64> {
-    let from_code = by_code.and_then(|(g, sigma)| {
-        let k = ((g - offset_ms) / 20.0).round();
-        let candidate = offset_ms + 20.0 * k;
-        let clear =
-            (candidate - g).abs() < 3.0 * sigma && 20.0 - (candidate - g).abs() > 6.0 * sigma;
-        (clear && candidate > 0.25).then_some(candidate)
-    });
+/// The lost time (ms) from the offset modulo 20 ms (`offset_ms`), the phase steps and the
+/// code's estimate `(g, sigma)`:
+///
+/// - the phase steps alone ([`resolve_gap_ms`]) or the code alone (one candidate `o + 20 k`
+///   within 3 sigma, every other one beyond 6 sigma) single out a candidate; when both do they
+///   must agree, and a phase candidate must be within 4 sigma of the code's estimate;
+/// - otherwise, when the code leaves exactly one candidate within 3 sigma and the phase steps
+///   explain it (score at least [`MIN_SCORE`]), that one: two independent measurements agree
+///   on it although neither alone excludes every other.
+pub fn choose(offset_ms: f64, steps: &[PhaseStep], by_code: Option<(f64, f64)>) -> Option<f64> {
+    let by_phase = resolve_gap_ms(offset_ms, steps, 1000.0);
+    let near_code = |sigmas: f64| -> Vec<f64> {
+        by_code.map_or(Vec::new(), |(g, sigma)| {
+            let k_lo = ((g - sigmas * sigma - offset_ms) / 20.0).ceil() as i64;
+            let k_hi = ((g + sigmas * sigma - offset_ms) / 20.0).floor() as i64;
+            (k_lo.max(0)..=k_hi)
+                .map(|k| offset_ms + 20.0 * k as f64)
+                .filter(|&c| c > 0.25)
+                .collect()
+        })
+    };
+    let from_code = match (near_code(3.0).as_slice(), near_code(6.0).len()) {
+        ([c], 1) => Some(*c),
+        _ => None,
+    };
+    let code_allows = |p: f64| by_code.is_none_or(|(g, sigma)| (p - g).abs() <= 4.0 * sigma);
     match (by_phase, from_code) {
         (Some(p), Some(c)) => ((p - c).abs() < 1e-6).then_some(p),
-        (p, c) => p.or(c),
+        (Some(p), None) => code_allows(p).then_some(p),
+        (None, Some(c)) => Some(c),
+        (None, None) => match near_code(3.0).as_slice() {
+            [c] if steps.len() >= MIN_STEPS && phase_score(*c, steps) >= MIN_SCORE => Some(*c),
+            _ => None,
+        },
     }
 }
 
@@ -140,15 +168,22 @@ pub fn choose(offset_ms: f64, by_phase: Option<f64>, by_code: Option<(f64, f64)>
 mod tests {
     use super::*;
 
-    /// Steps `2 pi f g` folded into (-pi/2, pi/2], with a little noise.
-    fn steps_for(g_ms: f64, freqs: &[f64], noise: &[f64]) -> Vec<(f64, f64)> {
+    /// Steps `2 pi (f g + f' g^2 / 2)` folded into (-pi/2, pi/2], with a little noise.
+    fn steps_for(g_ms: f64, freqs: &[f64], noise: &[f64]) -> Vec<PhaseStep> {
         freqs
             .iter()
             .zip(noise.iter().cycle())
-            .map(|(&f, &n)| {
-                let phi = std::f64::consts::TAU * f * g_ms * 1e-3 + n;
-                let folded = nearest_remainder(phi, std::f64::consts::PI);
-                (folded, f)
+            .enumerate()
+            .map(|(i, (&f, &n))| {
+                let mut s = PhaseStep {
+                    prn: i as u8 + 1,
+                    step_rad: 0.0,
+                    freq_hz: f,
+                    rate_hz_s: 0.9 - 0.25 * i as f64,
+                };
+                let phi = s.predicted_rad(g_ms * 1e-3) + n;
+                s.step_rad = nearest_remainder(phi, std::f64::consts::PI);
+                s
             })
             .collect()
     }
@@ -188,7 +223,7 @@ mod tests {
                 "{g}: {est} +- {sigma}"
             );
             let offset = (-offsets[0].0).rem_euclid(20.0);
-            let chosen = choose(offset, None, Some((est, sigma)));
+            let chosen = choose(offset, &[], Some((est, sigma)));
             assert!(
                 chosen.is_some_and(|c| (c - g).abs() < 1e-3),
                 "{g}: {chosen:?}"
@@ -201,10 +236,15 @@ mod tests {
         let steps = steps_for(31.0, &FREQS[..3], &NOISE);
         assert_eq!(resolve_gap_ms(11.0, &steps, 1000.0), None);
         // Steps that no length explains (random phases).
-        let random: Vec<(f64, f64)> = FREQS
+        let random: Vec<PhaseStep> = FREQS
             .iter()
             .zip([1.2, -0.7, 0.3, 1.5, -1.1, 0.9, -0.2, 0.6])
-            .map(|(&f, d)| (d, f))
+            .map(|(&f, d)| PhaseStep {
+                prn: 1,
+                step_rad: d,
+                freq_hz: f,
+                rate_hz_s: 0.0,
+            })
             .collect();
         assert_eq!(resolve_gap_ms(11.0, &random, 1000.0), None);
     }

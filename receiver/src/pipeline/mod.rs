@@ -12,6 +12,8 @@
 //! - [`dating`]: which GPS week labels receiver time before subframe 1 is decoded;
 //! - [`navdata`]: frame sync, subframes, ephemerides and SV time per satellite;
 //! - [`discontinuity`]: lost samples found by a carrier-phase jump common to the satellites;
+//! - [`code_jump`]: lost samples found by a code jump (prompt power collapsing together);
+//! - [`carrier_step`]: a satellite's carrier-phase step over lost samples;
 //! - [`gap_length`]: the length of lost time from the bit edges and carrier-phase steps;
 //! - [`sv_time`]: SV times kept across losses of the signal and lost samples;
 //! - [`observables`]: pseudoranges, carrier phase, Doppler at common receiver epochs;
@@ -19,7 +21,9 @@
 
 pub mod aid_monitor;
 pub mod aiding;
+pub mod carrier_step;
 pub mod channel_manager;
+pub mod code_jump;
 pub mod dating;
 pub mod discontinuity;
 pub mod fix_output;
@@ -30,6 +34,7 @@ pub mod observables;
 pub mod receiver;
 pub mod ring;
 pub mod sink;
+pub mod smoothing;
 pub mod sv_time;
 pub mod tracker;
 

@@ -10,6 +10,8 @@ use crate::config::{IonoModel, RunSettings, TropoModel};
 use crate::landmarks::LandmarkObservation;
 use crate::output::{ChannelRow, FixQuality};
 use crate::pipeline::aiding::InsFeedForward;
+use crate::pipeline::channel_manager::Realigned;
+use crate::pipeline::code_jump::{Collapse, CollapseMonitor};
 use crate::pipeline::discontinuity::{Discontinuity, DiscontinuityMonitor};
 pub use crate::pipeline::fix_output::FixStats;
 use crate::pipeline::fix_output::{fix_of, obs_epoch, passes_integrity};
@@ -56,8 +58,13 @@ pub struct NavigationProcessor {
     locked: BTreeSet<u8>,
     /// The satellites' SV times kept over losses and gaps.
     sv_time: SvTimeKeeper,
-    /// Watches for lost samples.
+    /// Watches for lost samples: carrier-phase jumps.
     monitor: DiscontinuityMonitor,
+    /// Watches for lost samples: prompt power collapsing on several satellites at once.
+    collapse: CollapseMonitor,
+    /// After a code realignment: the jump's sample, the satellites moved and the sample from
+    /// which their carrier phase is locked again, for the phase steps over the jump.
+    pending_steps: Option<(u64, Vec<u8>, u64)>,
     /// The last valid fix: stream time (s), clock bias after any clock step (m), clock drift
     /// (m/s).
     last_clock: Option<(f64, f64, f64)>,
@@ -70,6 +77,25 @@ pub struct NavigationProcessor {
 /// Time the code loops of channels that kept their satellites over lost samples need before
 /// their offsets measure the gap, s (four time constants of a 1 Hz DLL).
 const CODE_SETTLE_AFTER_GAP_S: f64 = 1.0;
+
+/// Time the code loops of channels moved onto a code that jumped need before their offsets
+/// measure the gap, s (the search placed them within a few hundredths of a chip).
+const CODE_SETTLE_AFTER_REALIGN_S: f64 = 0.5;
+
+/// Time the phase loops of channels moved onto a code that jumped need to lock again before
+/// the carrier-phase step over the jump is measured, s.
+const PHASE_SETTLE_AFTER_REALIGN_S: f64 = 0.25;
+
+/// What the end of a block found in the reports.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BlockEvent {
+    /// Samples lost by whole milliseconds: the carrier phase jumped on every satellite; the
+    /// channels must find their bit edges again.
+    PhaseJump(Discontinuity),
+    /// The prompt power collapsed on several satellites at once: their code must be searched
+    /// again (samples lost by a fraction of a millisecond, or a blockage).
+    Collapse(Collapse),
+}
 
 /// Solutions failing the integrity test in a row, after a valid one, that make the receiver
 /// time suspect.
@@ -108,6 +134,8 @@ impl NavigationProcessor {
             locked: BTreeSet::new(),
             sv_time: SvTimeKeeper::default(),
             monitor: DiscontinuityMonitor::new(fs_hz),
+            collapse: CollapseMonitor::new(),
+            pending_steps: None,
             last_clock: None,
             failed_in_row: 0,
             time_trusted: false,
@@ -115,29 +143,81 @@ impl NavigationProcessor {
     }
 
     /// After every channel has reported up to sample `end`: looks for lost samples. On a
-    /// discontinuity the SV times are dropped (every decoder must find frame sync again, the
-    /// HOW gives the time), carrier smoothing restarts, and no fix is made until then; returns
-    /// it so that the channels can find their bit edges again.
+    /// carrier-phase jump the SV times are kept aside until the gap's length is resolved
+    /// (frame sync gives the time when it is not), carrier smoothing restarts, and no fix is
+    /// made until then; the channels must then find their bit edges again. On a common
+    /// collapse of the prompt power their code must be searched again.
     pub fn end_block(
         &mut self,
         end: u64,
         sink: &mut dyn Sink,
-    ) -> Result<Option<Discontinuity>, SinkError> {
+    ) -> Result<Option<BlockEvent>, SinkError> {
+        self.measure_pending_steps(end);
+        if let Some(c) = self.collapse.evaluate(end, self.fs_hz) {
+            tracing::info!(
+                "{:.3} s: the prompt power of {} of {} satellites collapsed at once (samples lost, or a blockage): searching their code again",
+                c.sample as f64 / self.fs_hz,
+                c.satellites.len(),
+                c.watched
+            );
+            return Ok(Some(BlockEvent::Collapse(c)));
+        }
         let Some(d) = self.monitor.evaluate(end) else {
             return Ok(None);
         };
         let t_s = d.sample as f64 / self.fs_hz;
         tracing::warn!(
-            "{t_s:.3} s: samples lost (the carrier phase of {} of {} satellites jumped at once): no fix until the receiver time is re-established from the satellites' time of week",
+            "{t_s:.3} s: samples lost (the carrier phase of {} of {} satellites jumped at once): no fix until the receiver time is re-established",
             d.jumped,
             d.watched
         );
-        let steps = d.steps.iter().map(|&(_, step, f)| (step, f)).collect();
+        let steps = d.steps.clone();
+        tracing::debug!("carrier-phase steps over the jump: {steps:?}");
         // The code loops of the channels that kept their satellites take a second to follow
         // the code's step over the gap before their offsets measure it.
         self.forget_time(t_s, steps, Some(t_s + CODE_SETTLE_AFTER_GAP_S));
         sink.event(&ReceiverEvent::SampleGap { t_s })?;
-        Ok(Some(d))
+        Ok(Some(BlockEvent::PhaseJump(d)))
+    }
+
+    /// The channels of the satellites in `r` were moved onto a code that jumped as lost
+    /// samples make it jump. The SV times are kept aside until the length is resolved from
+    /// the new bit edges, the carrier-phase steps (measured once the phase loops hold again)
+    /// and the code, as after a whole-millisecond gap.
+    pub fn on_code_realigned(
+        &mut self,
+        r: &Realigned,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        let t_s = r.jump_sample as f64 / self.fs_hz;
+        let frac_ms = (-r.fraction_of_period).rem_euclid(1.0);
+        tracing::warn!(
+            "{t_s:.3} s: samples lost (the code of {} satellites jumped: {frac_ms:.4} ms modulo 1 ms, at least {:.1} ms): channels moved onto it; no fix until the receiver time is re-established",
+            r.prns.len(),
+            r.shortest_gap_s * 1e3
+        );
+        self.forget_time(t_s, Vec::new(), Some(t_s + CODE_SETTLE_AFTER_REALIGN_S));
+        let settle = (PHASE_SETTLE_AFTER_REALIGN_S * self.fs_hz) as u64;
+        self.monitor.hold_until(r.at_sample + settle);
+        self.pending_steps = Some((r.jump_sample, r.prns.clone(), r.at_sample + settle));
+        sink.event(&ReceiverEvent::SampleGap { t_s })
+    }
+
+    /// The carrier-phase steps over a code jump, once the phase loops of the moved channels
+    /// hold again (up to sample `end`): handed to the gap being recovered from.
+    fn measure_pending_steps(&mut self, end: u64) {
+        let Some((jump, prns, from)) = self.pending_steps.as_ref() else {
+            return;
+        };
+        if end < from + (0.02 * self.fs_hz) as u64 {
+            return;
+        }
+        let steps = self.monitor.phase_steps(prns, *jump, Some(*from));
+        tracing::debug!("carrier-phase steps over the code jump: {steps:?}");
+        if let Some(gap) = self.sv_time.gap.as_mut() {
+            gap.steps = steps;
+        }
+        self.pending_steps = None;
     }
 
     /// Says whether the reference week may date the outputs (true unless set here): when
@@ -198,6 +278,7 @@ impl NavigationProcessor {
     ) -> Result<(), SinkError> {
         sink.channel_epoch(channel, e)?;
         self.monitor.push(e);
+        self.collapse.push(e);
         self.searched.insert(e.prn);
         let locked = e.bit.is_some() || (e.pll_lock && e.state == ChannelState::Track);
         if locked && e.cn0_dbhz >= self.cn0_lost_dbhz {
@@ -218,6 +299,7 @@ impl NavigationProcessor {
                     e.t_rx_s
                 );
                 sink.event(&ReceiverEvent::GapMeasured { t_s, length_ms })?;
+                self.step_clock_over_gap(t_s, length_ms, sink)?;
             }
             None => {}
         }
@@ -326,15 +408,24 @@ impl NavigationProcessor {
     /// With the carrier-phase steps of the gap (`steps`), the SV times are kept, to be carried
     /// over it once its length is resolved from them and the new bit edges.
     /// `code_from_s`: from when the code offsets may measure the gap (`None`: not used).
-    fn forget_time(&mut self, t_s: f64, steps: Vec<(f64, f64)>, code_from_s: Option<f64>) {
+    fn forget_time(
+        &mut self,
+        t_s: f64,
+        steps: Vec<crate::pipeline::carrier_step::PhaseStep>,
+        code_from_s: Option<f64>,
+    ) {
         for dec in self.decoders.values_mut() {
             dec.reset_sync();
         }
+        // The clocks as they were a little before the gap (its instant is known to a few
+        // milliseconds).
+        self.sv_time
+            .rewind(((t_s - 0.003) * self.fs_hz).max(0.0) as u64);
         let gap = GapRecovery::new(t_s, self.last_clock, steps, code_from_s);
         if gap.unresolved {
             self.sv_time.make_rough(None);
         }
-        self.builder.restart();
+        self.builder.note_gap(t_s);
         self.sv_time.gap = Some(gap);
         self.prior = None;
     }
@@ -391,6 +482,7 @@ impl NavigationProcessor {
                 );
                 self.sv_time.move_over_gap(length_ms);
                 sink.event(&ReceiverEvent::GapMeasured { t_s, length_ms })?;
+                self.step_clock_over_gap(t_s, length_ms, sink)?;
             }
         }
         Ok(())
@@ -425,6 +517,33 @@ impl NavigationProcessor {
         self.sv_time
             .gap
             .get_or_insert_with(|| GapRecovery::new(t_s, before, Vec::new(), None));
+    }
+
+    /// Once the length of the samples lost at stream time `t_s` is known: the carrier smoothing
+    /// may be bridged over them, and the receiver time (which counts samples) is late by it; it is stepped forward by the whole milliseconds (the fraction is a clock
+    /// bias the solution takes up), so that the first fix after a long gap does not start
+    /// from a bias of tenths of a second (pseudoranges would come out negative).
+    fn step_clock_over_gap(
+        &mut self,
+        t_s: f64,
+        length_ms: f64,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        self.builder.set_gap_length(t_s, length_ms * 1e-3);
+        let step = length_ms.round() as i64;
+        if step == 0 {
+            return Ok(());
+        }
+        self.builder.step_clock_ms(step);
+        if let Some(gap) = self.sv_time.gap.as_mut() {
+            gap.stepped_ms += step;
+        }
+        if let Some((t, b, d)) = self.last_clock {
+            // The clock of the last fix, on the stepped time scale.
+            self.last_clock = Some((t, b + step as f64 * 1e-3 * SPEED_OF_LIGHT_MPS, d));
+        }
+        tracing::info!("receiver clock stepped by {step} ms over the lost samples");
+        sink.event(&ReceiverEvent::ClockStep { ms: step })
     }
 
     /// While the receiver time is re-established after lost samples, the first satellite

@@ -14,6 +14,7 @@
 //! code rate `r`, carrier phase by `(t - t_rx) f_D`.
 
 use crate::pipeline::navdata::NavDecoder;
+use crate::pipeline::smoothing::Hatch;
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
@@ -82,9 +83,12 @@ pub struct ObservableBuilder {
     lli: BTreeMap<u8, bool>,
     /// Highest epoch index any channel has reached.
     newest: i64,
-    /// Per PRN: the previous epoch's index, carrier phase (cycles) and smoothed pseudorange
-    /// with its number of averaged epochs (Hatch filter state), and the clock steps (ms) so far.
-    smoothing: BTreeMap<u8, (i64, f64, f64, u32, i64, f64)>,
+    /// Per PRN: the Hatch filter ([`crate::pipeline::smoothing`]), kept over losses of lock to
+    /// bridge them.
+    smoothing: BTreeMap<u8, Hatch>,
+    /// Samples lost: `(stream time s, length s if known)`; a filter is bridged over a gap only
+    /// once its length is known.
+    gaps: Vec<(f64, Option<f64>)>,
     /// Backward carrier-phase Doppler `-(L(n) - L(n-1)) / dt` per (epoch, PRN), for the central
     /// difference at emission.
     phase_rate: BTreeMap<(i64, u8), f64>,
@@ -108,6 +112,7 @@ impl ObservableBuilder {
             lli: BTreeMap::new(),
             newest: i64::MIN,
             smoothing: BTreeMap::new(),
+            gaps: Vec::new(),
             phase_rate: BTreeMap::new(),
             hatch_epochs: (rate_hz * 10.0).round().max(1.0) as u32,
             min_cn0_dbhz: f64::NEG_INFINITY,
@@ -141,8 +146,8 @@ impl ObservableBuilder {
         }
     }
 
-    /// Restarts every satellite's carrier smoothing and flags a loss of lock (the receiver time
-    /// or the SV times changed: samples were lost), and drops the epochs not yet emitted.
+    /// Restarts every satellite's carrier smoothing and flags a loss of lock (the SV times may
+    /// be wrong), and drops the epochs not yet emitted.
     pub fn restart(&mut self) {
         for lost in self.lli.values_mut() {
             *lost = true;
@@ -150,6 +155,38 @@ impl ObservableBuilder {
         self.smoothing.clear();
         self.phase_rate.clear();
         self.pending.clear();
+    }
+
+    /// Samples were lost at stream time `t_s`: every satellite's lock is flagged lost and the
+    /// epochs not yet emitted are dropped; the carrier smoothing is kept, to be bridged over
+    /// the gap once its length is known ([`ObservableBuilder::set_gap_length`]).
+    pub fn note_gap(&mut self, t_s: f64) {
+        for lost in self.lli.values_mut() {
+            *lost = true;
+        }
+        self.phase_rate.clear();
+        self.pending.clear();
+        // The epochs since the gap (found a few epochs late) were on a shifted time scale.
+        self.smoothing.retain(|_, h| h.rewind(t_s));
+        self.gaps.retain(|g| t_s - g.0 < 60.0);
+        self.gaps.push((t_s, None));
+    }
+
+    /// The samples lost at stream time `t_s` (within 50 ms) were `length_s` of signal.
+    pub fn set_gap_length(&mut self, t_s: f64, length_s: f64) {
+        if let Some(g) = self.gaps.iter_mut().find(|g| (g.0 - t_s).abs() < 0.05) {
+            g.1 = Some(length_s);
+        }
+    }
+
+    /// The signal time lost between stream times `from_s` and `to_s`, s: `None` when samples
+    /// of unknown length were lost in between.
+    fn lost_between(&self, from_s: f64, to_s: f64) -> Option<f64> {
+        self.gaps
+            .iter()
+            .filter(|g| g.0 > from_s && g.0 <= to_s)
+            .map(|g| g.1)
+            .sum()
     }
 
     /// Takes one channel report (with the decoder of its satellite); returns the epochs that
@@ -205,38 +242,42 @@ impl ObservableBuilder {
             // The NCO phase grows with the Doppler (range shrinking); RINEX phase grows with the
             // range: negate. The receiver clock steps move it by f_L1 per second.
             let carrier_cycles = -carrier + self.total_step_ms as f64 * 1e-3 * F_L1_HZ;
-            // Hatch filter (carrier smoothing, 10 s) and carrier Doppler, restarted on any loss
-            // of lock or gap: P_s(k) = P(k)/M + (M-1)/M (P_s(k-1) + lambda (L(k) - L(k-1))).
-            let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
-            let (smoothed, doppler_hz, m) = match self.smoothing.get(&e.prn) {
-                Some(&(k_prev, l_prev, ps_prev, m_prev, steps_prev, ts_prev))
-                    if k_prev == n - 1 && !lost_flag =>
-                {
-                    let m = (m_prev + 1).min(self.hatch_epochs);
-                    let mf = f64::from(m);
-                    let dl = carrier_cycles - l_prev;
-                    let ps = pseudorange_m / mf + (mf - 1.0) / mf * (ps_prev + lambda * dl);
-                    // A clock step is not a Doppler.
-                    let dl_signal = dl - (self.total_step_ms - steps_prev) as f64 * 1e-3 * F_L1_HZ;
-                    // Over the elapsed sample time (an epoch after a clock step is not 1/rate
-                    // after the previous one).
-                    let dt = t_epoch - t0.tow_s - ts_prev;
-                    self.phase_rate.insert((n, e.prn), -dl_signal / dt);
-                    (ps, -dl_signal / dt, m)
+            // Hatch filter (carrier smoothing, 10 s) and carrier Doppler; a loss of lock is
+            // bridged when it can be ([`crate::pipeline::smoothing`]), else the filter restarts.
+            let t_stream = t_epoch - t0.tow_s;
+            let steps = self.total_step_ms;
+            let max_m = self.hatch_epochs;
+            let lost_s = self
+                .smoothing
+                .get(&e.prn)
+                .and_then(|h| self.lost_between(h.t_stream_s, t_stream));
+            let (smoothed, doppler_hz) = match self.smoothing.get_mut(&e.prn) {
+                Some(h) if h.epoch == n - 1 && !lost_flag => {
+                    // A clock step is not a Doppler; over the elapsed sample time (an epoch
+                    // after a clock step is not 1/rate after the previous one).
+                    let dl_signal = carrier_cycles
+                        - h.carrier_cycles
+                        - (steps - h.steps_ms) as f64 * 1e-3 * F_L1_HZ;
+                    let rate = -dl_signal / (t_stream - h.t_stream_s);
+                    h.update(n, carrier_cycles, pseudorange_m, steps, t_stream, max_m);
+                    self.phase_rate.insert((n, e.prn), rate);
+                    (h.smoothed_m, rate)
                 }
-                _ => (pseudorange_m, e.doppler_hz, 1),
+                Some(h) => {
+                    let bridged = lost_s.is_some_and(|g| {
+                        h.bridge(n, carrier_cycles, pseudorange_m, steps, t_stream, g, max_m)
+                    });
+                    if !bridged {
+                        *h = Hatch::start(n, carrier_cycles, pseudorange_m, steps, t_stream);
+                    }
+                    (h.smoothed_m, e.doppler_hz)
+                }
+                None => {
+                    let h = Hatch::start(n, carrier_cycles, pseudorange_m, steps, t_stream);
+                    self.smoothing.insert(e.prn, h);
+                    (pseudorange_m, e.doppler_hz)
+                }
             };
-            self.smoothing.insert(
-                e.prn,
-                (
-                    n,
-                    carrier_cycles,
-                    smoothed,
-                    m,
-                    self.total_step_ms,
-                    t_epoch - t0.tow_s,
-                ),
-            );
             self.pending.entry(n).or_default().push(SatObservable {
                 prn: e.prn,
                 sv_tow_s: sv_tow,

@@ -13,7 +13,7 @@ use crate::pipeline::aid_monitor::{AidMonitor, AidingStats, GatedAid};
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
 use crate::pipeline::dating::WeekReference;
-use crate::pipeline::navigation::NavigationProcessor;
+use crate::pipeline::navigation::{BlockEvent, NavigationProcessor};
 use crate::pipeline::ring::{block_samples, SampleWindow};
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult};
@@ -571,17 +571,27 @@ impl Receiver {
             let t_done = done as f64 / self.fs_hz;
             monitor.evaluate(t_first, t_done, ff.expected_common_residual_hz(), &predict);
         }
-        if nav
-            .end_block(end, sink)
-            .map_err(ReceiverError::Sink)?
-            .is_some()
-        {
-            self.manager.restart_bit_sync();
+        match nav.end_block(end, sink).map_err(ReceiverError::Sink)? {
+            Some(BlockEvent::PhaseJump(_)) => self.manager.restart_bit_sync(),
+            Some(BlockEvent::Collapse(c)) => self.manager.request_realignment(&c),
+            None => {}
         }
-        if let Some(outcome) = found {
-            let first = outcome.first();
-            let started = self.manager.start_found(outcome);
-            self.announce(&started, first, sink)?;
+        match found {
+            Some(outcome) if outcome.is_realignment() => {
+                if let Some(r) = self.manager.realign(outcome) {
+                    // The bit edges of every channel moved with the code.
+                    self.manager.restart_bit_sync();
+                    self.nav
+                        .on_code_realigned(&r, sink)
+                        .map_err(ReceiverError::Sink)?;
+                }
+            }
+            Some(outcome) => {
+                let first = outcome.first();
+                let started = self.manager.start_found(outcome);
+                self.announce(&started, first, sink)?;
+            }
+            None => {}
         }
         let keep_from = self.manager.oldest_needed(end);
         self.window.discard_before(keep_from);

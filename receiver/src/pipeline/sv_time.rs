@@ -38,10 +38,10 @@ pub struct GapRecovery {
     pub t_s: f64,
     /// The last fix before it: stream time (s), clock bias after any step (m), drift (m/s).
     pub before: Option<(f64, f64, f64)>,
-    /// The carrier-phase steps at the gap `(step rad, carrier Hz)`: with them, the SV times
+    /// The carrier-phase steps at the gap: with them, the SV times
     /// are kept and carried over the gap once its length is resolved
     /// ([`crate::pipeline::gap_length`]); without, the time comes from frame sync.
-    pub steps: Vec<(f64, f64)>,
+    pub steps: Vec<crate::pipeline::carrier_step::PhaseStep>,
     /// Per PRN: how far the SV time kept falls off the channel's new bit edge (ms), and the
     /// satellite's SV time rate.
     pub edge_offsets: BTreeMap<u8, (f64, f64)>,
@@ -65,7 +65,7 @@ impl GapRecovery {
     pub fn new(
         t_s: f64,
         before: Option<(f64, f64, f64)>,
-        steps: Vec<(f64, f64)>,
+        steps: Vec<crate::pipeline::carrier_step::PhaseStep>,
         code_from_s: Option<f64>,
     ) -> Self {
         let unresolved =
@@ -90,7 +90,7 @@ impl GapRecovery {
     /// ([`crate::pipeline::gap_length::choose`]), or gives up after [`GAP_RESOLVE_S`].
     /// Returns whether the length was just resolved.
     pub fn add_edge_offset(&mut self, prn: u8, off_ms: f64, rate: f64, now_s: f64) -> bool {
-        use crate::pipeline::gap_length::{choose, estimate_from_code, resolve_gap_ms, MIN_STEPS};
+        use crate::pipeline::gap_length::{choose, estimate_from_code};
         self.edge_offsets.insert(prn, (off_ms, rate));
         let agreeing: Vec<(f64, f64)> = self
             .edge_offsets
@@ -102,16 +102,14 @@ impl GapRecovery {
             let mean = agreeing.iter().map(|o| o.0).sum::<f64>() / agreeing.len() as f64;
             // The kept time is g late: it falls -g (mod 20 ms) off the true bit edge.
             let offset = (-mean).rem_euclid(20.0);
-            let by_phase = (self.steps.len() >= MIN_STEPS)
-                .then(|| resolve_gap_ms(offset, &self.steps, 1000.0))
-                .flatten();
             let by_code = self
                 .code_from_s
                 .filter(|&t| now_s >= t)
                 .and_then(|_| estimate_from_code(&agreeing));
-            self.length_ms = choose(offset, by_phase, by_code);
+            self.length_ms =
+                choose(offset, &self.steps, by_code).map(|l| refine_length_ms(l, &agreeing));
             tracing::debug!(
-                "gap length: {offset:.3} ms modulo 20 ms from {} bit edges; by the carrier-phase steps {by_phase:?}, by the code {by_code:?}: {:?}",
+                "gap length: {offset:.3} ms modulo 20 ms from {} bit edges; by the code {by_code:?}; with the carrier-phase steps: {:?}",
                 agreeing.len(),
                 self.length_ms
             );
@@ -121,6 +119,25 @@ impl GapRecovery {
         }
         self.length_ms.is_some()
     }
+}
+
+/// The lost receiver time (ms) refined from `length_ms` (right to a few microseconds) and the
+/// offsets `(off_i ms, r_i)` of the kept SV times from the new bit edges: the SV time of
+/// satellite `i` ran `g r_i` over the gap, so `-off_i = g r_i - 20 m_i` for whole bits `m_i`,
+/// and `g` is the mean of `(20 m_i - off_i) / r_i` (the offsets alone give `g r_i`, which
+/// differs from `g` by up to `g 3e-6`: 1.5 us, 450 m of range, for half a second).
+pub fn refine_length_ms(length_ms: f64, offsets: &[(f64, f64)]) -> f64 {
+    if offsets.is_empty() {
+        return length_ms;
+    }
+    offsets
+        .iter()
+        .map(|&(off, r)| {
+            let m = ((length_ms * r + off) / 20.0).round();
+            (20.0 * m - off) / r
+        })
+        .sum::<f64>()
+        / offsets.len() as f64
 }
 
 impl GapRecovery {
@@ -180,15 +197,41 @@ pub struct SvTimeKeeper {
     pub gap: Option<GapRecovery>,
     /// Carried SV times refused at the new bit edge: `(stream time s, PRN, offset ms)`.
     pub refused: Vec<(f64, u8, f64)>,
+    /// Per PRN: the clock as it was, every [`SNAPSHOT_S`] over the last [`SNAPSHOTS`] of them
+    /// (to go back to before lost samples found late, [`SvTimeKeeper::rewind`]).
+    history: BTreeMap<u8, std::collections::VecDeque<SvClock>>,
 }
 
+/// Seconds between two kept snapshots of a satellite's clock.
+const SNAPSHOT_S: f64 = 0.01;
+/// Snapshots kept (0.3 s: a gap is found within a tenth of a second or two).
+const SNAPSHOTS: usize = 30;
+
 impl SvTimeKeeper {
-    /// Moves every kept SV time over a gap of `length_ms` (once its length is known): they
-    /// are exact again.
+    /// Moves every kept SV time over a gap of `length_ms` of receiver time (once its length is
+    /// known): each satellite's SV time ran `length r` meanwhile; they are exact again.
     pub fn move_over_gap(&mut self, length_ms: f64) {
         for c in self.clocks.values_mut() {
-            c.sv_tow_s += length_ms * 1e-3;
+            c.sv_tow_s += length_ms * 1e-3 * c.rate;
             c.rough = false;
+        }
+    }
+
+    /// Every clock back to where it stood before sample `sample` (lost samples found after
+    /// the fact: the reports since then may have read a shifted code, the loops following it).
+    pub fn rewind(&mut self, sample: u64) {
+        for (prn, snaps) in self.history.iter_mut() {
+            while snaps.back().is_some_and(|c| c.sample >= sample) {
+                snaps.pop_back();
+            }
+            match snaps.back() {
+                Some(c) => {
+                    self.clocks.insert(*prn, *c);
+                }
+                None => {
+                    self.clocks.remove(prn);
+                }
+            }
         }
     }
 
@@ -227,15 +270,23 @@ impl SvTimeKeeper {
                 Some(c) if !c.rough && e.sample_index > c.sample => c.rate + 0.02 * (rate - c.rate),
                 _ => rate,
             };
-            self.clocks.insert(
-                e.prn,
-                SvClock {
-                    sample: e.sample_index,
-                    sv_tow_s: sv,
-                    rate,
-                    rough: false,
-                },
-            );
+            let clock = SvClock {
+                sample: e.sample_index,
+                sv_tow_s: sv,
+                rate,
+                rough: false,
+            };
+            self.clocks.insert(e.prn, clock);
+            let snaps = self.history.entry(e.prn).or_default();
+            let due = snaps.back().is_none_or(|c| {
+                (e.sample_index.saturating_sub(c.sample)) as f64 >= SNAPSHOT_S * fs_hz
+            });
+            if due {
+                snaps.push_back(clock);
+                if snaps.len() > SNAPSHOTS {
+                    snaps.pop_front();
+                }
+            }
             return None;
         }
         let clock = self.clocks.get(&e.prn)?;

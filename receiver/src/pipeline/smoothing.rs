@@ -1,0 +1,345 @@
+//! Carrier smoothing of the pseudoranges (Hatch filter), carried over outages and gaps.
+//!
+//! `P_s(k) = P(k) / M + (M - 1) / M (P_s(k-1) + lambda (L(k) - L(k-1)))`, with `M` growing to
+//! the filter length: the code's noise (metres at 2.6 MHz) is averaged down while the carrier
+//! carries the range change. A loss of lock breaks the carrier, and a new filter would start
+//! from the raw code again: the first fixes after an outage or a sample gap would carry the
+//! raw noise, several times the smoothed error.
+//!
+//! When the satellite's pseudorange is continuous over the break (its SV time was carried
+//! over the outage, or over lost samples whose length is known), the filter bridges it instead
+//! of restarting: the range change over the break comes from the carrier phase *before* it,
+//! a quadratic in time fitted to the last [`HISTORY`] epochs (phase, Doppler and Doppler rate,
+//! extrapolated over at most [`MAX_BRIDGE_S`], and only when the quadratic follows the phase
+//! to [`MAX_FIT_RMS_CYCLES`]: not under a manoeuvre's jerk), so that
+//!
+//! `lambda dL = lambda (L_fit(t_prev + T) - L_fit(t_prev)) - c g + c dsteps`,
+//!
+//! with `T` the signal time elapsed (stream time plus the lost time `g`), `-c g` the receiver
+//! clock falling behind by the lost samples and `c dsteps` the receiver clock steps since.
+//! A bridge whose prediction misses the new code by more than [`MAX_INNOVATION_M`] (a carried
+//! time that was wrong) restarts the filter.
+
+use crate::pipeline::carrier_step::Quadratic;
+use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
+use std::collections::VecDeque;
+
+/// Epochs of carrier phase kept for a bridge.
+pub const HISTORY: usize = 30;
+/// Longest break bridged, s: the quadratic's extrapolation error grows with the cube of it
+/// (a Doppler acceleration of 0.01 Hz/s^2 gives 0.05 m over 3 s).
+pub const MAX_BRIDGE_S: f64 = 3.0;
+/// Largest difference between the bridged prediction and the new code accepted, m.
+pub const MAX_INNOVATION_M: f64 = 30.0;
+/// Largest RMS of the carrier phase about its quadratic fit that is bridged, cycles (a steady
+/// signal leaves millimetres; a 10 g manoeuvre's jerk leaves metres over the fit's 3 s).
+pub const MAX_FIT_RMS_CYCLES: f64 = 0.1;
+
+/// One satellite's Hatch filter.
+#[derive(Debug, Clone)]
+pub struct Hatch {
+    /// Epoch index of the last update.
+    pub epoch: i64,
+    /// Carrier phase at it, cycles (RINEX sign, with the clock steps).
+    pub carrier_cycles: f64,
+    /// Smoothed pseudorange, m.
+    pub smoothed_m: f64,
+    /// Epochs averaged.
+    pub m: u32,
+    /// Receiver clock steps so far at it, ms.
+    pub steps_ms: i64,
+    /// Stream time of the epoch (receiver time less the origin), s.
+    pub t_stream_s: f64,
+    /// `(stream time s, carrier phase cycles without the clock steps)` of the last epochs in
+    /// lock.
+    history: VecDeque<(f64, f64)>,
+    /// The filter after each of its last [`SNAPSHOTS`] epochs (to go back to before lost
+    /// samples found a few epochs late).
+    snapshots: VecDeque<Snapshot>,
+}
+
+/// What [`Hatch::rewind`] restores.
+#[derive(Debug, Clone, Copy)]
+struct Snapshot {
+    epoch: i64,
+    carrier_cycles: f64,
+    smoothed_m: f64,
+    m: u32,
+    steps_ms: i64,
+    t_stream_s: f64,
+}
+
+/// Epochs of the filter kept to rewind it.
+const SNAPSHOTS: usize = 16;
+
+impl Hatch {
+    /// A filter started at this epoch from the raw pseudorange.
+    pub fn start(
+        epoch: i64,
+        carrier_cycles: f64,
+        pseudorange_m: f64,
+        steps_ms: i64,
+        t_stream_s: f64,
+    ) -> Self {
+        let mut h = Self {
+            epoch,
+            carrier_cycles,
+            smoothed_m: pseudorange_m,
+            m: 1,
+            steps_ms,
+            t_stream_s,
+            history: VecDeque::new(),
+            snapshots: VecDeque::new(),
+        };
+        h.remember();
+        h
+    }
+
+    /// The filter as it was before stream time `t_s` (samples were lost then and found a few
+    /// epochs later: the epochs since were measured on a shifted time scale); false when it
+    /// has no epoch before (the caller drops it).
+    pub fn rewind(&mut self, t_s: f64) -> bool {
+        while self.snapshots.back().is_some_and(|s| s.t_stream_s >= t_s) {
+            self.snapshots.pop_back();
+        }
+        while self.history.back().is_some_and(|h| h.0 >= t_s) {
+            self.history.pop_back();
+        }
+        let Some(s) = self.snapshots.back().copied() else {
+            return false;
+        };
+        self.epoch = s.epoch;
+        self.carrier_cycles = s.carrier_cycles;
+        self.smoothed_m = s.smoothed_m;
+        self.m = s.m;
+        self.steps_ms = s.steps_ms;
+        self.t_stream_s = s.t_stream_s;
+        true
+    }
+
+    /// The carrier phase of this epoch without the receiver clock steps, cycles.
+    fn signal_cycles(&self) -> f64 {
+        self.carrier_cycles - self.steps_ms as f64 * 1e-3 * F_L1_HZ
+    }
+
+    fn remember(&mut self) {
+        let p = (self.t_stream_s, self.signal_cycles());
+        self.history.push_back(p);
+        if self.history.len() > HISTORY {
+            self.history.pop_front();
+        }
+        self.snapshots.push_back(Snapshot {
+            epoch: self.epoch,
+            carrier_cycles: self.carrier_cycles,
+            smoothed_m: self.smoothed_m,
+            m: self.m,
+            steps_ms: self.steps_ms,
+            t_stream_s: self.t_stream_s,
+        });
+        if self.snapshots.len() > SNAPSHOTS {
+            self.snapshots.pop_front();
+        }
+    }
+
+    /// The next epoch in lock: the usual update, up to `max_m` epochs averaged.
+    pub fn update(
+        &mut self,
+        epoch: i64,
+        carrier_cycles: f64,
+        pseudorange_m: f64,
+        steps_ms: i64,
+        t_stream_s: f64,
+        max_m: u32,
+    ) {
+        let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+        let dl = carrier_cycles - self.carrier_cycles;
+        self.advance(
+            epoch,
+            lambda * dl,
+            carrier_cycles,
+            pseudorange_m,
+            steps_ms,
+            t_stream_s,
+            max_m,
+        );
+        self.remember();
+    }
+
+    /// The range change (m, carrier sign, with the clock terms) from the last epoch to one
+    /// `elapsed_s` of signal later, across `lost_s` of lost samples and `dsteps_ms` of clock
+    /// steps; `None` without enough history or beyond [`MAX_BRIDGE_S`].
+    fn bridge_change_m(&self, elapsed_s: f64, lost_s: f64, dsteps_ms: i64) -> Option<f64> {
+        if !(0.0..=MAX_BRIDGE_S).contains(&elapsed_s) || self.history.len() < 5 {
+            return None;
+        }
+        let (t_last, l_last) = *self.history.back()?;
+        let (t_first, _) = *self.history.front()?;
+        if t_last - t_first < 0.3 {
+            return None;
+        }
+        let pts: Vec<(f64, f64)> = self
+            .history
+            .iter()
+            .map(|&(t, l)| (t - t_last, l - l_last))
+            .collect();
+        let q = Quadratic::fit(&pts)?;
+        // Under dynamics (a manoeuvre's jerk) no quadratic follows the phase, and none
+        // predicts it over the break.
+        let rms = (pts.iter().map(|&(t, l)| (l - q.at(t)).powi(2)).sum::<f64>() / pts.len() as f64)
+            .sqrt();
+        if rms > MAX_FIT_RMS_CYCLES {
+            return None;
+        }
+        let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+        Some(
+            lambda * (q.at(elapsed_s) - q.at(0.0)) - SPEED_OF_LIGHT_MPS * lost_s
+                + SPEED_OF_LIGHT_MPS * dsteps_ms as f64 * 1e-3,
+        )
+    }
+
+    /// Continues the filter over a break in lock (the pseudorange being continuous): `lost_s`
+    /// of samples lost since the last epoch. Returns false (the caller restarts the filter)
+    /// when the break cannot be bridged or the bridged prediction misses the new code.
+    #[allow(clippy::too_many_arguments)]
+    pub fn bridge(
+        &mut self,
+        epoch: i64,
+        carrier_cycles: f64,
+        pseudorange_m: f64,
+        steps_ms: i64,
+        t_stream_s: f64,
+        lost_s: f64,
+        max_m: u32,
+    ) -> bool {
+        let elapsed = t_stream_s - self.t_stream_s + lost_s;
+        let Some(change) = self.bridge_change_m(elapsed, lost_s, steps_ms - self.steps_ms) else {
+            return false;
+        };
+        if (self.smoothed_m + change - pseudorange_m).abs() > MAX_INNOVATION_M {
+            return false;
+        }
+        self.advance(
+            epoch,
+            change,
+            carrier_cycles,
+            pseudorange_m,
+            steps_ms,
+            t_stream_s,
+            max_m,
+        );
+        // A new lock period: its carrier starts a new history.
+        self.history.clear();
+        self.remember();
+        true
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn advance(
+        &mut self,
+        epoch: i64,
+        change_m: f64,
+        carrier_cycles: f64,
+        pseudorange_m: f64,
+        steps_ms: i64,
+        t_stream_s: f64,
+        max_m: u32,
+    ) {
+        self.m = (self.m + 1).min(max_m);
+        let mf = f64::from(self.m);
+        self.smoothed_m = pseudorange_m / mf + (mf - 1.0) / mf * (self.smoothed_m + change_m);
+        self.epoch = epoch;
+        self.carrier_cycles = carrier_cycles;
+        self.steps_ms = steps_ms;
+        self.t_stream_s = t_stream_s;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A satellite whose range is `r0 + v t + a t^2 / 2` (m) seen by a receiver whose clock
+    /// stands still over `lost_s` lost at `t_gap` (samples lost), epochs every 0.1 s of stream.
+    struct Truth {
+        r0: f64,
+        v: f64,
+        a: f64,
+    }
+
+    impl Truth {
+        fn range(&self, t_true: f64) -> f64 {
+            self.r0 + self.v * t_true + 0.5 * self.a * t_true * t_true
+        }
+    }
+
+    #[test]
+    fn a_bridge_over_lost_samples_continues_the_smoothed_range() {
+        let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+        let s = Truth {
+            r0: 21_000_000.0,
+            v: -600.0,
+            a: 0.12,
+        };
+        let (t_gap, lost) = (3.0, 0.5);
+        // Code noise of +-3 m (deterministic), no clock steps before the gap; after it the
+        // receiver is stepped by the whole 500 ms, and the pseudorange falls by c (g - 0.5 s).
+        let noise = |k: i64| 3.0 * ((k as f64 * 12.9898).sin() * 43_758.545).fract();
+        let mut h: Option<Hatch> = None;
+        let mut last_err = f64::NAN;
+        for k in 0..60i64 {
+            let t_stream = k as f64 * 0.1;
+            let after = t_stream >= t_gap;
+            let t_true = t_stream + if after { lost } else { 0.0 };
+            let steps = if after { 500 } else { 0 };
+            let clock_m = if after {
+                SPEED_OF_LIGHT_MPS * (0.5 - lost)
+            } else {
+                0.0
+            };
+            let p = s.range(t_true) + clock_m + noise(k);
+            // The carrier follows the range; after the gap the new channel's phase starts
+            // anywhere (here 12345.25 cycles), with the steps term.
+            let l_sig = if after {
+                12_345.25 + s.range(t_true) / lambda
+            } else {
+                s.range(t_true) / lambda
+            };
+            let l = l_sig + steps as f64 * 1e-3 * F_L1_HZ;
+            match h.as_mut() {
+                None => h = Some(Hatch::start(k, l, p, steps, t_stream)),
+                Some(f) if (t_stream - t_gap).abs() < 1e-9 => {
+                    assert!(f.bridge(k, l, p, steps, t_stream, lost, 100), "bridged");
+                }
+                Some(f) => f.update(k, l, p, steps, t_stream, 100),
+            }
+            if let Some(f) = &h {
+                last_err = f.smoothed_m - s.range(t_true) - clock_m;
+                if after {
+                    // Smoothed across the gap: well below the raw +-3 m.
+                    assert!(last_err.abs() < 1.0, "k {k}: {last_err}");
+                }
+            }
+        }
+        assert!(last_err.abs() < 0.5, "{last_err}");
+    }
+
+    #[test]
+    fn a_bridge_that_misses_the_new_code_or_is_too_long_is_refused() {
+        let mut h = Hatch::start(0, 0.0, 20e6, 0, 0.0);
+        for k in 1..10 {
+            h.update(
+                k,
+                -(k as f64) * 100.0,
+                20e6 - k as f64 * 19.0,
+                0,
+                k as f64 * 0.1,
+                100,
+            );
+        }
+        // A carried time 1 ms wrong: 300 km off the prediction.
+        let mut wrong = h.clone();
+        assert!(!wrong.bridge(20, 0.0, 20e6 - 300_000.0, 0, 2.0, 0.0, 100));
+        // Too long a break.
+        assert!(!h.bridge(60, 0.0, 20e6 - 1000.0, 0, 6.0, 0.0, 100));
+    }
+}
