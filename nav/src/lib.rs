@@ -4,6 +4,7 @@
 //! Every formula cites the IS-GPS-200 section or table it implements. Units are SI and are
 //! carried in the names (`tow_s`, `clock_bias_s`, `delta_n_rad_s`).
 
+pub mod almanac;
 pub mod atmosphere;
 pub mod constants;
 pub mod ephemeris;
@@ -14,6 +15,7 @@ pub mod rinex_nav;
 pub mod time;
 pub mod utc;
 
+pub use almanac::{Almanac, AlmanacPrediction, AlmanacSet};
 pub use atmosphere::{klobuchar_delay_s, saastamoinen_delay_m, KlobucharParams, UtcParams};
 pub use ephemeris::{select_ephemeris, HealthPolicy, MAX_EPHEMERIS_AGE_S};
 pub use ephemeris::{Ephemeris, SvState};

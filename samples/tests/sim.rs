@@ -6,7 +6,7 @@
 
 use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
 use gpsrx_dsp::{CaCode, Prn};
-use gpsrx_nav::lnav::decode_subframe;
+use gpsrx_nav::lnav::{decode_subframe, SubframePayload};
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
 use gpsrx_nav::rotate_for_earth_rotation as rotate_earth;
 use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
@@ -514,5 +514,40 @@ drift_s_s = 5.0e-8
                 sat.prn
             );
         }
+    }
+}
+
+#[test]
+fn almanac_pages_are_sent_when_asked_for() {
+    // [satellites] almanac = true: subframe 5 pages carry the almanac of PRN = page (1-24,
+    // IS-GPS-200 Table 20-V) derived from the nav file, decoded here from the bit stream.
+    let duration_s = 70.0;
+    for almanac in [false, true] {
+        let sc = scenario(
+            &format!("[satellites]\nprns = [31]\nalmanac = {almanac}"),
+            duration_s,
+            2.048e6,
+            "ci2",
+        );
+        let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+        let sat = &sim.satellites[0];
+        let bits: Vec<u8> = sat.bits.iter().map(|&b| u8::from(b < 0)).collect();
+        let mut almanac_pages = 0;
+        let mut prev = (false, false);
+        for chunk in bits.chunks_exact(300) {
+            let mut sf = [0u8; 300];
+            sf.copy_from_slice(chunk);
+            let d = decode_subframe(&sf, prev.0, prev.1).unwrap_or_else(|e| panic!("{e}"));
+            prev = d.last_d29_d30;
+            if let SubframePayload::Almanac(p) = d.payload {
+                let page = (d.how.subframe_start_tow_s() / 30) % 25 + 1;
+                if d.how.subframe_id == 5 {
+                    assert_eq!(u32::from(p.sv_id), page);
+                }
+                assert!((p.sqrt_a_sqrt_m - 5153.6).abs() < 10.0, "{p:?}");
+                almanac_pages += 1;
+            }
+        }
+        assert_eq!(almanac_pages > 0, almanac, "almanac = {almanac}");
     }
 }

@@ -1,11 +1,14 @@
 //! LNAV subframe decoder: parity check of the ten words (20.3.5.2), TLM and HOW (20.3.3.1,
-//! 20.3.3.2), and the content of subframes 1-3 and subframe 4 page 18 (20.3.3.3 - 20.3.3.5).
+//! 20.3.3.2), and the content of subframes 1-3, subframe 4 page 18, the almanac pages and
+//! pages 25 of subframes 4 and 5 (20.3.3.3 - 20.3.3.5).
 
-use super::encoder::{PAGE18_SV_ID, PREAMBLE};
+use super::encoder::{PAGE18_SV_ID, PAGE25_SV_ID, PREAMBLE, SF5_PAGE25_SV_ID};
 use super::fields as fd;
 use super::parity::{last_two_bits, parity_check};
 use super::LnavError;
+use crate::almanac::Almanac;
 use crate::atmosphere::KlobucharParams;
+use crate::time::GpsTime;
 use crate::utc::UtcParams;
 
 /// Telemetry word content (20.3.3.1).
@@ -117,6 +120,83 @@ pub struct Subframe3 {
     pub idot_rad_s: f64,
 }
 
+/// One almanac page: subframe 5 pages 1-24 or subframe 4 pages 2-5, 7-10, SV ID 1-32
+/// (20.3.3.5.1.2, Figure 20-1 sheet 4, Table 20-VI). The reference week WN_a is in subframe 5
+/// page 25 ([`Sf5Page25`]); [`AlmanacPage::to_almanac`] joins them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlmanacPage {
+    /// SV ID = PRN whose almanac this is (1-32).
+    pub sv_id: u8,
+    /// Data ID (2 bits; 01 for LNAV).
+    pub data_id: u8,
+    /// 8-bit SV health (20.3.3.5.1.3).
+    pub health: u8,
+    /// Eccentricity.
+    pub e: f64,
+    /// t_oa, s of week.
+    pub toa_s: u32,
+    /// delta_i, rad (i = 0.30 semicircles + delta_i).
+    pub delta_i_rad: f64,
+    /// OMEGA DOT, rad/s.
+    pub omega_dot_rad_s: f64,
+    /// sqrt(A), sqrt(m).
+    pub sqrt_a_sqrt_m: f64,
+    /// OMEGA_0, rad.
+    pub omega0_rad: f64,
+    /// omega, rad.
+    pub omega_rad: f64,
+    /// M_0, rad.
+    pub m0_rad: f64,
+    /// a_f0, s.
+    pub af0_s: f64,
+    /// a_f1, s/s.
+    pub af1_s_s: f64,
+}
+
+impl AlmanacPage {
+    /// The almanac with reference time (`wna_full`, t_oa); `wna_full` is the full week number
+    /// of the almanac reference time (WN_a of page 25 resolved, e.g. by
+    /// [`crate::time::resolve_week_modulo`] modulo 256).
+    pub fn to_almanac(&self, wna_full: u32) -> Almanac {
+        Almanac {
+            prn: self.sv_id,
+            health: self.health,
+            e: self.e,
+            toa: GpsTime::new(wna_full, f64::from(self.toa_s)),
+            delta_i_rad: self.delta_i_rad,
+            omega_dot_rad_s: self.omega_dot_rad_s,
+            sqrt_a_sqrt_m: self.sqrt_a_sqrt_m,
+            omega0_rad: self.omega0_rad,
+            omega_rad: self.omega_rad,
+            m0_rad: self.m0_rad,
+            af0_s: self.af0_s,
+            af1_s_s: self.af1_s_s,
+        }
+    }
+}
+
+/// Subframe 5 page 25, SV ID 51 (20.3.3.5.1.3, 20.3.3.5.1.5): almanac reference time and the
+/// 6-bit health of SV 1-24.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sf5Page25 {
+    /// t_oa, s of week.
+    pub toa_s: u32,
+    /// WN_a, the 8 LSBs of the almanac reference week.
+    pub wna_mod_256: u32,
+    /// 6-bit health of SV 1-24 (index PRN - 1); 0b111111 = SV not available.
+    pub health6: [u8; 24],
+}
+
+/// Subframe 4 page 25, SV ID 63 (20.3.3.5.1.3, 20.3.3.5.1.4): A-S flags and configurations of
+/// SV 1-32 and the 6-bit health of SV 25-32.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sf4Page25 {
+    /// 4-bit A-S flag (MSB) and configuration code of SV 1-32 (index PRN - 1).
+    pub sv_config: [u8; 32],
+    /// 6-bit health of SV 25-32 (index PRN - 25).
+    pub health6: [u8; 8],
+}
+
 /// Decoded subframe content.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SubframePayload {
@@ -134,7 +214,13 @@ pub enum SubframePayload {
         /// GPS-UTC parameters.
         utc: UtcParams,
     },
-    /// Any other subframe 4/5 page (not interpreted).
+    /// An almanac page (subframe 5 pages 1-24, subframe 4 pages 2-5 and 7-10).
+    Almanac(AlmanacPage),
+    /// Subframe 5 page 25: t_oa, WN_a, health of SV 1-24.
+    Sf5Page25(Sf5Page25),
+    /// Subframe 4 page 25: A-S/configuration of SV 1-32, health of SV 25-32.
+    Sf4Page25(Sf4Page25),
+    /// Any other subframe 4/5 page, including dummy almanac pages (SV ID 0), not interpreted.
     Other {
         /// Subframe ID (4 or 5).
         subframe_id: u8,
@@ -379,32 +465,89 @@ fn decode_sf3(w: &[u32; 10]) -> Subframe3 {
 fn decode_sf45(w: &[u32; 10], subframe_id: u8) -> SubframePayload {
     let data_id = u(w, &fd::DATA_ID) as u8;
     let sv_id = u(w, &fd::SV_ID) as u8;
-    if subframe_id == 4 && u32::from(sv_id) == PAGE18_SV_ID {
-        let mut iono = KlobucharParams {
-            alpha: [0.0; 4],
-            beta: [0.0; 4],
-        };
-        for k in 0..4 {
-            iono.alpha[k] = fd::ALPHA[k].get_si(w);
-            iono.beta[k] = fd::BETA[k].get_si(w);
-        }
-        let int = |field: &fd::Field| i32::try_from(field.get(w)).unwrap_or(0);
-        let utc = UtcParams {
-            a0_s: fd::A0.get_si(w),
-            a1_s_s: fd::A1.get_si(w),
-            tot_s: u(w, &fd::TOT) * 4096,
-            wnt: u(w, &fd::WNT),
-            dt_ls_s: int(&fd::DT_LS),
-            wn_lsf: u(w, &fd::WN_LSF),
-            dn: u(w, &fd::DN),
-            dt_lsf_s: int(&fd::DT_LSF),
-        };
-        SubframePayload::Page18 { iono, utc }
-    } else {
-        SubframePayload::Other {
+    match (subframe_id, u32::from(sv_id)) {
+        (4, PAGE18_SV_ID) => decode_page18(w),
+        (4, PAGE25_SV_ID) => SubframePayload::Sf4Page25(decode_sf4_page25(w)),
+        (5, SF5_PAGE25_SV_ID) => SubframePayload::Sf5Page25(decode_sf5_page25(w)),
+        // Table 20-V: SV IDs 1-32 are almanac pages (subframe 5 pages 1-24 and subframe 4
+        // pages 2-5, 7-10); the SV ID, not the page, names the satellite.
+        (_, 1..=32) => SubframePayload::Almanac(decode_almanac(w, sv_id, data_id)),
+        _ => SubframePayload::Other {
             subframe_id,
             data_id,
             sv_id,
+        },
+    }
+}
+
+fn decode_page18(w: &[u32; 10]) -> SubframePayload {
+    let mut iono = KlobucharParams {
+        alpha: [0.0; 4],
+        beta: [0.0; 4],
+    };
+    for k in 0..4 {
+        iono.alpha[k] = fd::ALPHA[k].get_si(w);
+        iono.beta[k] = fd::BETA[k].get_si(w);
+    }
+    let int = |field: &fd::Field| i32::try_from(field.get(w)).unwrap_or(0);
+    let utc = UtcParams {
+        a0_s: fd::A0.get_si(w),
+        a1_s_s: fd::A1.get_si(w),
+        tot_s: u(w, &fd::TOT) * 4096,
+        wnt: u(w, &fd::WNT),
+        dt_ls_s: int(&fd::DT_LS),
+        wn_lsf: u(w, &fd::WN_LSF),
+        dn: u(w, &fd::DN),
+        dt_lsf_s: int(&fd::DT_LSF),
+    };
+    SubframePayload::Page18 { iono, utc }
+}
+
+/// Almanac page fields (Table 20-VI).
+fn decode_almanac(w: &[u32; 10], sv_id: u8, data_id: u8) -> AlmanacPage {
+    AlmanacPage {
+        sv_id,
+        data_id,
+        health: u(w, &fd::ALM_HEALTH) as u8,
+        e: fd::ALM_E.get_si(w),
+        toa_s: u(w, &fd::ALM_TOA) * 4096,
+        delta_i_rad: fd::ALM_DELTA_I.get_si(w),
+        omega_dot_rad_s: fd::ALM_OMEGA_DOT.get_si(w),
+        sqrt_a_sqrt_m: fd::ALM_SQRT_A.get_si(w),
+        omega0_rad: fd::ALM_OMEGA0.get_si(w),
+        omega_rad: fd::ALM_OMEGA.get_si(w),
+        m0_rad: fd::ALM_M0.get_si(w),
+        af0_s: fd::ALM_AF0.get_si(w),
+        af1_s_s: fd::ALM_AF1.get_si(w),
+    }
+}
+
+fn decode_sf5_page25(w: &[u32; 10]) -> Sf5Page25 {
+    let mut health6 = [0u8; 24];
+    for (prn, h) in (1u8..).zip(health6.iter_mut()) {
+        if let Some(bit) = fd::sf5_page25_health_bit(prn) {
+            *h = fd::get_bits(w, bit, 6) as u8;
         }
     }
+    Sf5Page25 {
+        toa_s: u(w, &fd::P25_TOA) * 4096,
+        wna_mod_256: u(w, &fd::P25_WNA),
+        health6,
+    }
+}
+
+fn decode_sf4_page25(w: &[u32; 10]) -> Sf4Page25 {
+    let mut sv_config = [0u8; 32];
+    for (prn, c) in (1u8..).zip(sv_config.iter_mut()) {
+        if let Some(bit) = fd::sf4_page25_config_bit(prn) {
+            *c = fd::get_bits(w, bit, 4) as u8;
+        }
+    }
+    let mut health6 = [0u8; 8];
+    for (prn, h) in (25u8..).zip(health6.iter_mut()) {
+        if let Some(bit) = fd::sf4_page25_health_bit(prn) {
+            *h = fd::get_bits(w, bit, 6) as u8;
+        }
+    }
+    Sf4Page25 { sv_config, health6 }
 }

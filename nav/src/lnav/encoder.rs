@@ -1,10 +1,11 @@
 //! LNAV subframe encoder (IS-GPS-200 20.3.2 message structure, 20.3.3 content, 20.3.5 parity):
-//! turns an ephemeris (and optionally Klobuchar/UTC parameters) into the transmitted bit
-//! stream of subframes 1-5.
+//! turns an ephemeris (and optionally Klobuchar/UTC parameters and an almanac) into the
+//! transmitted bit stream of subframes 1-5.
 
 use super::fields::{self as fd, Field};
 use super::parity::{last_two_bits, parity_encode, solve_trailing_bits};
 use super::LnavError;
+use crate::almanac::{Almanac, AlmanacSet};
 use crate::atmosphere::KlobucharParams;
 use crate::ephemeris::Ephemeris;
 use crate::utc::UtcParams;
@@ -15,6 +16,17 @@ pub const PREAMBLE: u32 = 0x8B;
 pub const PAGE18_SV_ID: u32 = 56;
 /// Subframe 4 page 25 SV (page) ID.
 pub const PAGE25_SV_ID: u32 = 63;
+/// Subframe 5 page 25 SV (page) ID (Table 20-V).
+pub const SF5_PAGE25_SV_ID: u32 = 51;
+/// Number of pages of subframes 4 and 5 (20.3.3.5.1: a 12.5-min cycle of 25 frames).
+pub const PAGES_PER_CYCLE: u32 = 25;
+/// SV (page) ID of subframe 4 pages 1-25 (Table 20-V): 57 reserved, 25-32 almanac of those SVs,
+/// 52 NMCT, 53-54 system use, 55 special messages, 56 ionosphere/UTC, 58-62 reserved, 63 A-S
+/// flags, configurations and health of SV 25-32.
+pub const SF4_PAGE_SV_IDS: [u32; 25] = [
+    57, 25, 26, 27, 28, 57, 29, 30, 31, 32, 57, 62, 52, 53, 54, 57, 55, 56, 58, 59, 57, 60, 61, 62,
+    63,
+];
 /// Data ID of the LNAV message (20.3.3.5.1.1).
 pub const LNAV_DATA_ID: u32 = 0b01;
 /// Number of 6-s subframes, i.e. HOW TOW counts, in a week.
@@ -25,12 +37,23 @@ pub const SUBFRAMES_PER_WEEK: u32 = 100_800;
 #[derive(Debug, Clone, PartialEq)]
 pub struct LnavEncoder {
     frames: [[u32; 10]; 5],
+    /// Subframe 4 carries page 18 (true) or the page-25 style page (false) in `frames[3]`.
+    has_page18: bool,
+    /// Source words of subframe 4 and 5 pages 1-25 when an almanac is sent.
+    pages: Option<Box<PageCycle>>,
     /// Alert flag sent in every HOW (20.3.3.2); default false.
     pub alert: bool,
     /// Anti-spoof flag sent in every HOW (20.3.3.2); default false.
     pub anti_spoof: bool,
     /// 14-bit TLM message (20.3.3.1); default 0.
     pub tlm_message: u16,
+}
+
+/// Source words (words 3-10) of the 25 pages of subframes 4 and 5.
+#[derive(Debug, Clone, PartialEq)]
+struct PageCycle {
+    sf4: [[u32; 10]; 25],
+    sf5: [[u32; 10]; 25],
 }
 
 /// Writes `si` quantised into `field`, failing if it does not fit.
@@ -136,6 +159,8 @@ impl LnavEncoder {
 
         Ok(LnavEncoder {
             frames: [sf1, sf2, sf3, sf4, sf5],
+            has_page18: iono.is_some() || utc.is_some(),
+            pages: None,
             alert: false,
             anti_spoof: false,
             tlm_message: 0,
@@ -154,7 +179,14 @@ impl LnavEncoder {
         let index = (subframe_start_tow_s / 6) % SUBFRAMES_PER_WEEK;
         let subframe_id = index % 5 + 1;
         let tow_count = (index + 1) % SUBFRAMES_PER_WEEK;
-        let mut words = self.frames[(subframe_id - 1) as usize];
+        // 20.3.3.5.1: subframes 4 and 5 page through 25 pages, one per 30-s frame, counted
+        // from the start of the week: page = (frame index mod 25) + 1, frame index = TOW / 30.
+        let page = ((index / 5) % PAGES_PER_CYCLE) as usize;
+        let mut words = match (&self.pages, subframe_id) {
+            (Some(cycle), 4) => cycle.sf4[page],
+            (Some(cycle), 5) => cycle.sf5[page],
+            _ => self.frames[(subframe_id - 1) as usize],
+        };
         if subframe_id == 1 {
             fd::WN.put(&mut words, i64::from(week % 1024));
         }
@@ -179,6 +211,121 @@ impl LnavEncoder {
         }
         bits
     }
+}
+
+impl LnavEncoder {
+    /// Sends `almanac` in subframes 4 and 5, paging through the 25 pages of each by frame
+    /// (IS-GPS-200 20.3.3.5.1, Table 20-V): subframe 5 pages 1-24 carry the almanac of SV 1-24
+    /// and page 25 (SV ID 51) t_oa, WN_a and the health of SV 1-24; subframe 4 pages 2-5 and
+    /// 7-10 carry SV 25-32, page 18 the ionosphere/UTC page given to [`LnavEncoder::new`] and
+    /// page 25 (SV ID 63) the A-S/configuration words and the health of SV 25-32. A PRN without
+    /// almanac gets a dummy page (SV ID 0, alternating ones and zeros, 20.3.3.5.1.2); reserved,
+    /// NMCT, system-use and special-message pages carry their Table 20-V SV ID and the
+    /// alternating pattern. Without iono/UTC, page 18 is sent as a reserved page (SV ID 57), so
+    /// that no receiver takes zeros for a broadcast ionosphere.
+    ///
+    /// Page 18 then comes once per 12.5 min instead of in every frame. Fails with
+    /// [`LnavError::FieldRange`] when an almanac value does not fit its field.
+    pub fn with_almanac(mut self, almanac: &AlmanacSet) -> Result<LnavEncoder, LnavError> {
+        let dummy = dummy_page(0);
+        let mut sf4 = [dummy; 25];
+        let mut sf5 = [dummy; 25];
+        for (page, slot) in sf5.iter_mut().enumerate().take(24) {
+            let prn = page as u8 + 1;
+            if let Some(alm) = almanac.get(prn) {
+                *slot = almanac_page(alm)?;
+            }
+        }
+        sf5[24] = sf5_page25(almanac);
+        for (slot, &sv_id) in sf4.iter_mut().zip(SF4_PAGE_SV_IDS.iter()) {
+            *slot = match sv_id {
+                25..=32 => match almanac.get(sv_id as u8) {
+                    Some(alm) => almanac_page(alm)?,
+                    None => dummy,
+                },
+                PAGE18_SV_ID if self.has_page18 => self.frames[3],
+                PAGE18_SV_ID => dummy_page(57),
+                PAGE25_SV_ID => sf4_page25(almanac),
+                other => dummy_page(other),
+            };
+        }
+        self.pages = Some(Box::new(PageCycle { sf4, sf5 }));
+        Ok(self)
+    }
+}
+
+/// Writes an angle of the full +-1 semicircle range, folded into the field (never fails on
+/// range; a non-finite value does).
+fn put_angle(words: &mut [u32; 10], field: &Field, si: f64, prn: u8) -> Result<(), LnavError> {
+    if !si.is_finite() {
+        return put_si(words, field, si, prn);
+    }
+    field.put(words, field.to_count_wrapped(si));
+    Ok(())
+}
+
+/// Source words of the almanac page of `alm` (Figure 20-1 sheet 4, Table 20-VI).
+fn almanac_page(alm: &Almanac) -> Result<[u32; 10], LnavError> {
+    let prn = alm.prn;
+    let mut w = [0u32; 10];
+    fd::DATA_ID.put(&mut w, i64::from(LNAV_DATA_ID));
+    put_int(&mut w, &fd::SV_ID, i64::from(prn), prn)?;
+    put_si(&mut w, &fd::ALM_E, alm.e, prn)?;
+    put_si(&mut w, &fd::ALM_TOA, alm.toa.tow_s, prn)?;
+    put_si(&mut w, &fd::ALM_DELTA_I, alm.delta_i_rad, prn)?;
+    put_si(&mut w, &fd::ALM_OMEGA_DOT, alm.omega_dot_rad_s, prn)?;
+    put_int(&mut w, &fd::ALM_HEALTH, i64::from(alm.health), prn)?;
+    put_si(&mut w, &fd::ALM_SQRT_A, alm.sqrt_a_sqrt_m, prn)?;
+    put_angle(&mut w, &fd::ALM_OMEGA0, alm.omega0_rad, prn)?;
+    put_angle(&mut w, &fd::ALM_OMEGA, alm.omega_rad, prn)?;
+    put_angle(&mut w, &fd::ALM_M0, alm.m0_rad, prn)?;
+    put_si(&mut w, &fd::ALM_AF0, alm.af0_s, prn)?;
+    put_si(&mut w, &fd::ALM_AF1, alm.af1_s_s, prn)?;
+    Ok(w)
+}
+
+/// Subframe 5 page 25 (SV ID 51): t_oa, WN_a mod 256, 6-bit health of SV 1-24; the reserved
+/// bits of word 10 are zero.
+fn sf5_page25(set: &AlmanacSet) -> [u32; 10] {
+    let mut w = [0u32; 10];
+    fd::DATA_ID.put(&mut w, i64::from(LNAV_DATA_ID));
+    fd::SV_ID.put(&mut w, i64::from(SF5_PAGE25_SV_ID));
+    let toa_count = fd::P25_TOA.to_count(set.toa.tow_s).clamp(0, 255);
+    fd::P25_TOA.put(&mut w, toa_count);
+    fd::P25_WNA.put(&mut w, i64::from(set.toa.week % 256));
+    for (prn, &h) in (1u8..=24).zip(set.health6.iter()) {
+        if let Some(bit) = fd::sf5_page25_health_bit(prn) {
+            fd::put_bits(&mut w, bit, 6, u32::from(h));
+        }
+    }
+    w
+}
+
+/// Subframe 4 page 25 (SV ID 63): A-S/configuration of SV 1-32, health of SV 25-32; the
+/// reserved bits are zero.
+fn sf4_page25(set: &AlmanacSet) -> [u32; 10] {
+    let mut w = [0u32; 10];
+    fd::DATA_ID.put(&mut w, i64::from(LNAV_DATA_ID));
+    fd::SV_ID.put(&mut w, i64::from(PAGE25_SV_ID));
+    for (prn, (&c, &h)) in (1u8..=32).zip(set.sv_config.iter().zip(set.health6.iter())) {
+        if let Some(bit) = fd::sf4_page25_config_bit(prn) {
+            fd::put_bits(&mut w, bit, 4, u32::from(c));
+        }
+        if let Some(bit) = fd::sf4_page25_health_bit(prn) {
+            fd::put_bits(&mut w, bit, 6, u32::from(h));
+        }
+    }
+    w
+}
+
+/// A page with SV ID `sv_id` and the alternating pattern (dummy almanac page for SV ID 0,
+/// 20.3.3.5.1.2; filler for the reserved and system-use pages).
+fn dummy_page(sv_id: u32) -> [u32; 10] {
+    let mut w = [0u32; 10];
+    fill_alternating(&mut w);
+    fd::DATA_ID.put(&mut w, i64::from(LNAV_DATA_ID));
+    fd::SV_ID.put(&mut w, i64::from(sv_id));
+    w
 }
 
 /// Fills data bits 69-292 (after data ID and SV ID) with 1010... per word, as dummy almanac

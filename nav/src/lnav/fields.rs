@@ -1,8 +1,10 @@
-//! LNAV field layout and scaling: bit positions from IS-GPS-200 Figure 20-1 (subframes 1-3 and
-//! subframe 4 page 18), scale factors and two's-complement conventions from Tables 20-I, 20-III
-//! and 20-X. Quantisation to the ICD LSBs ([`Ephemeris::quantized_to_icd`]) uses exactly the
+//! LNAV field layout and scaling: bit positions from IS-GPS-200 Figure 20-1 (subframes 1-3,
+//! subframe 4 page 18, the almanac pages and pages 25 of subframes 4 and 5), scale factors and
+//! two's-complement conventions from Tables 20-I, 20-III, 20-VI and 20-X. Quantisation to the
+//! ICD LSBs ([`Ephemeris::quantized_to_icd`], [`Almanac::quantized_to_icd`]) uses exactly the
 //! arithmetic the decoder uses, so `decode(encode(x)) == x.quantized_to_icd()` bit for bit.
 
+use crate::almanac::{Almanac, AlmanacSet};
 use crate::atmosphere::KlobucharParams;
 use crate::constants::GPS_PI;
 use crate::ephemeris::Ephemeris;
@@ -113,6 +115,84 @@ pub const WN_LSF: Field = f("WN_LSF", &[(249, 8)], false, 1.0, false);
 pub const DN: Field = f("DN", &[(257, 8)], false, 1.0, false);
 pub const DT_LSF: Field = f("delta t_LSF", &[(271, 8)], true, 1.0, false);
 
+// Almanac pages: subframe 5 pages 1-24 and subframe 4 pages 2-5, 7-10 (Figure 20-1 sheet 4,
+// IS-GPS-200 20.3.3.5.1.2 and Table 20-VI). Cross-checked against Table 20-VI:
+//   e        16 bits  unsigned  2^-21               (range 0 .. 0.03125)
+//   t_oa      8 bits  unsigned  2^12 s              (0 .. 602112 s)
+//   delta_i  16 bits* signed    2^-19 semicircles   (i = 0.30 semicircles + delta_i)
+//   OMEGADOT 16 bits* signed    2^-38 semicircles/s
+//   sqrt(A)  24 bits  unsigned  2^-11 sqrt(m)
+//   OMEGA_0, omega, M_0  24 bits* signed  2^-23 semicircles
+//   a_f0     11 bits* signed    2^-20 s  (8 MSBs in word 10 bits 1-8, 3 LSBs in bits 20-22)
+//   a_f1     11 bits* signed    2^-38 s/s (word 10 bits 9-19)
+// and the 8-bit SV health in word 5 bits 17-24 (20.3.3.5.1.3).
+pub const ALM_E: Field = f("almanac e", &[(69, 16)], false, p2(-21), false);
+pub const ALM_TOA: Field = f("almanac t_oa", &[(91, 8)], false, p2(12), false);
+pub const ALM_DELTA_I: Field = f("almanac delta_i", &[(99, 16)], true, p2(-19), true);
+pub const ALM_OMEGA_DOT: Field = f("almanac OMEGA DOT", &[(121, 16)], true, p2(-38), true);
+pub const ALM_HEALTH: Field = f("almanac SV health", &[(137, 8)], false, 1.0, false);
+pub const ALM_SQRT_A: Field = f("almanac sqrt(A)", &[(151, 24)], false, p2(-11), false);
+pub const ALM_OMEGA0: Field = f("almanac OMEGA_0", &[(181, 24)], true, p2(-23), true);
+pub const ALM_OMEGA: Field = f("almanac omega", &[(211, 24)], true, p2(-23), true);
+pub const ALM_M0: Field = f("almanac M_0", &[(241, 24)], true, p2(-23), true);
+pub const ALM_AF0: Field = f("almanac a_f0", &[(271, 8), (290, 3)], true, p2(-20), false);
+pub const ALM_AF1: Field = f("almanac a_f1", &[(279, 11)], true, p2(-38), false);
+
+// Subframe 5 page 25, SV ID 51 (Figure 20-1 sheet 10, 20.3.3.5.1.5): t_oa and WN_a in word 3;
+// the 6-bit health of SV 1-24 in the 24 MSBs of words 4-9 ([`sf5_page25_health_bit`]).
+pub const P25_TOA: Field = f("page 25 t_oa", &[(69, 8)], false, p2(12), false);
+pub const P25_WNA: Field = f("WN_a", &[(77, 8)], false, 1.0, false);
+
+/// First ICD bit of the 6-bit health of `prn` (1-24) in subframe 5 page 25: four per word in
+/// the 24 MSBs of words 4-9 (20.3.3.5.1.3).
+pub fn sf5_page25_health_bit(prn: u8) -> Option<u16> {
+    let k = u16::from(prn).checked_sub(1).filter(|&k| k < 24)?;
+    Some(91 + 30 * (k / 4) + 6 * (k % 4))
+}
+
+/// First ICD bit of the 6-bit health of `prn` (25-32) in subframe 4 page 25: bits 19-24 of
+/// word 8, the 24 MSBs of word 9 and the 18 MSBs of word 10 (20.3.3.5.1.3).
+pub fn sf4_page25_health_bit(prn: u8) -> Option<u16> {
+    match prn {
+        25 => Some(229),
+        26..=29 => Some(241 + 6 * (u16::from(prn) - 26)),
+        30..=32 => Some(271 + 6 * (u16::from(prn) - 30)),
+        _ => None,
+    }
+}
+
+/// First ICD bit of the 4-bit A-S flag / SV configuration of `prn` (1-32) in subframe 4 page
+/// 25 (20.3.3.5.1.4): SV 1-4 in bits 9-24 of word 3, six per word in the 24 MSBs of words 4-7,
+/// SV 29-32 in the 16 MSBs of word 8 (then 2 reserved bits and the health of SV 25).
+pub fn sf4_page25_config_bit(prn: u8) -> Option<u16> {
+    match prn {
+        1..=4 => Some(69 + 4 * (u16::from(prn) - 1)),
+        5..=32 => {
+            let k = u16::from(prn) - 5;
+            Some(91 + 30 * (k / 6) + 4 * (k % 6))
+        }
+        _ => None,
+    }
+}
+
+/// Reads `len` (1..=24) bits starting at ICD bit `start` (within one word's data bits) as an
+/// unsigned count.
+pub fn get_bits(words: &[u32; 10], start: u16, len: u8) -> u32 {
+    (0..u32::from(len)).fold(0u32, |acc, b| {
+        let (w, shift) = locate(u32::from(start) + b);
+        (acc << 1) | ((words[w] >> shift) & 1)
+    })
+}
+
+/// Writes the `len` (1..=24) LSBs of `value` starting at ICD bit `start`.
+pub fn put_bits(words: &mut [u32; 10], start: u16, len: u8, value: u32) {
+    for b in 0..u32::from(len) {
+        let bit = (value >> (u32::from(len) - 1 - b)) & 1;
+        let (w, shift) = locate(u32::from(start) + b);
+        words[w] = (words[w] & !(1 << shift)) | (bit << shift);
+    }
+}
+
 impl Field {
     /// Total number of bits.
     pub fn bits(&self) -> u32 {
@@ -148,6 +228,31 @@ impl Field {
     /// The SI value rounded to the field's LSB.
     pub fn quantize(&self, si: f64) -> f64 {
         self.to_si(self.to_count(si))
+    }
+
+    /// Nearest raw count of an angle (semicircle field of the full +-1 semicircle range, e.g.
+    /// the almanac OMEGA_0, omega, M_0) folded into the field's two's-complement range: angles
+    /// are modulo 2 semicircles, so +pi is sent as -pi. Other fields: [`Field::to_count`].
+    pub fn to_count_wrapped(&self, si: f64) -> i64 {
+        let count = self.to_count(si);
+        let n = self.bits();
+        let full_circle =
+            self.signed && self.semicircles && self.lsb * (1u64 << (n - 1)) as f64 == 1.0;
+        if !full_circle || !si.is_finite() {
+            return count;
+        }
+        let modulus = 1i64 << n;
+        let folded = count.rem_euclid(modulus);
+        if folded >= modulus / 2 {
+            folded - modulus
+        } else {
+            folded
+        }
+    }
+
+    /// An angle rounded to the field's LSB and folded like [`Field::to_count_wrapped`].
+    pub fn quantize_wrapped(&self, si: f64) -> f64 {
+        self.to_si(self.to_count_wrapped(si))
     }
 
     /// SI value range the field can hold.
@@ -262,6 +367,45 @@ impl UtcParams {
             a1_s_s: A1.quantize(self.a1_s_s),
             tot_s: TOT.to_count(f64::from(self.tot_s)).clamp(0, 255) as u32 * 4096,
             ..*self
+        }
+    }
+}
+
+impl Almanac {
+    /// This almanac with every field rounded to its subframe 4/5 LSB (Table 20-VI), angles
+    /// OMEGA_0, omega and M_0 folded into +-1 semicircle: exactly what an
+    /// [`crate::lnav::LnavEncoder`] with this almanac transmits and the decoder recovers once
+    /// WN_a is known. t_oa is rounded to 4096 s within its week; PRN and health are unchanged.
+    pub fn quantized_to_icd(&self) -> Almanac {
+        Almanac {
+            e: ALM_E.quantize(self.e),
+            toa: GpsTime::new(self.toa.week, ALM_TOA.quantize(self.toa.tow_s)),
+            delta_i_rad: ALM_DELTA_I.quantize(self.delta_i_rad),
+            omega_dot_rad_s: ALM_OMEGA_DOT.quantize(self.omega_dot_rad_s),
+            sqrt_a_sqrt_m: ALM_SQRT_A.quantize(self.sqrt_a_sqrt_m),
+            omega0_rad: ALM_OMEGA0.quantize_wrapped(self.omega0_rad),
+            omega_rad: ALM_OMEGA.quantize_wrapped(self.omega_rad),
+            m0_rad: ALM_M0.quantize_wrapped(self.m0_rad),
+            af0_s: ALM_AF0.quantize(self.af0_s),
+            af1_s_s: ALM_AF1.quantize(self.af1_s_s),
+            ..self.clone()
+        }
+    }
+}
+
+impl AlmanacSet {
+    /// Every almanac quantised ([`Almanac::quantized_to_icd`]) and the page-25 t_oa rounded to
+    /// 4096 s; health and configuration words keep their 6 and 4 LSBs.
+    pub fn quantized_to_icd(&self) -> AlmanacSet {
+        AlmanacSet {
+            toa: GpsTime::new(self.toa.week, P25_TOA.quantize(self.toa.tow_s)),
+            almanacs: self
+                .almanacs
+                .iter()
+                .map(|(&prn, a)| (prn, a.quantized_to_icd()))
+                .collect(),
+            health6: self.health6.map(|h| h & 0x3F),
+            sv_config: self.sv_config.map(|c| c & 0x0F),
         }
     }
 }

@@ -1,19 +1,25 @@
 //! The GPS LNAV (L1 C/A) navigation message, IS-GPS-200 20.3.2 - 20.3.5: word parity,
-//! subframe encoding for the simulator, decoding and ephemeris assembly for the receiver.
+//! subframe encoding for the simulator, decoding, ephemeris assembly and almanac collection
+//! for the receiver.
 
+mod almanac_collector;
 mod assembler;
 mod decoder;
 mod encoder;
 pub mod fields;
 mod parity;
 
+pub use almanac_collector::AlmanacCollector;
 pub use assembler::{ephemeris_from_subframes, EphemerisAssembler};
 pub use decoder::{
     decode_subframe, decode_subframe_any_polarity, decode_tlm_how, is_inverted_preamble,
-    preamble_polarity, DecodedSubframe, How, Polarity, Subframe1, Subframe2, Subframe3,
-    SubframePayload, Tlm,
+    preamble_polarity, AlmanacPage, DecodedSubframe, How, Polarity, Sf4Page25, Sf5Page25,
+    Subframe1, Subframe2, Subframe3, SubframePayload, Tlm,
 };
-pub use encoder::{LnavEncoder, PAGE18_SV_ID, PAGE25_SV_ID, PREAMBLE, SUBFRAMES_PER_WEEK};
+pub use encoder::{
+    LnavEncoder, PAGE18_SV_ID, PAGE25_SV_ID, PAGES_PER_CYCLE, PREAMBLE, SF4_PAGE_SV_IDS,
+    SF5_PAGE25_SV_ID, SUBFRAMES_PER_WEEK,
+};
 pub use parity::{parity_bits, parity_check, parity_encode};
 
 /// LNAV encoding/decoding errors.

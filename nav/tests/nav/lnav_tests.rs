@@ -6,7 +6,7 @@ use gpsrx_nav::lnav::fields::{self as fd, Field};
 use gpsrx_nav::lnav::{
     decode_subframe, decode_subframe_any_polarity, decode_tlm_how, is_inverted_preamble,
     parity_bits, parity_check, parity_encode, DecodedSubframe, EphemerisAssembler, LnavEncoder,
-    LnavError, Polarity, SubframePayload,
+    LnavError, Polarity, Sf4Page25, SubframePayload,
 };
 use gpsrx_nav::{Ephemeris, GpsTime, KlobucharParams, UtcParams};
 
@@ -186,13 +186,13 @@ fn dummy_pages_without_iono_utc() {
     let eph = &brdc().ephemerides[0];
     let enc = LnavEncoder::new(eph, None, None).expect("fits");
     let sf4 = decode_subframe(&enc.subframe_bits(18, 2190), false, false).expect("valid");
+    // A page-25 style page with all data zero (SV ID 63): every SV healthy, configuration 0.
     assert_eq!(
         sf4.payload,
-        SubframePayload::Other {
-            subframe_id: 4,
-            data_id: 1,
-            sv_id: 63
-        }
+        SubframePayload::Sf4Page25(Sf4Page25 {
+            sv_config: [0; 32],
+            health6: [0; 8]
+        })
     );
     let sf5 = decode_subframe(&enc.subframe_bits(24, 2190), false, false).expect("valid");
     assert_eq!(

@@ -2,6 +2,7 @@
 //! one concept against independent truth: published values, RTKLIB 2.4.3 / pymap3d fixtures
 //! (see ../data/README.md) or closed-form identities.
 
+mod almanac_tests;
 mod atmosphere_tests;
 mod common;
 mod ephemeris_tests;

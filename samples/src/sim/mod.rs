@@ -23,6 +23,7 @@ use geometry::{Environment, Observation, SlowTerms};
 use gpsrx_dsp::constants::F_L1_HZ;
 use gpsrx_dsp::nco::SinCosTable;
 use gpsrx_dsp::{CaCode, Prn};
+use gpsrx_nav::almanac::{toa_near, AlmanacSet};
 use gpsrx_nav::ephemeris::{Ephemeris, HealthPolicy};
 use gpsrx_nav::lnav::LnavEncoder;
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
@@ -169,6 +170,15 @@ impl Simulator {
             tropo: scenario.atmosphere.troposphere,
             sv_ref_s: sv_ref.diff_s(start),
         };
+        // The almanac every satellite transmits (when asked for): all PRNs with an ephemeris
+        // near the start, visible or not, referred to the 4096-s t_oa nearest the start.
+        let almanac = scenario.satellites.almanac.then(|| {
+            let ephs: Vec<Ephemeris> = Prn::all()
+                .filter_map(|p| nav.select_with(p.get(), start, HealthPolicy::Ignore))
+                .map(Ephemeris::quantized_to_icd)
+                .collect();
+            AlmanacSet::from_ephemerides(&ephs, toa_near(start))
+        });
         let explicit = scenario.satellites.prns.clone();
         let mut satellites = Vec::new();
         for prn in Prn::all() {
@@ -207,6 +217,7 @@ impl Simulator {
                 navigation_bits(
                     &eph,
                     &nav,
+                    almanac.as_ref(),
                     sv_ref,
                     -env.sv_ref_s + scenario.duration_s + 6.0,
                 )?
@@ -525,15 +536,21 @@ impl Simulator {
 }
 
 /// Builds the transmitted LNAV bit stream (+1/-1, logic 0 -> +1) of one satellite from `sv_ref`
-/// on, covering at least `span_s` seconds.
+/// on, covering at least `span_s` seconds, with `almanac` in subframes 4 and 5 when given.
 fn navigation_bits(
     eph: &Ephemeris,
     nav: &gpsrx_nav::rinex_nav::NavData,
+    almanac: Option<&AlmanacSet>,
     sv_ref: GpsTime,
     span_s: f64,
 ) -> Result<Vec<i8>, SimError> {
-    let enc = LnavEncoder::new(eph, nav.iono.as_ref(), nav.utc.as_ref())
+    let mut enc = LnavEncoder::new(eph, nav.iono.as_ref(), nav.utc.as_ref())
         .map_err(|e| SimError::Nav(format!("PRN {}: {e}", eph.prn)))?;
+    if let Some(set) = almanac {
+        enc = enc
+            .with_almanac(set)
+            .map_err(|e| SimError::Nav(format!("almanac sent by PRN {}: {e}", eph.prn)))?;
+    }
     let subframes = (span_s / 6.0).ceil() as usize + 1;
     let mut bits = Vec::with_capacity(subframes * 300);
     for j in 0..subframes {

@@ -390,6 +390,12 @@ pub struct SatelliteConfig {
     /// Modulate the navigation data bits (false: a dataless signal, for loop studies).
     #[serde(default = "default_true")]
     pub nav_data: bool,
+    /// Send a real almanac in subframes 4 and 5 (IS-GPS-200 20.3.3.5, 25-page cycle), derived
+    /// from the ephemerides of all 32 PRNs at the start. Off by default: subframe 4 then
+    /// carries the ionosphere/UTC page 18 in every frame, whereas with the almanac page 18
+    /// comes once per 12.5 min and short recordings may hold none.
+    #[serde(default)]
+    pub almanac: bool,
 }
 
 impl Default for SatelliteConfig {
@@ -402,6 +408,7 @@ impl Default for SatelliteConfig {
             cn0_all_dbhz: None,
             cn0: Vec::new(),
             nav_data: true,
+            almanac: false,
         }
     }
 }
