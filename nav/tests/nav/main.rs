@@ -3,6 +3,7 @@
 //! (see ../data/README.md) or closed-form identities.
 
 mod atmosphere_tests;
+mod coarse_time_tests;
 mod common;
 mod ephemeris_tests;
 mod frames_tests;
