@@ -36,10 +36,18 @@ pub fn dop_enu(rows: &[[f64; 4]], origin: &Llh) -> Option<Dop> {
     if !(q.trace() >= 0.0 && q.trace().sqrt() <= super::wls::MAX_GDOP) {
         return None;
     }
-    let r = enu_rotation(origin);
     let qp: Matrix3<f64> = q.fixed_view::<3, 3>(0, 0).into_owned();
-    let qe = r * qp * r.transpose();
-    let (e, n, u, t) = (qe[(0, 0)], qe[(1, 1)], qe[(2, 2)], q[(3, 3)]);
+    dop_from_cofactor(&qp, q[(3, 3)], origin)
+}
+
+/// DOP from the cofactor matrix Q = (G^T G)^-1 of any solution with a position and a clock
+/// unknown: `q_pos_ecef` the ECEF position block, `q_clock` the clock diagonal element (m^2
+/// per m^2 of range variance). GDOP here covers position and clock only, also when the
+/// solution has further unknowns. None when a value is not finite.
+pub fn dop_from_cofactor(q_pos_ecef: &Matrix3<f64>, q_clock: f64, origin: &Llh) -> Option<Dop> {
+    let r = enu_rotation(origin);
+    let qe = r * q_pos_ecef * r.transpose();
+    let (e, n, u, t) = (qe[(0, 0)], qe[(1, 1)], qe[(2, 2)], q_clock);
     let dop = Dop {
         gdop: (e + n + u + t).sqrt(),
         pdop: (e + n + u).sqrt(),

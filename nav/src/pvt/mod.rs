@@ -10,11 +10,14 @@
 //!   eqs. 3.8-3.12;
 //! - [`velocity`]: velocity and clock drift from Dopplers by least squares;
 //! - [`raim`]: chi-square fault detection and exclusion (with our own chi-square quantile);
-//! - [`dop`]: dilution of precision in the local East-North-Up frame.
+//! - [`dop`]: dilution of precision in the local East-North-Up frame;
+//! - [`coarse_time`]: position and time from sub-millisecond code phases before the time of
+//!   week is known (van Diggelen ch. 4), on the same model, weights and chi-square test.
 //!
-//! The entry point is [`solve`]. Every failure is a [`PvtError`]; nothing here panics on bad
+//! The entry point is [`solve`] ([`solve_coarse_time`] without a time of week). Every failure is a [`PvtError`]; nothing here panics on bad
 //! input.
 
+pub mod coarse_time;
 pub mod dop;
 pub mod landmark;
 pub mod model;
@@ -22,6 +25,10 @@ pub mod raim;
 pub mod velocity;
 pub mod wls;
 
+pub use coarse_time::{
+    solve_coarse_time, CoarseApriori, CoarseIntegrity, CoarseMeasurement, CoarseSatellite,
+    CoarseTimeError, CoarseTimeSolution,
+};
 pub use dop::Dop;
 pub use landmark::Landmark;
 pub use model::{PvtOptions, SatMeasurement, Weighting};

@@ -188,6 +188,60 @@ pub struct PreparedSat {
     pub sv: SvState,
 }
 
+/// Checks what every satellite observation needs whatever its observable: PRN 1-63, the
+/// ephemeris of that PRN, a finite C/N0 and a PRN not among `earlier_prns` (the satellites
+/// already accepted in the epoch).
+pub fn check_satellite(
+    prn: u8,
+    ephemeris: &Ephemeris,
+    cn0_dbhz: f64,
+    earlier_prns: &[u8],
+) -> Result<(), PvtError> {
+    if prn == 0 || prn > 63 {
+        return Err(PvtError::InvalidMeasurement {
+            prn,
+            field: "prn",
+            value: f64::from(prn),
+        });
+    }
+    if ephemeris.prn != prn {
+        return Err(PvtError::EphemerisMismatch {
+            prn,
+            eph_prn: ephemeris.prn,
+        });
+    }
+    if !cn0_dbhz.is_finite() {
+        return Err(PvtError::InvalidMeasurement {
+            prn,
+            field: "cn0_dbhz",
+            value: cn0_dbhz,
+        });
+    }
+    if earlier_prns.contains(&prn) {
+        return Err(PvtError::DuplicatePrn { prn });
+    }
+    Ok(())
+}
+
+/// The state of satellite `prn` at GPS transmit time `t_tx` from `ephemeris`
+/// ([`Ephemeris::sv_state`]), rejecting a non-finite position or clock.
+pub fn state_at_transmit(
+    prn: u8,
+    ephemeris: &Ephemeris,
+    t_tx: GpsTime,
+) -> Result<SvState, PvtError> {
+    let sv = ephemeris.sv_state(t_tx);
+    if sv.pos_m.iter().all(|v| v.is_finite()) && sv.clock_bias_s.is_finite() {
+        Ok(sv)
+    } else {
+        Err(PvtError::InvalidMeasurement {
+            prn,
+            field: "ephemeris (non-finite satellite state)",
+            value: f64::NAN,
+        })
+    }
+}
+
 /// Checks the inputs (finite values, PRN/ephemeris match, no duplicates) and computes each
 /// satellite's GPS transmit time t_tx = t_sv - dt_sv(t_tx) (3 fixed-point passes; dt_sv
 /// changes by < 1e-11 s/s so the error after the third is far below 1e-15 s) and its state.
@@ -196,26 +250,16 @@ pub fn prepare(
     meas: &[SatMeasurement<'_>],
 ) -> Result<Vec<PreparedSat>, PvtError> {
     let mut out: Vec<PreparedSat> = Vec::with_capacity(meas.len());
+    let mut prns: Vec<u8> = Vec::with_capacity(meas.len());
     for m in meas {
         let invalid = |field, value| PvtError::InvalidMeasurement {
             prn: m.prn,
             field,
             value,
         };
-        if m.prn == 0 || m.prn > 63 {
-            return Err(invalid("prn", f64::from(m.prn)));
-        }
-        if m.ephemeris.prn != m.prn {
-            return Err(PvtError::EphemerisMismatch {
-                prn: m.prn,
-                eph_prn: m.ephemeris.prn,
-            });
-        }
+        check_satellite(m.prn, m.ephemeris, m.cn0_dbhz, &prns)?;
         if !(m.pseudorange_m.is_finite() && m.pseudorange_m > 0.0) {
             return Err(invalid("pseudorange_m", m.pseudorange_m));
-        }
-        if !m.cn0_dbhz.is_finite() {
-            return Err(invalid("cn0_dbhz", m.cn0_dbhz));
         }
         if let Some(d) = m.doppler_hz.filter(|d| !d.is_finite()) {
             return Err(invalid("doppler_hz", d));
@@ -226,9 +270,6 @@ pub fn prepare(
         if !epoch_rx_time.tow_s.is_finite() {
             return Err(invalid("epoch_rx_time.tow_s", epoch_rx_time.tow_s));
         }
-        if out.iter().any(|s| s.prn == m.prn) {
-            return Err(PvtError::DuplicatePrn { prn: m.prn });
-        }
         let t_sv = m
             .tx_time
             .unwrap_or_else(|| epoch_rx_time.add_seconds(-m.pseudorange_m / SPEED_OF_LIGHT_MPS));
@@ -236,10 +277,8 @@ pub fn prepare(
         for _ in 0..3 {
             t_tx = t_sv.add_seconds(-m.ephemeris.sv_state(t_tx).clock_bias_s);
         }
-        let sv = m.ephemeris.sv_state(t_tx);
-        if !(sv.pos_m.iter().all(|v| v.is_finite()) && sv.clock_bias_s.is_finite()) {
-            return Err(invalid("ephemeris (non-finite satellite state)", f64::NAN));
-        }
+        let sv = state_at_transmit(m.prn, m.ephemeris, t_tx)?;
+        prns.push(m.prn);
         out.push(PreparedSat {
             prn: m.prn,
             pseudorange_m: m.pseudorange_m,

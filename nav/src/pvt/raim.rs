@@ -14,7 +14,7 @@
 
 use super::wls::{solve_position, Context, Fix, N_UNKNOWNS};
 use super::PvtError;
-use nalgebra::Vector4;
+use nalgebra::{SMatrix, SVector};
 
 /// Integrity status of a solution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -159,16 +159,22 @@ pub fn chi_square_quantile(p: f64, dof: f64) -> Option<f64> {
     Some(x)
 }
 
-/// Normalised residual of each observation of `fix`: |e_i| / sqrt(sigma_i^2 - a_i N^-1 a_i^T).
-fn normalised_residuals(fix: &Fix) -> Vec<f64> {
-    let resid = fix.sat_residuals_m.iter().chain(&fix.landmark_residuals_m);
-    fix.geometry_rows
-        .iter()
-        .zip(&fix.sigmas_m)
-        .zip(resid)
+/// Baarda's normalised residuals |e_i| / sqrt(sigma_i^2 - a_i N^-1 a_i^T) of a weighted least
+/// squares with design rows `rows` (any number D of unknowns), a-priori sigmas `sigmas_m`,
+/// post-fit residuals `residuals_m` (same order) and N^-1 = (A^T P A)^-1. An observation with
+/// no redundancy (the variance of its residual vanishes) gets 0.
+pub fn normalised_residuals<'a, const D: usize>(
+    rows: &[[f64; D]],
+    sigmas_m: &[f64],
+    residuals_m: impl IntoIterator<Item = &'a f64>,
+    n_inv: &SMatrix<f64, D, D>,
+) -> Vec<f64> {
+    rows.iter()
+        .zip(sigmas_m)
+        .zip(residuals_m)
         .map(|((r, s), e)| {
-            let a = Vector4::from(*r);
-            let qe = s * s - (a.transpose() * fix.n_inv * a)[(0, 0)];
+            let a = SVector::<f64, D>::from(*r);
+            let qe = s * s - (a.transpose() * n_inv * a)[(0, 0)];
             if qe > 1e-12 * s * s {
                 e.abs() / qe.sqrt()
             } else {
@@ -178,12 +184,25 @@ fn normalised_residuals(fix: &Fix) -> Vec<f64> {
         .collect()
 }
 
-/// Whether the fix passes the chi-square test at false-alarm probability `pfa`.
-fn passes(fix: &Fix, pfa: f64) -> bool {
-    match chi_square_quantile(1.0 - pfa, fix.dof as f64) {
-        Some(threshold) => fix.wsse <= threshold,
+/// Whether a weighted residual sum of squares e^T P e = `wsse` with `dof` degrees of freedom
+/// passes the chi-square test at false-alarm probability `pfa` (true when dof = 0: there is
+/// nothing to test).
+pub fn chi_square_passes(wsse: f64, dof: usize, pfa: f64) -> bool {
+    match chi_square_quantile(1.0 - pfa, dof as f64) {
+        Some(threshold) => wsse <= threshold,
         None => true,
     }
+}
+
+/// Normalised residual of each observation of `fix`.
+fn fix_normalised_residuals(fix: &Fix) -> Vec<f64> {
+    let resid = fix.sat_residuals_m.iter().chain(&fix.landmark_residuals_m);
+    normalised_residuals(&fix.geometry_rows, &fix.sigmas_m, resid, &fix.n_inv)
+}
+
+/// Whether the fix passes the chi-square test at false-alarm probability `pfa`.
+fn passes(fix: &Fix, pfa: f64) -> bool {
+    chi_square_passes(fix.wsse, fix.dof, pfa)
 }
 
 /// Runs detection and, with enough redundancy, exclusion of one satellite.
@@ -201,7 +220,7 @@ pub fn check_and_exclude(ctx: &Context<'_>, fix: Fix) -> Result<(Fix, RaimStatus
     if fix.dof + N_UNKNOWNS < 6 {
         return Ok((fix, RaimStatus::FaultDetectedNotExcluded));
     }
-    let w = normalised_residuals(&fix);
+    let w = fix_normalised_residuals(&fix);
     let worst =
         w[..fix.used.len()]
             .iter()

@@ -17,7 +17,7 @@
 //! sigma = `doppler_sigma_mps` * sqrt([`super::Weighting::cn0_scale`]); covariance
 //! sigma0^2 N^-1 as for the position.
 
-use super::model::{PreparedSat, PvtOptions};
+use super::model::{Predicted, PreparedSat, PvtOptions};
 use super::wls::{Fix, N_UNKNOWNS};
 use crate::constants::{LAMBDA_L1_M, SPEED_OF_LIGHT_MPS};
 use crate::frames::{rotate_for_earth_rotation, rotation_rate_times, Vector3};
@@ -38,6 +38,33 @@ pub struct VelocitySolution {
     pub n_used: usize,
 }
 
+/// The satellite's part of the pseudorange-rate model above, at one prediction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SatRangeRate {
+    /// Light-time factor k = 1 / (1 - q/c).
+    pub k: f64,
+    /// Satellite velocity rotated into the frame of reception, R3 v_sv, m/s.
+    pub v_sv_mps: Vector3<f64>,
+    /// Rate of the modelled pseudorange for a receiver fixed in ECEF with no clock drift,
+    /// k l.(R3 v_sv) - c dt_sv_dot, m/s (the d/dt of [`Predicted::range_model_m`] with respect
+    /// to the receive time, atmosphere rates neglected).
+    pub rate_mps: f64,
+}
+
+/// Evaluates k, R3 v_sv and the static-receiver range rate of `sat` at the prediction `pred`.
+pub fn sat_range_rate(sat: &PreparedSat, pred: &Predicted) -> SatRangeRate {
+    let tau = pred.flight_time_s;
+    let v_sv = rotate_for_earth_rotation(&sat.sv.vel_mps, tau);
+    let l = pred.los;
+    let q = l.dot(&(rotation_rate_times(&sat.sv.pos_m, tau) - v_sv));
+    let k = 1.0 / (1.0 - q / SPEED_OF_LIGHT_MPS);
+    SatRangeRate {
+        k,
+        v_sv_mps: v_sv,
+        rate_mps: k * l.dot(&v_sv) - SPEED_OF_LIGHT_MPS * sat.sv.clock_drift_s_s,
+    }
+}
+
 /// Solves velocity and drift from the Dopplers of the satellites in `fix`; None with fewer
 /// than 4 Dopplers or a singular geometry.
 pub fn solve_velocity(
@@ -55,13 +82,10 @@ pub fn solve_velocity(
             continue;
         };
         let rr_meas = -doppler_hz * lambda_m;
-        let tau = pred.flight_time_s;
-        let v_sv = rotate_for_earth_rotation(&sat.sv.vel_mps, tau);
-        let l = pred.los;
-        let q = l.dot(&(rotation_rate_times(&sat.sv.pos_m, tau) - v_sv));
-        let k = 1.0 / (1.0 - q / SPEED_OF_LIGHT_MPS);
+        let sr = sat_range_rate(sat, pred);
+        let (k, l) = (sr.k, pred.los);
         rows.push(Vector4::new(-k * l.x, -k * l.y, -k * l.z, 1.0));
-        y.push(rr_meas - k * l.dot(&v_sv) + SPEED_OF_LIGHT_MPS * sat.sv.clock_drift_s_s);
+        y.push(rr_meas - sr.rate_mps);
         sigmas.push(opts.doppler_sigma_mps * opts.weighting.cn0_scale(sat.cn0_dbhz).sqrt());
     }
     if rows.len() < N_UNKNOWNS {

@@ -4,6 +4,7 @@
 
 mod almanac_tests;
 mod atmosphere_tests;
+mod coarse_time_tests;
 mod common;
 mod ephemeris_tests;
 mod frames_tests;

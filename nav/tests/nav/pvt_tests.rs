@@ -1,40 +1,19 @@
 //! PVT solver against synthetic epochs built from the real broadcast ephemerides of
-//! brdc0010.22n with an independent forward model written here (light-time iteration, Earth
+//! brdc0010.22n with the independent forward model of `common.rs` (light-time iteration, Earth
 //! rotation by an explicit z rotation, SV clock from `sv_state`, optional Klobuchar and
 //! Saastamoinen, receiver clock bias and drift; Dopplers by numerical differentiation of that
-//! model in time). Noise comes from a seeded splitmix64 + Box-Muller generator, so every
-//! statistic below is reproducible.
+//! model in time). Noise comes from the seeded splitmix64 + Box-Muller generator of
+//! `common.rs`, so every statistic below is reproducible.
 
-use crate::common::brdc;
-use gpsrx_nav::constants::{F_L1_HZ, OMEGA_E_DOT_RAD_S, SPEED_OF_LIGHT_MPS};
+use crate::common::{brdc, forward, Atmos, Gauss, NO_ATMOS};
+use gpsrx_nav::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::pvt::{
     chi_square_quantile, solve, Landmark, PvtError, PvtOptions, PvtSolution, RaimStatus,
     SatMeasurement, Weighting,
 };
-use gpsrx_nav::{
-    azimuth_elevation, enu_rotation, klobuchar_delay_s, saastamoinen_delay_m, Ephemeris, GpsTime,
-    KlobucharParams, Llh, NavData, Vector3,
-};
+use gpsrx_nav::{enu_rotation, Ephemeris, GpsTime, Llh, NavData, Vector3};
 
 const C: f64 = SPEED_OF_LIGHT_MPS;
-
-/// Seeded standard normal generator (splitmix64 + Box-Muller).
-struct Gauss(u64);
-
-impl Gauss {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-    }
-}
 
 /// The receiver's true state; `t_true` is GPS time of reception.
 #[derive(Clone, Copy)]
@@ -44,58 +23,6 @@ struct Truth {
     clock_m: f64,
     drift_mps: f64,
     t_true: GpsTime,
-}
-
-/// Atmosphere of the forward model.
-#[derive(Clone, Copy)]
-struct Atmos<'a> {
-    iono: Option<&'a KlobucharParams>,
-    tropo: bool,
-}
-
-const NO_ATMOS: Atmos<'static> = Atmos {
-    iono: None,
-    tropo: false,
-};
-
-/// Rotation of the ECEF frame about z by `theta` (the frame at reception is rotated by
-/// OmegaE * tau with respect to the frame at transmission).
-fn rot_z(v: &Vector3<f64>, theta: f64) -> Vector3<f64> {
-    Vector3::new(
-        theta.cos() * v.x + theta.sin() * v.y,
-        -theta.sin() * v.x + theta.cos() * v.y,
-        v.z,
-    )
-}
-
-/// Exact pseudorange received at true GPS time `t` at `pos` with clock bias `clock_m`; returns
-/// (P, raw SV transmit time, elevation rad).
-fn forward(
-    eph: &Ephemeris,
-    pos: &Vector3<f64>,
-    t: GpsTime,
-    clock_m: f64,
-    atm: Atmos<'_>,
-) -> (f64, GpsTime, f64) {
-    let mut tau = 0.07;
-    let mut sv = eph.sv_state(t);
-    let mut s_rot = sv.pos_m;
-    for _ in 0..10 {
-        sv = eph.sv_state(t.add_seconds(-tau));
-        s_rot = rot_z(&sv.pos_m, OMEGA_E_DOT_RAD_S * tau);
-        tau = (s_rot - pos).norm() / C;
-    }
-    let t_tx = t.add_seconds(-tau);
-    let (az, el) = azimuth_elevation(pos, &s_rot);
-    let llh = Llh::from_ecef(pos);
-    let mut p = C * tau + clock_m - C * sv.clock_bias_s;
-    if let Some(k) = atm.iono {
-        p += C * klobuchar_delay_s(k, t.tow_s, &llh, az, el);
-    }
-    if atm.tropo {
-        p += saastamoinen_delay_m(&llh, el);
-    }
-    (p, t_tx.add_seconds(sv.clock_bias_s), el)
 }
 
 /// One simulated satellite observation (owning the ephemeris).
