@@ -368,8 +368,7 @@ fn a_navigation_file_without_ephemeris_is_refused() {
 
 #[test]
 fn only_locked_satellites_count_as_tracked() {
-    // Two satellites: the 1 ms search finds fewer than 4, so the 10 ms search runs and pulls
-    // in channels on noise; those are "searched and dropped", not tracked.
+    // Two satellites: the other 30 PRNs are searched on noise for 6 s, harder and harder.
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
     let scenario = r#"
 duration_s = 6.0
@@ -405,11 +404,11 @@ rate_hz = 1.0
         panic!("not run")
     };
     let (report, _) = run_file(&args, false).unwrap_or_else(|e| panic!("{e:#}"));
+    // Two satellites in the sky, 30 PRNs searched again and again up to 10 ms x 40 (the
+    // background search spends its false-alarm probability over the searches): no false
+    // satellite is counted as tracked. A channel pulled in on noise (rare now) must show in
+    // `dropped_prns`, never in `tracked_prns`.
     assert_eq!(report.receiver.tracked_prns, vec![26, 31]);
-    assert!(
-        !report.receiver.dropped_prns.is_empty(),
-        "the weak search pulled in no noise channel: the test no longer tests anything"
-    );
     assert!(
         !report.receiver.dropped_prns.contains(&26) && !report.receiver.dropped_prns.contains(&31)
     );

@@ -53,6 +53,12 @@ pub struct RunSettings {
     pub acq_coherent_ms: u32,
     /// Acquisition non-coherent blocks (1 to 1000).
     pub acq_noncoherent: u32,
+    /// Probability that a PRN absent from the signal is reported as a satellite, over the
+    /// whole run (the background search spends it over its searches of that PRN).
+    pub acq_pfa: f64,
+    /// CPU time the background search may spend per second of signal, s (modelled:
+    /// [`crate::pipeline::search_schedule`]); a first round of searches may spend 3 s at once.
+    pub search_budget_s: f64,
     /// Use satellites whose ephemeris says they are unhealthy.
     pub allow_unhealthy: bool,
     /// Full GPS week of the recording: labels times until subframe 1 gives the week, and
@@ -75,6 +81,8 @@ impl Default for RunSettings {
             doppler_center_hz: 0.0,
             acq_coherent_ms: 1,
             acq_noncoherent: 10,
+            acq_pfa: 1e-5,
+            search_budget_s: 0.06,
             allow_unhealthy: false,
             week: None,
             prns: Vec::new(),
@@ -278,6 +286,18 @@ impl RunSettings {
             return bad(format!(
                 "acquisition non-coherent blocks {}: use 1 to 1000",
                 self.acq_noncoherent
+            ));
+        }
+        if !(self.acq_pfa > 0.0 && self.acq_pfa <= 0.1) {
+            return bad(format!(
+                "acquisition false-alarm probability {}: use a value in (0, 0.1]",
+                self.acq_pfa
+            ));
+        }
+        if !(self.search_budget_s.is_finite() && (0.0..=2.0).contains(&self.search_budget_s)) {
+            return bad(format!(
+                "search budget {} CPU s per second of signal: use 0 to 2",
+                self.search_budget_s
             ));
         }
         if let Some(p) = self.prns.iter().find(|p| !(1..=32).contains(*p)) {

@@ -1,5 +1,6 @@
 //! Integration tests of the receiver library: the pipeline driven in memory against the
 //! simulator's truth (one test binary for the crate).
 
+mod acquisition;
 mod faults;
 mod pipeline;

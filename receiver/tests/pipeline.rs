@@ -261,7 +261,7 @@ fn the_channel_manager_alone_finds_the_simulated_satellites_at_their_doppler() {
     let settings = SearchSettings {
         acq: AcqConfig::default(),
         weak_fallback: true,
-        reacquisition_interval_s: Some(1.0),
+        background: Some(gpsrx_receiver::pipeline::search_schedule::SearchBudget::default()),
         prns: Vec::new(),
         cold_targets: None,
     };

@@ -314,6 +314,9 @@ pub struct Channel {
     bit_sync_origin_ms: u64,
     pull_in_ms: u64,
     cn0_dbhz: f64,
+    /// The C/N0 while the signal was there (estimates above the loss threshold, averaged),
+    /// dB-Hz; NaN before the first.
+    tracked_cn0_dbhz: f64,
     low_cn0_count: u32,
     /// Accumulators of the current interval: E, P, L. The early replica leads the prompt by
     /// d/2 chip (its code phase is `c + d/2`), the late one lags it.
@@ -379,6 +382,7 @@ impl Channel {
             bit_sync_origin_ms: 0,
             pull_in_ms: 0,
             cn0_dbhz: start.cn0_dbhz,
+            tracked_cn0_dbhz: start.cn0_dbhz,
             low_cn0_count: 0,
             acc: [Complex64::new(0.0, 0.0); 3],
             acc_ms: 0,
@@ -407,6 +411,13 @@ impl Channel {
     /// Latest C/N0 estimate, dB-Hz (NaN before the first).
     pub fn cn0_dbhz(&self) -> f64 {
         self.cn0_dbhz
+    }
+
+    /// The C/N0 while the signal was there (the estimates above the loss threshold, averaged;
+    /// the acquisition's before the first), dB-Hz: how hard a search must be to find the
+    /// satellite again once the channel is lost.
+    pub fn tracked_cn0_dbhz(&self) -> f64 {
+        self.tracked_cn0_dbhz
     }
 
     /// The carrier NCO frequency (the Doppler the channel holds), Hz.
@@ -633,6 +644,13 @@ impl Channel {
     /// [`ChannelConfig::cn0_lost_dbhz`] with the code lock detector out release the channel.
     fn on_cn0_estimate(&mut self, c: f64) {
         self.cn0_dbhz = c;
+        if c >= self.cfg.cn0_lost_dbhz {
+            self.tracked_cn0_dbhz = if self.tracked_cn0_dbhz.is_finite() {
+                self.tracked_cn0_dbhz + 0.2 * (c - self.tracked_cn0_dbhz)
+            } else {
+                c
+            };
+        }
         if c < self.cfg.weak_enter_dbhz {
             self.weak = true;
         } else if c > self.cfg.weak_leave_dbhz {

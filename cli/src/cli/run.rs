@@ -70,6 +70,14 @@ pub struct RunArgs {
     /// Acquisition non-coherent sum of this many coherent blocks [default: 10].
     #[arg(long, value_name = "N")]
     pub acq_noncoherent: Option<u32>,
+    /// Probability that a PRN absent from the signal is reported as a satellite, over the whole
+    /// run [default: 0.00001]. The background search spends it over its repeated searches.
+    #[arg(long, value_name = "P")]
+    pub acq_pfa: Option<f64>,
+    /// CPU time the background search for missing satellites may spend per second of signal,
+    /// s [default: 0.06]: raise it to find weak satellites sooner, lower it for speed.
+    #[arg(long, value_name = "S")]
+    pub search_budget: Option<f64>,
     /// RAIM false-alarm probability [default: 0.001].
     #[arg(long, value_name = "P")]
     pub raim_pfa: Option<f64>,
@@ -158,6 +166,8 @@ impl RunArgs {
         set(&mut r.rate_hz, self.rate);
         set(&mut r.elevation_mask_deg, self.elevation_mask);
         set(&mut r.raim_pfa, self.raim_pfa);
+        set(&mut r.acq_pfa, self.acq_pfa);
+        set(&mut r.search_budget_s, self.search_budget);
         set(&mut r.doppler_max_hz, self.doppler_max);
         set(&mut r.doppler_center_hz, self.doppler_center);
         if let Some(v) = self.acq_coherent_ms {

@@ -61,6 +61,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         acq_coherent_ms: None,
         acq_noncoherent: None,
         raim_pfa: None,
+        acq_pfa: None,
+        search_budget: None,
         allow_unhealthy: false,
         landmarks: None,
         ins: None,

@@ -124,7 +124,7 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
     let search = SearchSettings {
         acq,
         weak_fallback: false,
-        reacquisition_interval_s: Some(1.0),
+        background: Some(gpsrx_receiver::pipeline::search_schedule::SearchBudget::default()),
         prns,
         cold_targets: Some(targets),
     };

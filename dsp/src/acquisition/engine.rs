@@ -153,7 +153,8 @@ impl AcquisitionEngine {
             .with_max_len(1)
             .map(|(t, &(b0, b1))| {
                 let mut s = self.take_scratch();
-                let r = self.search_prn(samples, &spectra, t.prn, b0, b1, &mut s);
+                let pfa = t.pfa.unwrap_or(self.config.pfa);
+                let r = self.search_prn(samples, &spectra, t.prn, (b0, b1), pfa, &mut s);
                 self.give_scratch(s);
                 r
             })
@@ -267,8 +268,8 @@ impl AcquisitionEngine {
         samples: &[Complex32],
         spectra: &[Complex32],
         prn: Prn,
-        b0: i64,
-        b1: i64,
+        (b0, b1): (i64, i64),
+        pfa: f64,
         s: &mut Scratch,
     ) -> AcqResult {
         let l = &self.layout;
@@ -290,7 +291,7 @@ impl AcquisitionEngine {
         }
         let nc = self.config.noncoherent;
         let cells = rows * l.n_lags * passes;
-        let threshold = detection_threshold(nc, self.config.pfa, cells) / f64::from(nc);
+        let threshold = detection_threshold(nc, pfa, cells) / f64::from(nc);
         let detected = peak.metric >= threshold;
         let step = l.doppler_step_hz;
         let coarse_hz = (b0 as f64 + peak.row as f64 + peak.row_frac) * step;

@@ -106,6 +106,9 @@ pub struct SearchTarget {
     pub prn: Prn,
     /// Doppler window (min, max), Hz, or `None` for the engine's whole range.
     pub doppler_window_hz: Option<(f64, f64)>,
+    /// False-alarm probability of this search (`None`: the engine's): a scheduler that
+    /// searches a PRN again and again spends its false-alarm probability over the searches.
+    pub pfa: Option<f64>,
 }
 
 impl SearchTarget {
@@ -114,6 +117,7 @@ impl SearchTarget {
         Self {
             prn,
             doppler_window_hz: None,
+            pfa: None,
         }
     }
 
@@ -122,7 +126,14 @@ impl SearchTarget {
         Self {
             prn,
             doppler_window_hz: Some((center_hz - half_width_hz, center_hz + half_width_hz)),
+            pfa: None,
         }
+    }
+
+    /// The same search with the false-alarm probability `pfa`.
+    pub fn with_pfa(mut self, pfa: f64) -> Self {
+        self.pfa = Some(pfa);
+        self
     }
 }
 

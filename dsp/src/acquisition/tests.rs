@@ -265,10 +265,7 @@ fn bad_settings_and_short_input_are_errors() {
         e.search_all(&short),
         Err(AcqError::NotEnoughSamples { .. })
     ));
-    let far = SearchTarget {
-        prn: prn(1),
-        doppler_window_hz: Some((20_000.0, 21_000.0)),
-    };
+    let far = SearchTarget::around(prn(1), 20_500.0, 500.0);
     let x = vec![Complex32::new(0.0, 0.0); e.samples_needed()];
     assert!(matches!(
         e.search(&x, &[far]),

@@ -33,10 +33,12 @@ pub mod navigation;
 pub mod observables;
 pub mod receiver;
 pub mod ring;
+pub mod search_schedule;
 pub mod sink;
 pub mod smoothing;
 pub mod sv_time;
 pub mod tracker;
+pub mod visibility;
 
 pub use channel_manager::SearchSettings;
 pub use dating::{WeekReference, WeekSource};

@@ -17,13 +17,14 @@ pub use crate::pipeline::fix_output::FixStats;
 use crate::pipeline::fix_output::{fix_of, obs_epoch, passes_integrity};
 use crate::pipeline::navdata::{NavDecoder, NavEvent};
 use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
+use crate::pipeline::search_schedule::Visibility;
 use crate::pipeline::sink::{
     FixReport, NavigationEnd, ObservablesReport, Progress, ReceiverEvent, Sink, SinkError,
 };
 use crate::pipeline::sv_time::{CarryNote, GapRecovery, SvTimeKeeper};
 use gpsrx_nav::atmosphere::KlobucharParams;
 use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
-use gpsrx_nav::ephemeris::Ephemeris;
+use gpsrx_nav::ephemeris::{Ephemeris, HealthPolicy};
 use gpsrx_nav::pvt::{solve, Landmark, PvtOptions, PvtSolution, RaimStatus, SatMeasurement};
 use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
@@ -96,6 +97,14 @@ pub enum BlockEvent {
     /// again (samples lost by a fraction of a millisecond, or a blockage).
     Collapse(Collapse),
 }
+
+/// Doppler uncertainty of a satellite predicted from a fix and an ephemeris, Hz (the fix's
+/// velocity and clock drift are good to a few cm/s: a few hertz; the rest is margin), and its
+/// growth with the age of the fix, Hz/s (a receiver accelerating at 1 g changes the Doppler by
+/// up to 50 Hz/s).
+pub const PREDICTED_DOPPLER_HZ: f64 = 60.0;
+/// See [`PREDICTED_DOPPLER_HZ`].
+pub const PREDICTED_DOPPLER_RATE_HZ_S: f64 = 50.0;
 
 /// Solutions failing the integrity test in a row, after a valid one, that make the receiver
 /// time suspect.
@@ -232,6 +241,44 @@ impl NavigationProcessor {
     /// week that does not come from the system clock.
     fn week_known(&self) -> bool {
         self.reference_week_known || self.decoders.values().any(|d| d.decoded_week().is_some())
+    }
+
+    /// What is predicted of `prn` at stream time `t_stream_s` for the acquisition scheduler:
+    /// with a fix (position, velocity, clock bias and drift) and the satellite's ephemeris
+    /// (decoded or from `--nav`), whether it is above the horizon and its Doppler within
+    /// [`PREDICTED_DOPPLER_HZ`] plus [`PREDICTED_DOPPLER_RATE_HZ_S`] per second since the fix
+    /// ([`crate::pipeline::visibility`]); else nothing.
+    pub fn visibility(&self, prn: u8, t_stream_s: f64) -> Visibility {
+        let (Some(fix), Some(t0)) = (self.prior.as_ref(), self.builder.rx_time_origin()) else {
+            return Visibility::Unknown;
+        };
+        // GPS time: receiver time less the clock bias of the fix.
+        let t = t0.add_seconds(t_stream_s - fix.clock_bias_m / SPEED_OF_LIGHT_MPS);
+        let decoded = self.decoders.get(&prn).and_then(|d| d.ephemeris.as_ref());
+        let eph = decoded.or_else(|| {
+            self.nav_assist
+                .as_ref()
+                .and_then(|n| n.select_with(prn, t, HealthPolicy::PreferHealthy))
+        });
+        let Some(eph) = eph.filter(|e| e.is_within_s(t, 4.0 * 3600.0)) else {
+            return Visibility::Unknown;
+        };
+        let rx = gpsrx_core::PosVel {
+            pos_m: fix.pos_ecef_m,
+            vel_mps: fix.vel_ecef_mps.unwrap_or_default(),
+        };
+        let drift = fix.clock_drift_mps.unwrap_or(0.0) / SPEED_OF_LIGHT_MPS;
+        match crate::pipeline::visibility::predict(eph, &rx, t, drift) {
+            Some(p) if p.elevation_deg < 0.0 => Visibility::Below,
+            Some(p) => {
+                let age_s = (t.tow_s - fix.time.tow_s).abs();
+                Visibility::Visible {
+                    doppler_hz: p.doppler_hz,
+                    half_width_hz: PREDICTED_DOPPLER_HZ + PREDICTED_DOPPLER_RATE_HZ_S * age_s,
+                }
+            }
+            None => Visibility::Unknown,
+        }
     }
 
     /// The fixes so far, summarised.

@@ -15,6 +15,7 @@ use crate::pipeline::channel_manager::{ChannelManager, ColdStartError, SearchSet
 use crate::pipeline::dating::WeekReference;
 use crate::pipeline::navigation::{BlockEvent, NavigationProcessor};
 use crate::pipeline::ring::{block_samples, SampleWindow};
+use crate::pipeline::search_schedule::SearchBudget;
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult};
 use gpsrx_dsp::Prn;
@@ -25,9 +26,6 @@ use gpsrx_samples::{SampleError, SampleSource};
 use gpsrx_tracking::AidingPort;
 use num_complex::Complex32;
 use std::path::Path;
-
-/// Seconds of signal between re-acquisition searches.
-const REACQUISITION_INTERVAL_S: f64 = 1.0;
 
 /// Why the receiver stopped.
 #[derive(Debug, thiserror::Error)]
@@ -268,8 +266,8 @@ impl Receiver {
         Self::with_search(config, fs_hz, assistance, Self::configured_search(config))
     }
 
-    /// The search [`ReceiverConfig`] describes: its integration and Doppler range, the
-    /// 10 ms x 10 weak-signal fallback, re-acquisition every second.
+    /// The search [`ReceiverConfig`] describes: its integration, Doppler range and false-alarm
+    /// probability, and the background search with its budget.
     fn configured_search(config: &ReceiverConfig) -> SearchSettings {
         let run = &config.run;
         SearchSettings {
@@ -278,10 +276,14 @@ impl Receiver {
                 noncoherent: run.acq_noncoherent,
                 doppler_center_hz: run.doppler_center_hz,
                 doppler_max_hz: run.doppler_max_hz,
+                pfa: run.acq_pfa,
                 ..AcqConfig::default()
             },
             weak_fallback: true,
-            reacquisition_interval_s: Some(REACQUISITION_INTERVAL_S),
+            background: Some(SearchBudget {
+                per_signal_s: run.search_budget_s,
+                ..SearchBudget::default()
+            }),
             prns: run.prns.iter().filter_map(|&p| Prn::new(p).ok()).collect(),
             cold_targets: None,
         }
@@ -407,7 +409,11 @@ impl Receiver {
         // block is read behind them.
         loop {
             let view = self.window.view();
-            let due = self.manager.due_search(view);
+            let (nav, fs) = (&self.nav, self.fs_hz);
+            let t_s = view.end() as f64 / fs;
+            let due = self
+                .manager
+                .due_search(view, &|p| nav.visibility(p.get(), t_s));
             let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
             let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
             let manager = &mut self.manager;
@@ -537,7 +543,10 @@ impl Receiver {
     /// One block: the channels process the samples before `limit`, with a due search beside.
     fn step(&mut self, limit: u64, sink: &mut dyn Sink) -> Result<(), ReceiverError> {
         let view = self.window.view().until(limit);
-        let due = self.manager.due_search(view);
+        let (nav, t_s) = (&self.nav, limit as f64 / self.fs_hz);
+        let due = self
+            .manager
+            .due_search(view, &|p| nav.visibility(p.get(), t_s));
         let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
         let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
         let found = self.manager.work(view, due, aid);
@@ -588,7 +597,10 @@ impl Receiver {
             }
             Some(outcome) => {
                 let first = outcome.first();
-                let started = self.manager.start_found(outcome);
+                let (nav, t_s) = (&self.nav, end as f64 / self.fs_hz);
+                let started = self
+                    .manager
+                    .start_found(outcome, &|p| nav.visibility(p.get(), t_s));
                 self.announce(&started, first, sink)?;
             }
             None => {}

@@ -2,9 +2,10 @@
 //! broadcast ephemerides, an approximate position and the time.
 
 use anyhow::{bail, Context};
-use gpsrx_core::{los_doppler_hz, PosVel};
+use gpsrx_core::PosVel;
 use gpsrx_dsp::Prn;
-use gpsrx_nav::{azimuth_elevation, GpsTime, HealthPolicy, Llh, NavData, Vector3};
+use gpsrx_nav::{GpsTime, HealthPolicy, Llh, NavData, Vector3};
+use gpsrx_receiver::pipeline::visibility;
 
 /// What the ephemeris predicts for one satellite at the receiver.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -25,38 +26,24 @@ pub struct Prediction {
 
 /// Predicted Doppler and elevation of every PRN with an ephemeris valid at `t` (healthy or not,
 /// healthy ones first: [`NavData::select_with`] with [`HealthPolicy::PreferHealthy`]) that is
-/// at least `mask_deg` above the horizon of a static receiver at `rx`.
-///
-/// The satellite state is taken at transmit time `t - tau` (light time iterated three times
-/// from 75 ms) and rotated by the Earth's rotation during the flight (IS-GPS-200
-/// 20.3.3.4.3.3.2; [`gpsrx_nav::Ephemeris::at_reception`]). With `u` the unit vector from the
-/// receiver to the satellite, the range rate is `rho_dot = (v_sv - v_rx) . u` (v_rx = 0 in
-/// ECEF), and the Doppler is positive when the range shrinks:
-/// `f_D = -rho_dot / lambda_L1 + f_L1 clock_drift_sv` ([`gpsrx_core::los_doppler_hz`]; a
-/// satellite clock running fast transmits above 1575.42 MHz). The receiver's own clock drift is unknown here and adds
-/// `-drift * f_L1` to every satellite (1e-6 s/s = -1575 Hz): cover it with the search window.
+/// at least `mask_deg` above the horizon of a static receiver at `rx`
+/// ([`gpsrx_receiver::pipeline::visibility::predict`]). The receiver's own clock drift is
+/// unknown here and adds `-drift * f_L1` to every satellite (1e-6 s/s = -1575 Hz): cover it
+/// with the search window.
 pub fn predict(nav: &NavData, rx: &Llh, t: GpsTime, mask_deg: f64) -> Vec<Prediction> {
-    let rx_ecef = rx.to_ecef();
+    let rx = PosVel {
+        pos_m: rx.to_ecef(),
+        vel_mps: Vector3::zeros(),
+    };
     Prn::all()
         .filter_map(|prn| {
             let eph = nav.select_with(prn.get(), t, HealthPolicy::PreferHealthy)?;
-            let seen = eph.at_reception(t, &rx_ecef, 0.075, 3);
-            let sv = PosVel {
-                pos_m: seen.sv.pos_m,
-                vel_mps: seen.sv.vel_mps,
-            };
-            let rx = PosVel {
-                pos_m: rx_ecef,
-                vel_mps: Vector3::zeros(),
-            };
-            let doppler_hz = los_doppler_hz(&sv, &rx, seen.sv.clock_drift_s_s, 0.0)?;
-            let (az, el) = azimuth_elevation(&rx_ecef, &seen.sv.pos_m);
-            let elevation_deg = el.to_degrees();
-            (elevation_deg >= mask_deg && doppler_hz.is_finite()).then_some(Prediction {
+            let p = visibility::predict(eph, &rx, t, 0.0)?;
+            (p.elevation_deg >= mask_deg).then_some(Prediction {
                 prn,
-                doppler_hz,
-                elevation_deg,
-                azimuth_deg: az.to_degrees(),
+                doppler_hz: p.doppler_hz,
+                elevation_deg: p.elevation_deg,
+                azimuth_deg: p.azimuth_deg,
                 healthy: eph.sv_health == 0,
             })
         })

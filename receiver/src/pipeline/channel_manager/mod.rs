@@ -1,0 +1,523 @@
+//! The channel manager: which satellites have a tracking channel, and the searches that start
+//! new ones.
+//!
+//! - Cold start: the first samples of the stream are searched for every wanted PRN with the
+//!   configured search (or the assisted targets).
+//! - Background search ([`crate::pipeline::search_schedule`]): every PRN without a live channel
+//!   is searched again and again within a CPU budget per second of signal, escalating the
+//!   integration while it is not found (to 10 ms x 40, about 28 dB-Hz), satellites just lost
+//!   (around their last Doppler, every 0.2 s) and predicted visible ones (around their
+//!   predicted Doppler) first, predicted hidden ones never. A detection at the Doppler of a
+//!   much stronger tracked satellite (modulo 1 kHz) is that satellite's cross-correlation, not
+//!   a satellite.
+//! - Code realignment ([`realign`]): after a common collapse of the prompt power, the channels
+//!   are moved onto the code that jumped.
+//! - Work: every channel processes the code periods the sample window holds, in parallel
+//!   (rayon), concurrently with a due search (rayon `join`).
+
+mod realign;
+
+pub use realign::{Realigned, REALIGN_DOPPLER_HZ};
+
+use crate::pipeline::ring::SampleView;
+use crate::pipeline::search_schedule::{
+    Batch, Liveness, Scheduler, SearchBudget, Visibility, LEVELS,
+};
+use gpsrx_dsp::acquisition::{AcqConfig, AcqResult, AcquisitionEngine, SearchTarget};
+use gpsrx_dsp::Prn;
+use gpsrx_tracking::{
+    AidingPort, Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState,
+};
+use num_complex::Complex32;
+use rayon::prelude::*;
+
+/// A detection this many dB below a tracked satellite, at its Doppler modulo 1 kHz (within
+/// [`XCORR_DOPPLER_HZ`]), is taken for its cross-correlation (C/A codes cross-correlate at
+/// -21 to -24 dB, at Doppler differences that are whole kHz).
+pub const XCORR_MARGIN_DB: f64 = 12.0;
+/// See [`XCORR_MARGIN_DB`], Hz.
+pub const XCORR_DOPPLER_HZ: f64 = 60.0;
+
+/// How the manager searches.
+#[derive(Debug, Clone)]
+pub struct SearchSettings {
+    /// The acquisition engine's settings (integration, Doppler range, false-alarm
+    /// probability): the cold start's search and the first level of the background search.
+    pub acq: AcqConfig,
+    /// Escalate the background search to the weak-signal levels
+    /// ([`crate::pipeline::search_schedule::LEVELS`]) for PRNs not found.
+    pub weak_fallback: bool,
+    /// The background search's CPU budget; `None`: no search after the cold start.
+    pub background: Option<SearchBudget>,
+    /// PRNs to look for (empty: all 32).
+    pub prns: Vec<Prn>,
+    /// The cold start's targets, when known better than "every wanted PRN, full Doppler
+    /// range" (an assisted search with predicted Doppler windows).
+    pub cold_targets: Option<Vec<SearchTarget>>,
+}
+
+/// A search due in this block: its first sample and its targets, and what it is for (a
+/// scheduled batch, or a code realignment).
+#[derive(Debug)]
+pub struct DueSearch {
+    first: u64,
+    /// Samples read from `first`.
+    len: usize,
+    targets: Vec<SearchTarget>,
+    batch: Option<Batch>,
+    realign: Option<realign::Realign>,
+}
+
+/// What a search found: its first sample, targets and results.
+#[derive(Debug)]
+pub struct SearchOutcome {
+    first: u64,
+    results: Vec<AcqResult>,
+    batch: Option<Batch>,
+    realign: Option<realign::Realign>,
+}
+
+impl SearchOutcome {
+    /// Index of the first sample searched.
+    pub fn first(&self) -> u64 {
+        self.first
+    }
+
+    /// Whether this is the search of a code realignment ([`ChannelManager::realign`]).
+    pub fn is_realignment(&self) -> bool {
+        self.realign.is_some()
+    }
+}
+
+/// The tracking channels and the searches that start them.
+#[derive(Debug)]
+pub struct ChannelManager {
+    fs_hz: f64,
+    channel_config: ChannelConfig,
+    /// The search engines: the configured one, then the weak-signal levels.
+    engines: Vec<AcquisitionEngine>,
+    /// The cold start is still to come.
+    cold_pending: bool,
+    settings: Option<SearchSettings>,
+    channels: Vec<Channel>,
+    /// Per channel, the reports of the last round (kept: no allocation per block).
+    reports: Vec<Vec<ChannelEpoch>>,
+    schedule: Option<Scheduler>,
+    /// A code realignment waiting for its samples.
+    realign: Option<realign::Realign>,
+    /// The engine of code realignment searches; `None` without searches.
+    realign_engine: Option<AcquisitionEngine>,
+}
+
+impl ChannelManager {
+    /// A manager that searches with `settings` and starts channels with `channel_config`.
+    pub fn new(
+        fs_hz: f64,
+        channel_config: ChannelConfig,
+        settings: SearchSettings,
+    ) -> Result<Self, gpsrx_dsp::acquisition::AcqError> {
+        let mut engines = vec![AcquisitionEngine::new(fs_hz, settings.acq.clone())?];
+        if settings.weak_fallback {
+            for &(coherent_ms, noncoherent) in &LEVELS {
+                let cfg = AcqConfig {
+                    coherent_ms,
+                    noncoherent,
+                    ..settings.acq.clone()
+                };
+                engines.push(AcquisitionEngine::new(fs_hz, cfg)?);
+            }
+        }
+        let realign_engine = Some(realign::realign_engine(fs_hz, &settings.acq)?);
+        Ok(Self {
+            fs_hz,
+            channel_config,
+            engines,
+            cold_pending: true,
+            settings: Some(settings),
+            channels: Vec::new(),
+            reports: Vec::new(),
+            schedule: None,
+            realign: None,
+            realign_engine,
+        })
+    }
+
+    /// A manager for channels started elsewhere, with no search (loop studies, tests).
+    pub fn with_channels(fs_hz: f64, channels: Vec<Channel>) -> Self {
+        Self {
+            fs_hz,
+            channel_config: ChannelConfig::default(),
+            engines: Vec::new(),
+            cold_pending: false,
+            settings: None,
+            channels,
+            reports: Vec::new(),
+            schedule: None,
+            realign: None,
+            realign_engine: None,
+        }
+    }
+
+    /// Samples the cold start wants before it searches (0 when it is done or there is none).
+    pub fn cold_start_samples(&self) -> usize {
+        match (self.cold_pending, self.engines.first()) {
+            (true, Some(e)) => e.samples_wanted(),
+            _ => 0,
+        }
+    }
+
+    /// Whether the cold start is still to come.
+    pub fn cold_start_pending(&self) -> bool {
+        self.cold_pending && !self.engines.is_empty()
+    }
+
+    /// Samples the cold start cannot do without.
+    pub fn cold_start_minimum(&self) -> usize {
+        match (self.cold_pending, self.engines.first()) {
+            (true, Some(e)) => e.samples_needed(),
+            _ => 0,
+        }
+    }
+
+    /// Searches `samples` (whose first sample has index `first_index`) for every wanted PRN,
+    /// starts a channel per satellite found, and returns the detections. The background search
+    /// (when configured) starts from here.
+    pub fn cold_start(
+        &mut self,
+        samples: &[Complex32],
+        first_index: u64,
+    ) -> Result<Vec<AcqResult>, ColdStartError> {
+        if !self.cold_start_pending() {
+            return Ok(Vec::new());
+        }
+        self.cold_pending = false;
+        let engine = &self.engines[0];
+        let n = samples.len();
+        if n < engine.samples_needed() {
+            return Err(ColdStartError::TooShort {
+                samples: n,
+                needed: engine.samples_needed(),
+            });
+        }
+        let prns: Vec<Prn> = self
+            .settings
+            .as_ref()
+            .map(|s| s.prns.clone())
+            .unwrap_or_default();
+        let targets: Vec<SearchTarget> =
+            match self.settings.as_ref().and_then(|s| s.cold_targets.clone()) {
+                Some(t) => t,
+                None => wanted_prns(&prns).map(SearchTarget::full).collect(),
+            };
+        let found = engine.search(&samples[..n.min(engine.samples_wanted())], &targets)?;
+        for d in found.iter().filter(|d| d.detected) {
+            let start = ChannelStart::from_acquisition(d, first_index);
+            self.channels
+                .push(Channel::new(&start, self.fs_hz, &self.channel_config)?);
+            tracing::info!(
+                "{}: acquired, Doppler {:.0} Hz, C/N0 {:.1} dB-Hz",
+                d.prn,
+                d.doppler_hz,
+                d.cn0_dbhz.unwrap_or(f64::NAN)
+            );
+        }
+        if let Some((budget, s)) = self
+            .settings
+            .as_ref()
+            .and_then(|s| s.background.map(|b| (b, s)))
+        {
+            let end = first_index + engine.samples_wanted().min(n) as u64;
+            self.schedule = Some(Scheduler::new(self.fs_hz, budget, s.acq.pfa, &prns, end));
+        }
+        Ok(found.into_iter().filter(|d| d.detected).collect())
+    }
+
+    /// Samples the background search reads at most (0 without one).
+    fn search_samples(&self) -> usize {
+        match self.schedule {
+            Some(_) => self
+                .engines
+                .iter()
+                .map(AcquisitionEngine::samples_wanted)
+                .max()
+                .unwrap_or(0),
+            None => 0,
+        }
+    }
+
+    /// Whether `prn` has a live channel, or when and at what Doppler its last one was lost.
+    fn liveness(&self, prn: Prn) -> Liveness {
+        if self.live(prn).is_some() {
+            return Liveness::Live;
+        }
+        match self.channels.iter().rev().find(|c| c.prn() == prn) {
+            Some(c) => Liveness::LostAt(c.next_span().0, c.doppler_hz(), c.tracked_cn0_dbhz()),
+            None => Liveness::Never,
+        }
+    }
+
+    /// The search due now that the window is `window`, if one is: a code realignment whose
+    /// samples have come, else the background search's next batch, with `visibility` what is
+    /// predicted of each PRN.
+    pub fn due_search(
+        &mut self,
+        window: SampleView<'_>,
+        visibility: &dyn Fn(Prn) -> Visibility,
+    ) -> Option<DueSearch> {
+        if let Some(due) = self.due_realignment(window) {
+            return Some(due);
+        }
+        let mut schedule = self.schedule.take()?;
+        let span = window.end() - window.start();
+        let batch = schedule.due(
+            window.end(),
+            span,
+            &self.engines,
+            &|p| self.liveness(p),
+            visibility,
+        );
+        self.schedule = Some(schedule);
+        let batch = batch?;
+        tracing::debug!(
+            "search at sample {}: level {}, {} PRN(s)",
+            window.end(),
+            batch.level,
+            batch.targets.len()
+        );
+        Some(DueSearch {
+            first: batch.first,
+            len: batch.len,
+            targets: batch.targets.clone(),
+            batch: Some(batch),
+            realign: None,
+        })
+    }
+
+    /// Every channel processes the code periods `window` holds (in parallel), while `search`
+    /// (if any) runs beside them. With `aid`, each channel's NCOs get the fed-forward Doppler
+    /// of its satellite at the start of every code period.
+    pub fn work(
+        &mut self,
+        window: SampleView<'_>,
+        search: Option<DueSearch>,
+        aid: Option<&dyn AidingPort>,
+    ) -> Option<SearchOutcome> {
+        self.reports.resize_with(self.channels.len(), Vec::new);
+        let channels = &mut self.channels;
+        let reports = &mut self.reports;
+        let mut run_all = || {
+            channels
+                .par_iter_mut()
+                .zip(reports.par_iter_mut())
+                .for_each(|(ch, out)| run_channel(ch, window, aid, out));
+        };
+        let engine = match &search {
+            Some(s) if s.realign.is_some() => self.realign_engine.as_ref(),
+            Some(s) => s.batch.as_ref().and_then(|b| self.engines.get(b.level)),
+            None => None,
+        };
+        match (engine, search) {
+            (Some(engine), Some(s)) => {
+                let samples = window.get(s.first, s.len).unwrap_or(&[]);
+                let (results, ()) = rayon::join(|| engine.search(samples, &s.targets), run_all);
+                let results = results
+                    .map_err(|e| tracing::warn!("a search failed: {e}"))
+                    .ok();
+                results.map(|results| SearchOutcome {
+                    first: s.first,
+                    results,
+                    batch: s.batch,
+                    realign: s.realign,
+                })
+            }
+            _ => {
+                run_all();
+                None
+            }
+        }
+    }
+
+    /// Hands the reports of the last [`ChannelManager::work`] to `f` as `(channel index,
+    /// report)`, channel by channel, each in time order.
+    pub fn drain_reports<E>(
+        &mut self,
+        mut f: impl FnMut(usize, &ChannelEpoch) -> Result<(), E>,
+    ) -> Result<(), E> {
+        for (i, r) in self.reports.iter_mut().enumerate() {
+            let mut result = Ok(());
+            for e in r.iter() {
+                result = f(i, e);
+                if result.is_err() {
+                    break;
+                }
+            }
+            r.clear();
+            result?;
+        }
+        Ok(())
+    }
+
+    /// Whether detection `d` sits at the Doppler of a much stronger live channel modulo 1 kHz
+    /// ([`XCORR_MARGIN_DB`]): its cross-correlation, not a satellite.
+    fn cross_correlation(&self, d: &AcqResult) -> Option<Prn> {
+        let cn0 = d.cn0_dbhz?;
+        self.channels
+            .iter()
+            .filter(|c| c.state() != ChannelState::Lost && c.prn() != d.prn)
+            .find(|c| {
+                let apart = d.doppler_hz - c.doppler_hz();
+                let off_khz = apart - (apart / 1000.0).round() * 1000.0;
+                off_khz.abs() <= XCORR_DOPPLER_HZ && c.cn0_dbhz() - cn0 >= XCORR_MARGIN_DB
+            })
+            .map(Channel::prn)
+    }
+
+    /// Starts channels for what a search found (`visibility` as in
+    /// [`ChannelManager::due_search`]); returns the detections.
+    pub fn start_found(
+        &mut self,
+        mut outcome: SearchOutcome,
+        visibility: &dyn Fn(Prn) -> Visibility,
+    ) -> Vec<AcqResult> {
+        for d in outcome.results.iter_mut().filter(|d| d.detected) {
+            if let Some(strong) = self.cross_correlation(d) {
+                tracing::debug!(
+                    "{}: detection at {:.0} Hz, {:.1} dB-Hz taken for a cross-correlation of {strong}",
+                    d.prn,
+                    d.doppler_hz,
+                    d.cn0_dbhz.unwrap_or(f64::NAN)
+                );
+                d.detected = false;
+                d.cross_correlation_of = Some(strong);
+            }
+        }
+        let end = outcome.first + outcome.batch.as_ref().map_or(0, |b| b.len as u64);
+        if let (Some(s), Some(b)) = (self.schedule.as_mut(), outcome.batch.as_ref()) {
+            s.record(b, &outcome.results, end, visibility);
+        }
+        let mut started = Vec::new();
+        for d in outcome.results.into_iter().filter(|d| d.detected) {
+            let start = ChannelStart::from_acquisition(&d, outcome.first);
+            match Channel::new(&start, self.fs_hz, &self.channel_config) {
+                Ok(ch) => {
+                    tracing::info!(
+                        "{}: acquired at {:.2} s, Doppler {:.0} Hz, C/N0 {:.1} dB-Hz",
+                        d.prn,
+                        outcome.first as f64 / self.fs_hz,
+                        d.doppler_hz,
+                        d.cn0_dbhz.unwrap_or(f64::NAN)
+                    );
+                    self.channels.push(ch);
+                    started.push(d);
+                }
+                Err(e) => tracing::warn!("{}: cannot start a channel: {e}", d.prn),
+            }
+        }
+        started
+    }
+
+    /// The oldest sample still needed: the slowest live channel's next code period, and the
+    /// samples the next search will read. `end` is the window's end.
+    pub fn oldest_needed(&self, end: u64) -> u64 {
+        let live = self
+            .channels
+            .iter()
+            .filter(|c| c.state() != ChannelState::Lost);
+        let oldest = live.map(|c| c.next_span().0).min().unwrap_or(end);
+        let search_from = end.saturating_sub(self.search_samples() as u64);
+        // A code realignment waiting for its samples keeps the latest search's worth.
+        let realign_from = self.realign.as_ref().map_or(u64::MAX, |_| {
+            end.saturating_sub(self.realign_samples().unwrap_or(0) as u64)
+        });
+        oldest.min(search_from).min(realign_from)
+    }
+
+    /// Whether nothing more can happen: every channel lost and no search to start new ones.
+    pub fn finished(&self) -> bool {
+        self.schedule.is_none()
+            && !self.cold_start_pending()
+            && self
+                .channels
+                .iter()
+                .all(|c| c.state() == ChannelState::Lost)
+    }
+
+    /// Every live channel forgets its data-bit edges ([`Channel::restart_bit_sync`]).
+    pub fn restart_bit_sync(&mut self) {
+        for c in self
+            .channels
+            .iter_mut()
+            .filter(|c| c.state() != ChannelState::Lost)
+        {
+            c.restart_bit_sync();
+        }
+    }
+
+    /// The channels, in the order they were started.
+    pub fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+
+    /// The channels, consumed.
+    pub fn into_channels(self) -> Vec<Channel> {
+        self.channels
+    }
+}
+
+/// The cold start could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum ColdStartError {
+    /// Fewer samples than one search needs.
+    #[error(
+        "the recording is too short for acquisition ({samples} samples; at least {needed} needed)"
+    )]
+    TooShort {
+        /// Samples available.
+        samples: usize,
+        /// Samples one search needs.
+        needed: usize,
+    },
+    /// The search failed.
+    #[error(transparent)]
+    Acquisition(#[from] gpsrx_dsp::acquisition::AcqError),
+    /// A channel could not be started.
+    #[error("cannot start a tracking channel: {0}")]
+    Channel(#[from] gpsrx_tracking::ConfigError),
+}
+
+/// The PRNs in `prns`, or all 32 when it is empty.
+fn wanted_prns(prns: &[Prn]) -> Box<dyn Iterator<Item = Prn> + '_> {
+    if prns.is_empty() {
+        Box::new(Prn::all())
+    } else {
+        Box::new(prns.iter().copied())
+    }
+}
+
+/// Processes every code period of `ch` that `window` holds, appending the reports to `out`.
+fn run_channel(
+    ch: &mut Channel,
+    window: SampleView<'_>,
+    aid: Option<&dyn AidingPort>,
+    out: &mut Vec<ChannelEpoch>,
+) {
+    while ch.state() != ChannelState::Lost {
+        let (start, n) = ch.next_span();
+        if start < window.start() {
+            ch.skip_to(window.start());
+            continue;
+        }
+        match window.get(start, n) {
+            Some(x) => {
+                if let Some(aid) = aid {
+                    let t = start as f64 / ch.fs_hz();
+                    ch.set_aid(aid.doppler_aid(ch.prn(), t), t);
+                }
+                if let Some(e) = ch.process_code_period(x) {
+                    out.push(e);
+                }
+            }
+            None => break,
+        }
+    }
+}

@@ -1,0 +1,498 @@
+//! Which satellites are searched, when, and how hard: the background acquisition scheduler.
+//!
+//! Every wanted PRN without a live channel is searched again and again, escalating the
+//! integration while it is not found ([`LEVELS`]): the configured search (1 ms x 10 by default,
+//! about 36 dB-Hz), then 10 ms x 10 (about 31 dB-Hz) and 10 ms x 40 (about 28 dB-Hz), the
+//! 10 ms blocks guarded against data-bit edges by the engine's half-shifted pass. Satellites
+//! come first in this order:
+//!
+//! 1. lost in the last [`HOT_FOR_S`]: around their last Doppler, every [`HOT_INTERVAL_S`];
+//! 2. predicted visible ([`Visibility::Visible`]: from `--nav` or decoded ephemerides and a
+//!    position), in their predicted Doppler window, never left more than [`PREDICTED_WAIT_S`];
+//! 3. the others over the whole Doppler range, the least recently searched first, waiting
+//!    [`UNKNOWN_WAIT_S`] once the most sensitive search has failed. Satellites predicted below
+//!    the horizon are not searched.
+//!
+//! **CPU budget.** Searches spend a budget of modelled CPU time ([`SearchBudget`]: a bucket
+//! that refills by a fixed amount per second of *signal*, so a post-processing run stays as
+//! fast as the budget says, and a real-time one never stalls its tracking for long). The cost
+//! of a search is modelled from its size, `samples x Doppler bins x passes x`
+//! [`COST_S_PER_SAMPLE_BIN`] (measured on the development machine), not timed, so that runs are
+//! deterministic.
+//!
+//! **False alarms.** A PRN searched `k` times would collect `k` false-alarm chances; its `k`-th
+//! search gets `pfa 6 / (pi^2 k^2)` (the sum over all `k` is `pfa`): searching longer never
+//! makes a false satellite more likely than one search at `pfa`.
+
+use gpsrx_dsp::acquisition::{AcqResult, AcquisitionEngine, SearchTarget};
+use gpsrx_dsp::Prn;
+
+/// Coherent integration (ms) and non-coherent blocks of the levels after the configured
+/// search (level 0).
+pub const LEVELS: [(u32, u32); 2] = [(10, 10), (10, 40)];
+/// How long after a loss a satellite is searched in the narrow hot window, s.
+pub const HOT_FOR_S: f64 = 60.0;
+/// Seconds of signal between two hot searches of a satellite.
+pub const HOT_INTERVAL_S: f64 = 0.2;
+/// Half width of the hot Doppler window: this much, Hz, plus [`HOT_DOPPLER_RATE_HZ_S`] per
+/// second since the loss.
+pub const HOT_DOPPLER_HZ: f64 = 250.0;
+/// See [`HOT_DOPPLER_HZ`], Hz/s.
+pub const HOT_DOPPLER_RATE_HZ_S: f64 = 25.0;
+/// Longest wait between two searches of a satellite predicted visible, s.
+pub const PREDICTED_WAIT_S: f64 = 2.0;
+/// Wait after the most sensitive search of an unpredicted satellite failed, s.
+pub const UNKNOWN_WAIT_S: f64 = 15.0;
+/// Seconds of signal between two scheduling decisions.
+pub const TICK_S: f64 = 0.1;
+/// Modelled CPU time of a search per sample, Doppler bin and pass, s, for 1 ms coherent
+/// blocks, and divided by the coherent milliseconds for longer ones (measured per PRN over
+/// +-5 kHz at 2.6 MHz on the 2-core development machine: 1 ms x 10 2.2 ms, 10 ms x 10 44 ms,
+/// 10 ms x 40 172 ms).
+pub const COST_S_PER_SAMPLE_BIN: f64 = 3.7e-9;
+/// Largest modelled cost of one batch, s (a block waits for its search).
+pub const MAX_BATCH_S: f64 = 0.3;
+
+/// The CPU time searches may spend.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchBudget {
+    /// Refill per second of signal, CPU s (0.06: searching costs at most 6 % of a core).
+    pub per_signal_s: f64,
+    /// Capacity of the bucket, CPU s (spent at once at the start: a first full round).
+    pub burst_s: f64,
+}
+
+impl Default for SearchBudget {
+    fn default() -> Self {
+        Self {
+            per_signal_s: 0.06,
+            burst_s: 3.0,
+        }
+    }
+}
+
+/// What is known of a satellite's visibility now.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Visibility {
+    /// Above the elevation mask, its Doppler within `doppler_hz +- half_width_hz`.
+    Visible {
+        /// Predicted Doppler, Hz (with the receiver clock drift when known).
+        doppler_hz: f64,
+        /// Uncertainty, Hz.
+        half_width_hz: f64,
+    },
+    /// Below the horizon.
+    Below,
+    /// Nothing known.
+    Unknown,
+}
+
+/// A search the channel manager is to run: the level's engine, its samples and targets.
+#[derive(Debug, Clone)]
+pub struct Batch {
+    /// Index of the engine (0: the configured search, then [`LEVELS`]).
+    pub level: usize,
+    /// First sample and number of samples searched.
+    pub first: u64,
+    /// Samples read.
+    pub len: usize,
+    /// The PRNs and their windows.
+    pub targets: Vec<SearchTarget>,
+    /// Per target: a hot search (a satellite just lost).
+    pub hot: Vec<bool>,
+}
+
+/// Whether a satellite has a channel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Liveness {
+    /// A live channel tracks it.
+    Live,
+    /// Its last channel lost the signal at this sample index, holding this Doppler (Hz), with
+    /// this C/N0 (dB-Hz) while it tracked.
+    LostAt(u64, f64, f64),
+    /// It never had a channel.
+    Never,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct PrnState {
+    level: usize,
+    searches: u32,
+    /// Sample index before which it is not searched.
+    not_before: u64,
+}
+
+/// A candidate for the next batch: priority (lower first), its level, target and cost.
+struct Candidate {
+    hot: bool,
+    priority: (u8, u64),
+    level: usize,
+    target: SearchTarget,
+    cost_s: f64,
+}
+
+/// The scheduler (see the module documentation).
+#[derive(Debug, Clone)]
+pub struct Scheduler {
+    fs_hz: f64,
+    budget: SearchBudget,
+    tokens_s: f64,
+    last_refill: u64,
+    next_tick: u64,
+    pfa: f64,
+    wanted: Vec<Prn>,
+    prns: [PrnState; 32],
+}
+
+impl Scheduler {
+    /// A scheduler for samples at `fs_hz` searching `wanted` (all 32 if empty) with the
+    /// false-alarm probability `pfa` per PRN over the whole run, starting at sample `start`.
+    pub fn new(fs_hz: f64, budget: SearchBudget, pfa: f64, wanted: &[Prn], start: u64) -> Self {
+        Self {
+            fs_hz,
+            budget,
+            tokens_s: budget.burst_s,
+            last_refill: start,
+            next_tick: start,
+            pfa,
+            wanted: if wanted.is_empty() {
+                Prn::all().collect()
+            } else {
+                wanted.to_vec()
+            },
+            prns: [PrnState::default(); 32],
+        }
+    }
+
+    /// The modelled CPU time left, s.
+    pub fn tokens_s(&self) -> f64 {
+        self.tokens_s
+    }
+
+    /// The false-alarm probability of the next search of `prn`.
+    fn pfa_of(&self, prn: Prn) -> f64 {
+        let k = f64::from(self.prns[prn.index()].searches + 1);
+        self.pfa * 6.0 / (std::f64::consts::PI.powi(2) * k * k)
+    }
+
+    /// The batch due at sample `now`, if any: `engines` are the levels' engines, `window` the
+    /// samples held (`now - window` is the oldest), `live` whether a PRN has a channel,
+    /// `visibility` what is predicted of it.
+    pub fn due(
+        &mut self,
+        now: u64,
+        window: u64,
+        engines: &[AcquisitionEngine],
+        live: &dyn Fn(Prn) -> Liveness,
+        visibility: &dyn Fn(Prn) -> Visibility,
+    ) -> Option<Batch> {
+        let elapsed = now.saturating_sub(self.last_refill) as f64 / self.fs_hz;
+        self.tokens_s =
+            (self.tokens_s + elapsed * self.budget.per_signal_s).min(self.budget.burst_s);
+        self.last_refill = now;
+        if now < self.next_tick {
+            return None;
+        }
+        self.next_tick = now + (TICK_S * self.fs_hz) as u64;
+        let due: Vec<Prn> = self
+            .wanted
+            .iter()
+            .copied()
+            .filter(|&p| live(p) != Liveness::Live && now >= self.prns[p.index()].not_before)
+            .collect();
+        let mut candidates: Vec<Candidate> = due
+            .into_iter()
+            .filter_map(|p| self.candidate(p, now, engines, live(p), visibility(p)))
+            .collect();
+        candidates.sort_by_key(|c| c.priority);
+        let level = candidates.first()?.level;
+        let engine = engines.get(level)?;
+        let len = engine.samples_wanted() as u64;
+        if window < len {
+            return None;
+        }
+        let mut spent = 0.0;
+        let mut targets = Vec::new();
+        let mut hot = Vec::new();
+        for c in candidates.into_iter().filter(|c| c.level == level) {
+            if spent + c.cost_s > self.tokens_s.min(MAX_BATCH_S) && !targets.is_empty() {
+                break;
+            }
+            if c.cost_s > self.tokens_s {
+                break;
+            }
+            spent += c.cost_s;
+            hot.push(c.hot);
+            targets.push(c.target.with_pfa(self.pfa_of(c.target.prn)));
+        }
+        if targets.is_empty() {
+            return None;
+        }
+        self.tokens_s -= spent;
+        Some(Batch {
+            level,
+            first: now - len,
+            len: len as usize,
+            targets,
+            hot,
+        })
+    }
+
+    /// The candidate search of `p` at sample `now`, or `None` when it is not to be searched
+    /// (predicted below the horizon: looked at again in [`UNKNOWN_WAIT_S`]).
+    fn candidate(
+        &mut self,
+        p: Prn,
+        now: u64,
+        engines: &[AcquisitionEngine],
+        live: Liveness,
+        vis: Visibility,
+    ) -> Option<Candidate> {
+        let s = self.prns[p.index()];
+        let hot = match live {
+            Liveness::LostAt(at, doppler, cn0) => {
+                let since_s = now.saturating_sub(at) as f64 / self.fs_hz;
+                (since_s < HOT_FOR_S).then(|| {
+                    let w = HOT_DOPPLER_HZ + HOT_DOPPLER_RATE_HZ_S * since_s;
+                    (doppler, w, level_for_cn0(cn0))
+                })
+            }
+            _ => None,
+        };
+        let (rank, level, target) = match (hot, vis) {
+            (Some((d, w, l)), _) => (0, l, SearchTarget::around(p, d, w)),
+            (None, Visibility::Below) => {
+                self.prns[p.index()].not_before = now + (UNKNOWN_WAIT_S * self.fs_hz) as u64;
+                return None;
+            }
+            (
+                None,
+                Visibility::Visible {
+                    doppler_hz,
+                    half_width_hz,
+                },
+            ) => (
+                1,
+                s.level,
+                SearchTarget::around(p, doppler_hz, half_width_hz),
+            ),
+            (None, Visibility::Unknown) => (2, s.level, SearchTarget::full(p)),
+        };
+        let level = level.min(engines.len().saturating_sub(1));
+        let engine = engines.get(level)?;
+        Some(Candidate {
+            hot: rank == 0,
+            priority: (rank, s.not_before),
+            level,
+            cost_s: cost_s(engine, &target),
+            target,
+        })
+    }
+
+    /// Takes the results of `batch`, searched at sample `now`, with `visibility` as in
+    /// [`Scheduler::due`]: a PRN not found searches harder next time, or waits once the
+    /// hardest search failed.
+    pub fn record(
+        &mut self,
+        batch: &Batch,
+        results: &[AcqResult],
+        now: u64,
+        visibility: &dyn Fn(Prn) -> Visibility,
+    ) {
+        let max_level = LEVELS.len();
+        for (i, (t, r)) in batch.targets.iter().zip(results).enumerate() {
+            let s = &mut self.prns[t.prn.index()];
+            s.searches += 1;
+            if r.detected {
+                s.level = 0;
+                continue;
+            }
+            let hot = batch.hot.get(i).copied().unwrap_or(false);
+            let wait_s = if hot {
+                HOT_INTERVAL_S
+            } else if batch.level < max_level {
+                s.level = batch.level + 1;
+                0.0
+            } else if matches!(visibility(t.prn), Visibility::Visible { .. }) {
+                PREDICTED_WAIT_S
+            } else {
+                UNKNOWN_WAIT_S
+            };
+            s.not_before = now + (wait_s * self.fs_hz) as u64;
+        }
+    }
+}
+
+/// The least sensitive level that finds a satellite of `cn0_dbhz` (the C/N0 its channel
+/// measured): 1 ms x 10 from 37 dB-Hz, 10 ms x 10 from 31 dB-Hz, else 10 ms x 40.
+pub fn level_for_cn0(cn0_dbhz: f64) -> usize {
+    if !cn0_dbhz.is_finite() || cn0_dbhz >= 37.0 {
+        0
+    } else if cn0_dbhz >= 31.0 {
+        1
+    } else {
+        2
+    }
+}
+
+/// The modelled CPU time of searching `target` with `engine`, s.
+pub fn cost_s(engine: &AcquisitionEngine, target: &SearchTarget) -> f64 {
+    let step = engine.doppler_step_hz();
+    let (lo, hi) = engine.doppler_range_hz();
+    let (a, b) = target.doppler_window_hz.unwrap_or((lo, hi));
+    let bins = ((b.min(hi) - a.max(lo)) / step).max(0.0) + 1.0;
+    let coherent_ms = engine.config().coherent_ms.max(1);
+    let passes = if coherent_ms >= 2 { 2.0 } else { 1.0 };
+    engine.samples_needed() as f64 * bins * passes * COST_S_PER_SAMPLE_BIN / f64::from(coherent_ms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gpsrx_dsp::acquisition::AcqConfig;
+
+    const FS: f64 = 2.6e6;
+
+    fn engines() -> Vec<AcquisitionEngine> {
+        let base = AcqConfig::default();
+        std::iter::once(base.clone())
+            .chain(LEVELS.iter().map(|&(c, n)| AcqConfig {
+                coherent_ms: c,
+                noncoherent: n,
+                ..base.clone()
+            }))
+            .map(|cfg| AcquisitionEngine::new(FS, cfg).expect("engine"))
+            .collect()
+    }
+
+    fn result(prn: Prn, detected: bool) -> AcqResult {
+        AcqResult {
+            prn,
+            detected,
+            code_phase_samples: 0.0,
+            code_phase_chips: 0.0,
+            doppler_hz: 0.0,
+            doppler_coarse_hz: 0.0,
+            cn0_dbhz: None,
+            metric: 1.0,
+            threshold: 2.0,
+            peak_ratio: 1.0,
+            bit_offset_ms: 0,
+            refine_ms: 0,
+            cross_correlation_of: None,
+        }
+    }
+
+    /// Runs the scheduler for `seconds` of signal with nothing ever found; returns per PRN
+    /// the levels searched and the sample of each search.
+    fn run(
+        seconds: f64,
+        vis: &dyn Fn(Prn) -> Visibility,
+        budget: SearchBudget,
+    ) -> Vec<Vec<(usize, u64)>> {
+        let engines = engines();
+        let mut s = Scheduler::new(FS, budget, 1e-3, &[], 0);
+        let mut log = vec![Vec::new(); 32];
+        let block = (0.01 * FS) as u64;
+        let mut now = block;
+        while (now as f64) < seconds * FS {
+            if let Some(b) = s.due(now, now, &engines, &|_| Liveness::Never, vis) {
+                for t in &b.targets {
+                    log[t.prn.index()].push((b.level, now));
+                    assert!(t
+                        .pfa
+                        .is_some_and(|p| p <= 1e-3 * 6.0 / std::f64::consts::PI.powi(2) + 1e-12));
+                }
+                let results: Vec<AcqResult> =
+                    b.targets.iter().map(|t| result(t.prn, false)).collect();
+                s.record(&b, &results, now, vis);
+            }
+            now += block;
+        }
+        log
+    }
+
+    #[test]
+    fn unfound_satellites_are_searched_ever_harder_within_the_budget() {
+        let log = run(60.0, &|_| Visibility::Unknown, SearchBudget::default());
+        for (i, l) in log.iter().enumerate() {
+            let levels: Vec<usize> = l.iter().map(|x| x.0).collect();
+            // Every PRN reaches the most sensitive search within a minute, in order.
+            assert!(levels.len() >= 3, "PRN {}: {levels:?}", i + 1);
+            assert_eq!(&levels[..3], &[0, 1, 2], "PRN {}", i + 1);
+        }
+        // The modelled CPU time spent stays within the budget: 3 s + 0.06 s per second.
+        let engines = engines();
+        let spent: f64 = log
+            .iter()
+            .enumerate()
+            .flat_map(|(i, l)| {
+                let prn = Prn::new(i as u8 + 1).expect("prn");
+                l.iter().map(move |&(lvl, _)| (lvl, prn))
+            })
+            .map(|(lvl, prn)| cost_s(&engines[lvl], &SearchTarget::full(prn)))
+            .sum();
+        assert!(spent <= 3.0 + 0.06 * 60.0 + 1e-9, "spent {spent} s");
+    }
+
+    #[test]
+    fn predicted_satellites_come_first_and_never_wait_long_and_hidden_ones_are_skipped() {
+        let vis = |p: Prn| match p.get() {
+            1..=4 => Visibility::Visible {
+                doppler_hz: 1000.0,
+                half_width_hz: 300.0,
+            },
+            5..=8 => Visibility::Unknown,
+            _ => Visibility::Below,
+        };
+        let log = run(40.0, &vis, SearchBudget::default());
+        for l in &log[8..] {
+            assert!(
+                l.is_empty(),
+                "a satellite below the horizon was searched: {l:?}"
+            );
+        }
+        for (i, l) in log[..4].iter().enumerate() {
+            // First, as soon as the window holds a search (0.11 s).
+            let first = l.first().map(|x| x.1 as f64 / FS);
+            assert!(first.is_some_and(|t| t <= 0.15), "PRN {}: {first:?}", i + 1);
+            let longest = l.windows(2).map(|w| w[1].1 - w[0].1).max().unwrap_or(0) as f64 / FS;
+            assert!(
+                longest <= PREDICTED_WAIT_S + 0.2,
+                "PRN {}: waited {longest} s",
+                i + 1
+            );
+        }
+    }
+
+    #[test]
+    fn a_lost_satellite_is_searched_in_its_hot_window_every_fifth_of_a_second() {
+        let engines = engines();
+        let mut s = Scheduler::new(FS, SearchBudget::default(), 1e-3, &[], 0);
+        let prn = Prn::new(7).expect("prn");
+        let lost_at = (5.0 * FS) as u64;
+        let mut times = Vec::new();
+        let block = (0.01 * FS) as u64;
+        let mut now = (5.0 * FS) as u64;
+        while (now as f64) < 7.0 * FS {
+            let live = |p: Prn| {
+                if p == prn {
+                    Liveness::LostAt(lost_at, -1234.0, 45.0)
+                } else {
+                    Liveness::Live
+                }
+            };
+            if let Some(b) = s.due(now, now, &engines, &live, &|_| Visibility::Unknown) {
+                let t = b.targets[0];
+                assert_eq!(b.level, 0);
+                let (lo, hi) = t.doppler_window_hz.expect("narrow");
+                assert!(lo < -1234.0 && hi > -1234.0 && hi - lo < 700.0, "{lo} {hi}");
+                times.push(now);
+                let r = vec![result(prn, false)];
+                s.record(&b, &r, now, &|_| Visibility::Unknown);
+            }
+            now += block;
+        }
+        assert!(times.len() >= 9, "{} hot searches in 2 s", times.len());
+    }
+}
