@@ -380,3 +380,74 @@ fn the_broadcast_utc_weeks_are_resolved_with_the_decoded_week() {
         .unwrap_or_else(|| panic!("no week in `{gput}`"));
     assert_eq!(week, utc.wnt, "`{gput}`");
 }
+
+#[test]
+fn the_almanac_broadcast_is_decoded_and_written_as_yuma() {
+    // The simulator sends subframes 4 and 5 pages by frame number (IS-GPS-200 Table 20-V):
+    // starting at TOW 538430 s, the frame of 538440 s carries subframe 5 page 24 (PRN 24) and
+    // the next one page 25 (t_oa and WN_a), which dates it. Truth: the almanac the simulator
+    // derives from the broadcast ephemerides (`Almanac::from_ephemeris`).
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let text = r#"
+duration_s = 75.0
+seed = 3
+nav = "builtin:brdc0010.22n"
+[start]
+week = 2190
+tow_s = 538430.0
+[output]
+format = "ci8"
+fs_hz = 2.048e6
+[receiver]
+kind = "static"
+llh_deg = [37.5665, 126.9780, 40.0]
+[satellites]
+almanac = true
+"#;
+    let sc = Scenario::from_toml(text).unwrap_or_else(|e| panic!("{e}"));
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let data = sim
+        .run(dir.path(), &|_| {})
+        .unwrap_or_else(|e| panic!("{e}"))
+        .data_path;
+    let out = dir.path().join("out");
+    run(
+        &data,
+        &out,
+        &["--nav", nav_file().to_str().unwrap_or_default()],
+    );
+    let yuma = std::fs::read_to_string(out.join("almanac.yuma")).unwrap_or_else(|e| panic!("{e}"));
+    let block = yuma
+        .split("\n\n")
+        .find(|b| b.contains("almanac for PRN-24"))
+        .unwrap_or_else(|| panic!("no PRN 24 in {yuma}"));
+    let field = |name: &str| -> f64 {
+        block
+            .lines()
+            .find(|l| l.starts_with(name))
+            .and_then(|l| l.split(':').nth(1))
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap_or(f64::NAN)
+    };
+    let nav = gpsrx_nav::rinex_nav::parse_rinex_nav(gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let t = gpsrx_nav::GpsTime::new(2190, 538440.0);
+    let eph = nav
+        .select_with(24, t, gpsrx_nav::HealthPolicy::PreferHealthy)
+        .unwrap_or_else(|| panic!("no ephemeris of PRN 24"));
+    let toa = gpsrx_nav::GpsTime::new(2190, field("Time of Applicability"));
+    let want = gpsrx_nav::almanac::Almanac::from_ephemeris(eph, toa);
+    // Within the ICD's quantisation (Table 20-VI: e 2^-21, sqrt A 2^-11, angles 2^-23 to
+    // 2^-15 semicircles).
+    assert!((field("Eccentricity") - want.e).abs() < 1e-6, "{block}");
+    assert!(
+        (field("SQRT(A)") - want.sqrt_a_sqrt_m).abs() < 1e-3,
+        "{block}"
+    );
+    assert!(
+        (field("Orbital Inclination") - want.inclination_rad()).abs() < 1e-5,
+        "{block}"
+    );
+    assert!((field("Mean Anom") - want.m0_rad).abs() < 1e-6, "{block}");
+    assert_eq!(field("week"), f64::from(2190 % 1024));
+}

@@ -4,7 +4,8 @@
 //! `channels.csv`, `observables.rnx` (RINEX 3; held back until the first fix gives the
 //! header's approximate position, or 300 s of observables with the week known, or the end;
 //! never written while the GPS week is unknown, see [`crate::pipeline::dating`]),
-//! `ephemeris.rnx` (the decoded ephemerides, at the end), `track.geojson` and `track.kml` (the
+//! `ephemeris.rnx` (the decoded ephemerides, at the end), `almanac.yuma` (the decoded almanac,
+//! when one was), `track.geojson` and `track.kml` (the
 //! fixes, at the end).
 
 use crate::output::{
@@ -202,6 +203,10 @@ impl Sink for FileSink {
             ..NavHeader::default()
         };
         write_rinex_nav_file(&self.dir.join("ephemeris.rnx"), &header, &records)?;
+        if let Some(set) = end.almanac.as_ref().filter(|s| !s.almanacs.is_empty()) {
+            let mut f = create_file(&self.dir.join("almanac.yuma"))?;
+            super::yuma::write_yuma(&mut f, "almanac.yuma", set)?;
+        }
         let mut f = create_file(&self.dir.join("track.geojson"))?;
         write_geojson(&mut f, "track.geojson", &self.fixes)?;
         let mut f = create_file(&self.dir.join("track.kml"))?;

@@ -2,6 +2,7 @@
 //!
 //! - [`rinex_obs`]: RINEX 3.04 GPS observation file (`observables.rnx`), streamed epoch by epoch;
 //! - [`rinex_nav`]: RINEX 3.04 GPS navigation file (`ephemeris.rnx`);
+//! - [`yuma`]: the decoded almanac as a YUMA file (`almanac.yuma`);
 //! - [`nmea`]: NMEA 0183 GGA, RMC, GSA and GSV sentences (`pvt.nmea`);
 //! - [`geojson`] and [`kml`]: the track for maps (`track.geojson`, `track.kml`);
 //! - [`pvt_csv`]: one row per fix (`pvt.csv`) and one row per channel and epoch
@@ -20,6 +21,7 @@ pub mod nmea;
 pub mod pvt_csv;
 pub mod rinex_nav;
 pub mod rinex_obs;
+pub mod yuma;
 
 use gpsrx_nav::{GpsTime, Llh};
 use std::fs::File;

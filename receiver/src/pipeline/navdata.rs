@@ -42,6 +42,9 @@ pub enum NavEvent {
     },
     /// A complete, consistent ephemeris (subframes 1-3 with matching IODE/IODC).
     Ephemeris(Box<Ephemeris>),
+    /// A subframe 4 or 5 page of the almanac (an almanac page or a page 25), for the
+    /// almanac collected from all satellites.
+    AlmanacPage(Box<DecodedSubframe>),
     /// A subframe failed parity.
     ParityFailure,
     /// A subframe's HOW disagrees with the SV time kept (a carried-over time, or the time of
@@ -382,6 +385,11 @@ impl NavDecoder {
             SubframePayload::Page18 { iono, utc } => {
                 self.iono = Some(iono);
                 self.utc_broadcast = Some(utc);
+            }
+            SubframePayload::Almanac(_)
+            | SubframePayload::Sf5Page25(_)
+            | SubframePayload::Sf4Page25(_) => {
+                events.push(NavEvent::AlmanacPage(Box::new(sf)));
             }
             _ => {
                 if let Some(eph) = self.assembler.push(&sf) {

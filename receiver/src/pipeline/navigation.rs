@@ -25,6 +25,7 @@ use crate::pipeline::sv_time::{CarryNote, GapRecovery, SvTimeKeeper};
 use gpsrx_nav::atmosphere::KlobucharParams;
 use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
 use gpsrx_nav::ephemeris::{Ephemeris, HealthPolicy};
+use gpsrx_nav::lnav::AlmanacCollector;
 use gpsrx_nav::pvt::{solve, Landmark, PvtOptions, PvtSolution, RaimStatus, SatMeasurement};
 use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
@@ -41,6 +42,8 @@ pub struct NavigationProcessor {
     nav_assist: Option<NavData>,
     landmarks: Vec<LandmarkObservation>,
     decoders: BTreeMap<u8, NavDecoder>,
+    /// The almanac from every satellite's subframes 4 and 5.
+    almanac: AlmanacCollector,
     builder: ObservableBuilder,
     prior: Option<PvtSolution>,
     iono_fallback_said: bool,
@@ -131,6 +134,7 @@ impl NavigationProcessor {
             nav_assist,
             landmarks,
             decoders: BTreeMap::new(),
+            almanac: AlmanacCollector::new(reference_week),
             builder,
             prior: None,
             iono_fallback_said: false,
@@ -260,15 +264,20 @@ impl NavigationProcessor {
                 .as_ref()
                 .and_then(|n| n.select_with(prn, t, HealthPolicy::PreferHealthy))
         });
-        let Some(eph) = eph.filter(|e| e.is_within_s(t, 4.0 * 3600.0)) else {
-            return Visibility::Unknown;
-        };
         let rx = gpsrx_core::PosVel {
             pos_m: fix.pos_ecef_m,
             vel_mps: fix.vel_ecef_mps.unwrap_or_default(),
         };
         let drift = fix.clock_drift_mps.unwrap_or(0.0) / SPEED_OF_LIGHT_MPS;
-        match crate::pipeline::visibility::predict(eph, &rx, t, drift) {
+        // An ephemeris within 4 h, else the decoded almanac (a few hertz worse: margin enough).
+        let seen = match eph.filter(|e| e.is_within_s(t, 4.0 * 3600.0)) {
+            Some(e) => e.at_reception(t, &rx.pos_m, 0.075, 3),
+            None => match self.almanac.almanac(prn) {
+                Some(a) => a.at_reception(t, &rx.pos_m),
+                None => return Visibility::Unknown,
+            },
+        };
+        match crate::pipeline::visibility::predict_seen(&seen, &rx, drift) {
             Some(p) if p.elevation_deg < 0.0 => Visibility::Below,
             Some(p) => {
                 let age_s = (t.tow_s - fix.time.tow_s).abs();
@@ -311,6 +320,7 @@ impl NavigationProcessor {
                 .collect(),
             iono: self.decoders.values().find_map(|d| d.iono),
             utc: self.decoders.values().find_map(|d| d.utc),
+            almanac: self.almanac.almanac_set(),
         }
     }
 
@@ -411,6 +421,15 @@ impl NavigationProcessor {
                             prn: e.prn,
                             iode: eph.iode,
                         })?;
+                    }
+                    NavEvent::AlmanacPage(sf) => {
+                        if let Some(w) = dec.decoded_week() {
+                            self.almanac.set_reference_week(w);
+                        }
+                        let added = self.almanac.push(&sf);
+                        if !added.is_empty() {
+                            tracing::debug!("almanac of {added:?} decoded (from G{:02})", e.prn);
+                        }
                     }
                     NavEvent::TowMismatch { error_ms } => {
                         tracing::warn!(

@@ -124,6 +124,8 @@ pub struct NavigationEnd {
     pub iono: Option<KlobucharParams>,
     /// Broadcast UTC parameters, if decoded.
     pub utc: Option<UtcParams>,
+    /// The almanac decoded from subframes 4 and 5 (complete pages dated by a page 25), if any.
+    pub almanac: Option<gpsrx_nav::almanac::AlmanacSet>,
 }
 
 /// The receiver's outputs go to a sink.

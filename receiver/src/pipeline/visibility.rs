@@ -10,6 +10,7 @@
 
 use gpsrx_core::{los_doppler_hz, PosVel};
 use gpsrx_nav::ephemeris::Ephemeris;
+use gpsrx_nav::frames::SvAtReception;
 use gpsrx_nav::{azimuth_elevation, GpsTime};
 
 /// What an ephemeris predicts for one satellite at the receiver.
@@ -32,7 +33,20 @@ pub fn predict(
     t: GpsTime,
     rx_clock_drift_s_s: f64,
 ) -> Option<SatPrediction> {
-    let seen = eph.at_reception(t, &rx.pos_m, 0.075, 3);
+    predict_seen(
+        &eph.at_reception(t, &rx.pos_m, 0.075, 3),
+        rx,
+        rx_clock_drift_s_s,
+    )
+}
+
+/// The prediction from the satellite's state at reception `seen` (from an ephemeris, or an
+/// almanac: [`gpsrx_nav::almanac::Almanac::at_reception`]), as [`predict`].
+pub fn predict_seen(
+    seen: &SvAtReception,
+    rx: &PosVel,
+    rx_clock_drift_s_s: f64,
+) -> Option<SatPrediction> {
     let sv = PosVel {
         pos_m: seen.sv.pos_m,
         vel_mps: seen.sv.vel_mps,
