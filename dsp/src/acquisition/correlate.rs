@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 impl AcquisitionEngine {
     /// Forward FFTs of every block of every pass at every fractional Doppler offset, stored
-    /// polyphase (`X[D j + r]` at `r * inv_len + j`) so that the decimated reads are contiguous.
+    /// polyphase (`X[D j + r]` at `r * spec_len + j`) so that the decimated reads are contiguous.
     pub(super) fn block_spectra(&self, samples: &[Complex32]) -> Vec<Complex32> {
         let l = &self.layout;
         let n = l.block_len;
@@ -42,7 +42,7 @@ impl AcquisitionEngine {
             }
             self.fwd.process_with_scratch(tmp, &mut s.fft);
             let d = l.decimation;
-            let m = l.inv_len;
+            let m = l.spec_len;
             for r in 0..d {
                 for (j, o) in out[r * m..(r + 1) * m].iter_mut().enumerate() {
                     *o = tmp[d * j + r];
@@ -65,7 +65,9 @@ impl AcquisitionEngine {
         s: &mut Scratch,
     ) {
         let l = &self.layout;
-        let (n, m, lags, q_total) = (l.block_len, l.inv_len, l.n_lags, l.subdivision);
+        let (n, sl, m, lags, q_total) =
+            (l.block_len, l.spec_len, l.inv_len, l.n_lags, l.subdivision);
+        let (kp, kn) = (l.keep_pos, l.keep_neg);
         let rows = (b1 - b0 + 1) as usize;
         s.grid.clear();
         s.grid.resize(rows * lags, 0.0);
@@ -80,23 +82,23 @@ impl AcquisitionEngine {
             let f_hz = bin as f64 * l.doppler_step_hz;
             let grid_row = &mut s.grid[row * lags..(row + 1) * lags];
             for (b, &ms) in starts.iter().enumerate() {
-                let base = ((pass * blocks_per_pass + b) * q_total + q) * n + r * m;
-                let src = &spectra[base..base + m];
-                // Y[j] = X[D (j + a) + r] conj(C[j]) / len: the Doppler shift is a rotation.
+                let base = ((pass * blocks_per_pass + b) * q_total + q) * n + r * sl;
+                let src = &spectra[base..base + sl];
+                // Y[j] = X[D (j + a) + r] conj(C[j]) / len: the Doppler shift is a rotation;
+                // the lowest kp non-negative and kn negative frequencies j (relative to the
+                // Doppler) are kept, zeros between them when the inverse FFT is longer.
                 let buf = &mut s.buf[..m];
-                let (head, tail) = buf.split_at_mut(m - a);
-                for ((y, x), c) in head.iter_mut().zip(&src[a..]).zip(&replica[..m - a]) {
-                    *y = x * c;
-                }
-                for ((y, x), c) in tail.iter_mut().zip(&src[..a]).zip(&replica[m - a..]) {
-                    *y = x * c;
-                }
+                let (pos, rest) = buf.split_at_mut(kp);
+                let (mid, neg) = rest.split_at_mut(m - kp - kn);
+                mul_rotated(pos, src, a, &replica[..kp]);
+                mul_rotated(neg, src, (sl - kn + a) % sl, &replica[m - kn..]);
+                mid.fill(Complex32::new(0.0, 0.0));
                 self.inv.process_with_scratch(buf, &mut s.fft);
                 // Where the code period that started at lag tau of block 0 starts in this block:
                 // the block start rounding plus the code Doppler (code runs f/f_L1 faster).
                 let ideal = f64::from(ms) * l.period_samples;
                 let shift = (ideal - l.block_start_sample(ms) as f64) - ideal * f_hz / F_L1_HZ;
-                let rs = (shift.round() as i64).rem_euclid(m as i64) as usize;
+                let rs = ((shift / l.lag_samples).round() as i64).rem_euclid(m as i64) as usize;
                 let first = lags.min(m - rs);
                 for (g, y) in grid_row[..first].iter_mut().zip(&buf[rs..rs + first]) {
                     *g += y.norm_sqr();
@@ -106,5 +108,55 @@ impl AcquisitionEngine {
                 }
             }
         }
+    }
+
+    /// Noise power of a full-band correlation over that of the search's band-limited one at
+    /// Doppler bin `bin`: `sum_j P[j] W[j] / sum_{j kept} P[j] W[j]`, with `P` the power
+    /// spectrum of the first pass's blocks (relative to the bin's Doppler) and `W` the mean
+    /// replica power spectrum. 1 when the search keeps the whole spectrum. The grid floor times
+    /// this is the noise of the prompts of the refinement, which correlate at the input rate,
+    /// whatever the front-end filter (white noise gives 1/(fraction of the replica's power in
+    /// the band), about 1.05 at +-2.048 MHz).
+    pub(super) fn band_noise_ratio(&self, spectra: &[Complex32], bin: i64) -> f64 {
+        let l = &self.layout;
+        if l.inv_len >= l.spec_len {
+            return 1.0;
+        }
+        let (n, sl, q_total) = (l.block_len, l.spec_len, l.subdivision);
+        let q = bin.rem_euclid(q_total as i64) as usize;
+        let k = (bin - q as i64) / q_total as i64;
+        let kk = k.rem_euclid(n as i64) as usize;
+        let (r, a) = (kk % l.decimation, kk / l.decimation);
+        let (mut all, mut kept) = (0.0f64, 0.0f64);
+        for b in 0..l.block_start_ms.first().map_or(0, Vec::len) {
+            let base = (b * q_total + q) * n + r * sl;
+            let src = &spectra[base..base + sl];
+            for (j, w) in self.replica_power.iter().enumerate() {
+                let p = f64::from(src[(j + a) % sl].norm_sqr() * w);
+                all += p;
+                if j < l.keep_pos || j >= sl - l.keep_neg {
+                    kept += p;
+                }
+            }
+        }
+        if kept > 0.0 && all.is_finite() {
+            (all / kept).max(1.0)
+        } else {
+            1.0
+        }
+    }
+}
+
+/// `dst[t] = src[(start + t) mod src.len()] * rep[t]` (`start < src.len()`,
+/// `dst.len() <= src.len()`), in at most two contiguous runs.
+fn mul_rotated(dst: &mut [Complex32], src: &[Complex32], start: usize, rep: &[Complex32]) {
+    let first = dst.len().min(src.len() - start);
+    let (d0, d1) = dst.split_at_mut(first);
+    let (r0, r1) = rep.split_at(first);
+    for ((y, x), c) in d0.iter_mut().zip(&src[start..]).zip(r0) {
+        *y = x * c;
+    }
+    for ((y, x), c) in d1.iter_mut().zip(src).zip(r1) {
+        *y = x * c;
     }
 }

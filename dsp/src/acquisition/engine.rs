@@ -8,6 +8,7 @@ use super::replica::{fractional_wipeoffs, replica_spectra};
 use super::stats::detection_threshold;
 use super::{AcqGrid, AcqResult, SearchTarget};
 use crate::constants::{CA_CHIP_RATE_HZ, CA_CODE_LENGTH};
+use crate::correlator::{Correlator, PackedCode};
 use crate::{CaCode, Prn};
 use num_complex::{Complex32, Complex64};
 use rayon::prelude::*;
@@ -42,7 +43,10 @@ pub struct AcquisitionEngine {
     pub(super) fine: Arc<dyn Fft<f32>>,
     pub(super) fine_len: usize,
     pub(super) replicas: Vec<Vec<Complex32>>,
-    pub(super) codes: Vec<CaCode>,
+    /// Mean `|C[k]|^2` of the 32 replicas over the whole block spectrum (`spec_len` bins).
+    pub(super) replica_power: Vec<f32>,
+    pub(super) correlator: Correlator,
+    pub(super) packed: Vec<PackedCode>,
     pub(super) wipeoffs: Vec<Vec<Complex32>>,
     pub(super) scratch_pool: Mutex<Vec<Scratch>>,
     pub(super) spectra_pool: Mutex<Vec<Vec<Complex32>>>,
@@ -55,6 +59,7 @@ impl fmt::Debug for AcquisitionEngine {
             .field("config", &self.config)
             .field("block_len", &self.layout.block_len)
             .field("inverse_fft_len", &self.layout.inv_len)
+            .field("lag_samples", &self.layout.lag_samples)
             .field("doppler_step_hz", &self.layout.doppler_step_hz)
             .finish_non_exhaustive()
     }
@@ -71,8 +76,8 @@ impl AcquisitionEngine {
         let inv = planner.plan_fft_inverse(layout.inv_len);
         let fine_len = (8 * config.refine_ms as usize).next_power_of_two().max(256);
         let fine = planner.plan_fft_forward(fine_len);
-        let fwd_replica = planner.plan_fft_forward(layout.inv_len);
-        let replicas = replica_spectra(&layout, fs_hz, &fwd_replica);
+        let fwd_replica = planner.plan_fft_forward(layout.spec_len);
+        let (replicas, replica_power) = replica_spectra(&layout, fs_hz, &fwd_replica);
         let wipeoffs = fractional_wipeoffs(&layout);
         Ok(Self {
             fs_hz,
@@ -83,7 +88,11 @@ impl AcquisitionEngine {
             fine,
             fine_len,
             replicas,
-            codes: Prn::all().map(CaCode::new).collect(),
+            replica_power,
+            correlator: Correlator::best(),
+            packed: Prn::all()
+                .map(|p| PackedCode::new(CaCode::new(p).chips()))
+                .collect(),
             wipeoffs,
             scratch_pool: Mutex::new(Vec::new()),
             spectra_pool: Mutex::new(Vec::new()),
@@ -188,6 +197,7 @@ impl AcquisitionEngine {
             prn: target.prn,
             doppler_hz: (b0..=b1).map(|b| b as f64 * step).collect(),
             n_lags: self.layout.n_lags,
+            lag_samples: self.layout.lag_samples,
             noncoherent: self.config.noncoherent,
             power: s.grid.clone(),
         };
@@ -275,8 +285,8 @@ impl AcquisitionEngine {
         let l = &self.layout;
         let rows = (b1 - b0 + 1) as usize;
         let passes = l.block_start_ms.len();
-        let spc = self.fs_hz / CA_CHIP_RATE_HZ;
-        let exclusion = spc.ceil() as usize;
+        // One chip in search lags.
+        let exclusion = (self.fs_hz / CA_CHIP_RATE_HZ / l.lag_samples).ceil() as usize;
         self.fill_grid(spectra, prn, b0, b1, 0, s);
         let (mut peak, mut pass) = (
             analyse(&s.grid, rows, l.n_lags, exclusion, &mut s.floors),
@@ -295,7 +305,7 @@ impl AcquisitionEngine {
         let detected = peak.metric >= threshold;
         let step = l.doppler_step_hz;
         let coarse_hz = (b0 as f64 + peak.row as f64 + peak.row_frac) * step;
-        let code_phase = peak.lag_frac.rem_euclid(l.period_samples);
+        let code_phase = (peak.lag_frac * l.lag_samples).rem_euclid(l.period_samples);
         let mut result = AcqResult {
             prn,
             detected,
@@ -313,28 +323,40 @@ impl AcquisitionEngine {
             cross_correlation_of: None,
         };
         if detected {
-            self.refine(samples, &peak, &mut result, s);
+            let band = self.band_noise_ratio(spectra, b0 + peak.row as i64);
+            self.refine(samples, &peak, band, &mut result, s);
         }
         result
     }
 
     /// Fine Doppler from squared prompts, then the code phase from early/prompt/late
     /// correlators at that Doppler, and the C/N0 at the apex of their triangle.
-    fn refine(&self, samples: &[Complex32], peak: &Peak, r: &mut AcqResult, s: &mut Scratch) {
+    /// `band` is the full-band over in-band noise power of a correlation (1 when the search
+    /// keeps the whole spectrum; see [`Self::band_noise_ratio`]).
+    fn refine(
+        &self,
+        samples: &[Complex32],
+        peak: &Peak,
+        band: f64,
+        r: &mut AcqResult,
+        s: &mut Scratch,
+    ) {
         let l = &self.layout;
-        let chips = self.codes[r.prn.index()].chips();
+        let code = &self.packed[r.prn.index()];
         let k_max = self.config.refine_ms as usize;
         let t_p = 1e-3;
         let max_dev = l.doppler_step_hz.min(240.0);
-        // sigma_x^2 per sample from the grid floor: E|corr|^2 = block_len sigma_x^2 per block.
+        // sigma_x^2 per sample from the grid floor: E|corr|^2 = block_len sigma_x^2 per block
+        // for a full-band correlation (the prompts below), `1/band` of that in the grid.
         let var_per_sample =
-            peak.noise_mean / (f64::from(self.config.noncoherent) * l.block_len as f64);
+            peak.noise_mean * band / (f64::from(self.config.noncoherent) * l.block_len as f64);
         let noise_var = var_per_sample * l.period_samples;
         let fs = self.fs_hz;
         let tau = r.code_phase_samples;
         correlate_periods(
             samples,
-            chips,
+            &self.correlator,
+            code,
             fs,
             tau,
             r.doppler_hz,
@@ -350,7 +372,8 @@ impl AcquisitionEngine {
         let d = 0.5 * fs / CA_CHIP_RATE_HZ;
         correlate_periods(
             samples,
-            chips,
+            &self.correlator,
+            code,
             fs,
             tau,
             r.doppler_hz,

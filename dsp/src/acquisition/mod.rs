@@ -8,7 +8,7 @@
 //! PRN and Doppler bin f the engine computes the circular correlation with the code replica,
 //! `corr[tau] = sum_n x[n] exp(-j 2 pi f n/fs) c[n - tau]`, for every lag tau of one code period
 //! by FFT: `corr = IFFT( FFT(x e^{-j 2 pi f n/fs}) conj(FFT(c)) )`, and sums `|corr|^2` over the
-//! blocks. Three things keep this cheap and exact:
+//! blocks. Four things keep this cheap and exact:
 //!
 //! - **Doppler by rotation.** Bins are spaced `1/(Q T)` Hz (Q >= 2, default 2, i.e. 500 Hz at
 //!   1 ms; the bin width never exceeds 2/(3T)). A bin `f = (k + q/Q)/T` is the spectrum of the
@@ -19,7 +19,24 @@
 //!   M-period block, so only every M-th bin of its spectrum is non-zero and the correlation of an
 //!   M-ms block is an L-point inverse FFT: a 10 ms block costs the same per bin as a 1 ms one.
 //!   At any other rate the replica is resampled over the whole block (N = round(M fs/1 kHz)
-//!   samples, any N: rustfft handles every size) and the inverse FFT is N points.
+//!   samples) and the correlation is taken from the N-point block spectrum.
+//! - **A fast search length at any rate.** The inverse FFTs (32 PRNs x bins x blocks: nearly all
+//!   the work) do not run at the length of that spectrum, S = L or N, but at a search length
+//!   S' (`config::search_len`): S itself when it is a multiple of 16 with no prime factor above
+//!   7 and at most 4096 per ms (4, 2.048, 8.184... MHz); otherwise the next such length up to
+//!   4096 per ms (2.6 MHz: 2600 -> 2688; the spectrum zero-padded), and 4096 per ms for anything
+//!   faster (5, 12, 16.368, 24 MHz: the 4096 lowest frequencies kept, +-2.048 MHz, 95 % of the
+//!   C/A power). In both cases the S'-point inverse FFT of the kept bins
+//!   `Y[k] = X[k] conj(C[k]) / S`, k signed, is the *band-limited circular correlation*
+//!   `corr(tau) = (1/S) sum_{k kept} X[k] conj(C[k]) exp(j 2 pi k tau / S)` evaluated at
+//!   `tau = m S/S'` input samples, m = 0..S'-1: exactly the correlation of the block and the
+//!   replica both passed through an ideal low-pass of S' bins (nothing aliases: bins are dropped,
+//!   not folded), or, when padding, the exact correlation interpolated between its samples. So
+//!   a search lag is `S/S'` input samples and the code phase is converted back exactly; the
+//!   forward FFTs still run at S (a handful per search, whatever the factors of S). The search
+//!   then costs about the same at 5, 12, 16.368 or 25 MHz as at 4 MHz (the old per-input-sample
+//!   inverse FFTs took 0.4 to 1.1 s at 12 to 25 MHz, and 16368 = 2^4 3 11 31 ran 4 times slower
+//!   per point than 4096).
 //! - **Code Doppler.** The lags of later blocks are shifted by the code Doppler of the bin
 //!   (code rate 1.023 MHz (1 + f/f_L1)) before the non-coherent sum, so long sums stay on the peak.
 //!
@@ -36,11 +53,18 @@
 //! the estimate is good to a fraction of a percent and the false-alarm rate does not depend on the
 //! input level). A PRN is detected when `metric = peak / floor >= threshold`, where
 //! `threshold * N` is the Gamma(N, 1) quantile for a per-cell probability `pfa / cells`: the union
-//! bound over all cells of the PRN's search (Doppler bins x lags x passes), so `pfa` bounds the
+//! bound over all cells of the PRN's search (Doppler bins x search lags x passes), so `pfa` bounds the
 //! probability that a search of one PRN on noise reports anything. Neighbouring cells share noise,
 //! but this far in the tail their exceedances are nearly independent, so the bound is close to
 //! exact: on 3,200 noise-only PRN searches, 31 passed the threshold for `pfa = 1e-2` and 3 the
-//! one for 1e-3 (receiver/tests/acquisition.rs).
+//! one for 1e-3 (receiver/tests/acquisition.rs). Each cell of the band-limited grid is still a
+//! linear function of Gaussian noise (complex circular, one variance per row), so the model is
+//! unchanged by the search length; what changes is the number of cells and their correlation.
+//! With about 4 search lags per chip at every rate above 4 MHz both are those of a 4 MHz
+//! search, and the bound stays as tight: 1280 noise-only PRN searches at `pfa = 0.05` gave 61
+//! false alarms at 4 MHz, 65 at 12 MHz and 65 at 2.6 MHz (64 expected; `tests.rs`). Searched at
+//! the input rate, 12 MHz had 11.7 correlated lags per chip, 3 times the cells, and a looser
+//! bound (52).
 //!
 //! The floor is estimated per Doppler row: a narrowband interferer or a DC offset correlated
 //! with the periodic code raises a whole row evenly (a tone's correlation with the code has the
@@ -72,7 +96,8 @@
 //!
 //! - Code phase: triangle fit to the noise-subtracted amplitudes at the peak lag and its
 //!   neighbours. Doppler: parabola through the amplitudes of the peak bin and its neighbours.
-//! - Fine Doppler: 1-ms prompt correlations over up to `refine_ms` whole code periods from the
+//! - Fine Doppler: 1-ms prompt correlations (the tracking loops' SIMD block correlator, at the
+//!   input rate) over up to `refine_ms` whole code periods from the
 //!   detected code phase (so data-bit edges fall between prompts); their squares carry no data
 //!   and form a tone at twice the residual Doppler, located by a zero-padded FFT and a parabola.
 //!   Measured on the simulator with 100 prompts: 0.1 Hz rms at 40 dB-Hz, 0.4 Hz at 32 dB-Hz.
@@ -81,7 +106,9 @@
 //! - C/N0: power-minus-noise at the apex of that triangle,
 //!   `C/N0 = (mean |p_k|^2 - sigma_p^2) / (sigma_p^2 * 1 ms)`, with the prompt noise variance
 //!   `sigma_p^2` taken from the grid floor (so it is the noise the correlator sees, whatever the
-//!   front-end filter); without a whole prompt, `(metric - 1) / T` from the grid. It reads 0.1 to
+//!   front-end filter) times, when the grid is band-limited, the ratio of full-band to in-band
+//!   noise of a correlation, from the blocks' power spectrum weighted by the replicas' (about
+//!   1.05 for white noise at 12 MHz); without a whole prompt, `(metric - 1) / T` from the grid. It reads 0.1 to
 //!   0.3 dB low (the signal's own correlation sidelobes raise its row's floor by about 1/1023 of
 //!   its peak power per lag).
 
@@ -178,8 +205,11 @@ pub struct AcqGrid {
     pub prn: Prn,
     /// Doppler of each row, Hz.
     pub doppler_hz: Vec<f64>,
-    /// Code lags per row (one code period of samples).
+    /// Code lags per row: one code period of search lags (one lag = `lag_samples` input
+    /// samples; the input rate itself up to 4096 samples per ms with a fast FFT length).
     pub n_lags: usize,
+    /// Input samples per code lag of the grid (1 when the search runs at the input rate).
+    pub lag_samples: f64,
     /// Blocks summed in each cell.
     pub noncoherent: u32,
     /// Row-major `doppler_hz.len() x n_lags` sums of `|corr|^2`.

@@ -10,6 +10,7 @@
 //! (a triangle fit to their amplitudes), and the C/N0 is taken at the apex of that triangle.
 
 use crate::constants::{CA_CHIP_RATE_HZ, CA_CODE_LENGTH, F_L1_HZ};
+use crate::correlator::{Correlator, PackedCode, ReplicaState, SampleSlice, MAX_TAPS};
 use num_complex::{Complex32, Complex64};
 use rustfft::Fft;
 use std::sync::Arc;
@@ -18,10 +19,15 @@ use std::sync::Arc;
 /// `p_k = sum_n x[n] c(n - offset) exp(-j 2 pi f n / fs)`, one output per `offsets_samples`
 /// entry (0 = prompt; +-d = late/early replicas), with the code rate scaled by the carrier
 /// Doppler (code Doppler = carrier Doppler / 1540). Stops where the samples end.
+///
+/// Each period is one call of the tracking loops' block correlator (`correlator`: SIMD where the
+/// CPU has it, f32 arithmetic, the carrier seeded exactly in f64 at the first sample of every
+/// period and the code from a 2^-32-chip NCO), so the cost per sample is the same at any rate.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn correlate_periods(
     samples: &[Complex32],
-    chips: &[i8; CA_CODE_LENGTH],
+    correlator: &Correlator,
+    code: &PackedCode,
     fs_hz: f64,
     code_phase_samples: f64,
     doppler_hz: f64,
@@ -34,14 +40,14 @@ pub(crate) fn correlate_periods(
     let chips_per_sample = chip_rate / fs_hz;
     let period = CA_CODE_LENGTH as f64 / chips_per_sample;
     let tau = code_phase_samples.rem_euclid(period);
-    let w = -2.0 * std::f64::consts::PI * doppler_hz / fs_hz;
-    let rot = Complex64::from_polar(1.0, w);
-    let len = CA_CODE_LENGTH as f64;
-    let shifts: Vec<f64> = offsets_samples
-        .iter()
-        .map(|o| o * chips_per_sample)
-        .collect();
-    let mut acc = vec![Complex64::new(0.0, 0.0); shifts.len()];
+    let cycles_per_sample = doppler_hz / fs_hz;
+    // A replica delayed by `o` samples reads the chip `o * chips_per_sample` earlier.
+    let mut taps = [0.0f64; MAX_TAPS];
+    let n_taps = offsets_samples.len().min(MAX_TAPS).min(out.len());
+    for (t, o) in taps.iter_mut().zip(offsets_samples) {
+        *t = -o * chips_per_sample;
+    }
+    let mut acc = [Complex32::new(0.0, 0.0); MAX_TAPS];
     for k in 0..k_max {
         let start = tau + k as f64 * period;
         let n0 = start.ceil() as usize;
@@ -49,28 +55,23 @@ pub(crate) fn correlate_periods(
         if n1 > samples.len() {
             break;
         }
-        let mut ph = Complex64::from_polar(1.0, w * n0 as f64);
-        acc.fill(Complex64::new(0.0, 0.0));
-        // Chip phase of sample n0 in [0, chips_per_sample); advanced by addition (the rounding
-        // error over one period is ~1e-12 chip).
-        let mut chip = (n0 as f64 - start) * chips_per_sample;
-        for x in &samples[n0..n1] {
-            let v = Complex64::new(f64::from(x.re), f64::from(x.im)) * ph;
-            for (a, sh) in acc.iter_mut().zip(&shifts) {
-                // chip - sh + 1023 is positive (|sh| < 1023): truncation is floor, and one
-                // subtraction wraps it; no fmod or floor call in the loop.
-                let mut c = (chip - sh + len) as usize;
-                if c >= CA_CODE_LENGTH {
-                    c -= CA_CODE_LENGTH;
-                }
-                let c = chips[c.min(CA_CODE_LENGTH - 1)];
-                *a += v * f64::from(c);
-            }
-            chip += chips_per_sample;
-            ph *= rot;
-        }
-        for (o, a) in out.iter_mut().zip(&acc) {
-            o.push(*a);
+        let state = ReplicaState {
+            code_phase_chips: (n0 as f64 - start) * chips_per_sample,
+            code_rate_chips_s: chip_rate,
+            carrier_phase_cycles: (cycles_per_sample * n0 as f64).rem_euclid(1.0),
+            carrier_freq_hz: doppler_hz,
+            carrier_rate_hz_s: 0.0,
+        };
+        correlator.correlate_packed(
+            SampleSlice::Cf32(&samples[n0..n1]),
+            fs_hz,
+            code,
+            &state,
+            &taps[..n_taps],
+            &mut acc[..n_taps],
+        );
+        for (o, a) in out.iter_mut().zip(&acc[..n_taps]) {
+            o.push(Complex64::new(f64::from(a.re), f64::from(a.im)));
         }
     }
 }

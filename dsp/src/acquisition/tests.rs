@@ -1,6 +1,7 @@
 //! Unit tests of the acquisition engine on synthetic signals.
 
 use super::*;
+use crate::acquisition::stats;
 use crate::constants::{CA_CHIP_RATE_HZ, F_L1_HZ};
 use crate::CaCode;
 use num_complex::{Complex32, Complex64};
@@ -71,10 +72,11 @@ fn engine(fs: f64, cfg: AcqConfig) -> AcquisitionEngine {
 }
 
 /// The FFT grid equals the correlation computed sample by sample (f64), for a whole and a
-/// fractional number of samples per code period.
+/// fractional number of samples per code period, where the search keeps the block spectrum as
+/// it is (its length is already a fast one, at most 4096 per ms).
 #[test]
 fn grid_matches_direct_correlation() {
-    for &(fs, ms) in &[(1.2e6, 2u32), (1.5345e6, 3u32), (1.1e6, 1u32)] {
+    for &(fs, ms) in &[(1.2e6, 2u32), (2.048e6, 3u32), (2.048_000_5e6, 2u32)] {
         let cfg = AcqConfig {
             coherent_ms: ms,
             noncoherent: 1,
@@ -83,6 +85,7 @@ fn grid_matches_direct_correlation() {
             ..AcqConfig::default()
         };
         let e = engine(fs, cfg);
+        assert_eq!(e.layout.inv_len, e.layout.spec_len, "fs {fs}");
         let mut noise = Noise(11);
         let x: Vec<Complex32> = (0..e.samples_needed())
             .map(|_| {
@@ -122,6 +125,135 @@ fn grid_matches_direct_correlation() {
                 "fs {fs} ms {ms} row {row} lag {lag}: fft {got} direct {want}"
             );
         }
+    }
+}
+
+/// Naive DFT (f64), `sign` -1 forward.
+fn dft(x: &[Complex64]) -> Vec<Complex64> {
+    let n = x.len();
+    let tw: Vec<Complex64> = (0..n)
+        .map(|k| Complex64::from_polar(1.0, -2.0 * std::f64::consts::PI * k as f64 / n as f64))
+        .collect();
+    (0..n)
+        .map(|k| {
+            let mut acc = Complex64::new(0.0, 0.0);
+            let mut idx = 0usize;
+            for v in x {
+                acc += v * tw[idx];
+                idx += k;
+                if idx >= n {
+                    idx -= n;
+                }
+            }
+            acc
+        })
+        .collect()
+}
+
+/// Where the block spectrum is resampled (zero-padded to a fast length, or truncated to the
+/// 4096 lowest frequencies per ms), the grid is the band-limited correlation
+/// `corr(tau) = (1/S) sum_{k kept} X[k] conj(C[k]) exp(j 2 pi k tau / S)` (S bins of the
+/// wiped-off block, folded to one period when a period is a whole number of samples; k signed)
+/// at `tau = lag * S / inv_len` input samples, computed here with naive f64 DFTs.
+#[test]
+fn grid_is_the_band_limited_correlation() {
+    // Padded: 1.1 MHz (1100 -> 1120), 2.6 MHz x 2 ms (2600 -> 2688 per period), 1.5345 MHz
+    // x 3 ms (fractional period, 4604 -> 4608). Truncated: 5 MHz (5000 -> 4096), 6 MHz x 2 ms,
+    // 4.3001 MHz (fractional, 4300 -> 4096).
+    for &(fs, ms) in &[
+        (1.1e6, 1u32),
+        (2.6e6, 2),
+        (1.5345e6, 3),
+        (5.0e6, 1),
+        (6.0e6, 2),
+        (4.3001e6, 1),
+    ] {
+        let cfg = AcqConfig {
+            coherent_ms: ms,
+            noncoherent: 1,
+            doppler_max_hz: 1000.0,
+            bit_edge_offsets: Some(false),
+            ..AcqConfig::default()
+        };
+        let e = engine(fs, cfg);
+        let l = e.layout.clone();
+        assert_ne!(l.inv_len, l.spec_len, "fs {fs}");
+        let mut noise = Noise(23);
+        let x: Vec<Complex32> = (0..e.samples_needed())
+            .map(|_| {
+                let v = noise.complex(1.0);
+                Complex32::new(v.re as f32, v.im as f32)
+            })
+            .collect();
+        let g = e
+            .grid(&x, &SearchTarget::full(prn(9)))
+            .unwrap_or_else(|err| panic!("{err}"));
+        let code = CaCode::new(prn(9));
+        let (n, sl) = (l.block_len, l.spec_len);
+        let c: Vec<Complex64> = (0..sl)
+            .map(|k| {
+                let chip = (k as f64 * CA_CHIP_RATE_HZ / fs) as usize;
+                Complex64::new(f64::from(code.chip(chip % 1023)), 0.0)
+            })
+            .collect();
+        let cs = dft(&c);
+        for row in [0, g.doppler_hz.len() - 1] {
+            let f = g.doppler_hz[row];
+            let mut folded = vec![Complex64::new(0.0, 0.0); sl];
+            for (k, v) in x[..n].iter().enumerate() {
+                let ph = -2.0 * std::f64::consts::PI * f * k as f64 / fs;
+                folded[k % sl] += Complex64::new(f64::from(v.re), f64::from(v.im))
+                    * Complex64::from_polar(1.0, ph);
+            }
+            let xs = dft(&folded);
+            for &lag in &[0usize, 1, 333, g.n_lags / 2 + 1, g.n_lags - 1] {
+                let tau = lag as f64 * l.lag_samples;
+                let mut acc = Complex64::new(0.0, 0.0);
+                let kept = (0..l.keep_pos as i64).chain(-(l.keep_neg as i64)..0);
+                for k in kept {
+                    let i = k.rem_euclid(sl as i64) as usize;
+                    let ph = 2.0 * std::f64::consts::PI * k as f64 * tau / sl as f64;
+                    acc += xs[i] * cs[i].conj() * Complex64::from_polar(1.0, ph);
+                }
+                let want = (acc / sl as f64).norm_sqr();
+                let got = f64::from(g.power[row * g.n_lags + lag]);
+                let scale = n as f64;
+                assert!(
+                    (got - want).abs() < 2e-4 * scale + 1e-4 * want,
+                    "fs {fs} ms {ms} row {row} lag {lag}: fft {got} band-limited {want}"
+                );
+            }
+        }
+    }
+}
+
+/// The search length: kept where it is already fast and at most 4096 per ms, padded to the
+/// next fast length below that, 4096 per ms above.
+#[test]
+fn search_lengths() {
+    for &(fs, ms, spec, inv) in &[
+        (4.0e6, 1u32, 4000usize, 4000usize),
+        (4.0e6, 10, 4000, 4000),
+        (2.048e6, 1, 2048, 2048),
+        (2.6e6, 1, 2600, 2688),
+        (1.023e6, 1, 1023, 1024),
+        (5.0e6, 1, 5000, 4096),
+        (12.0e6, 4, 12000, 4096),
+        (16.368e6, 1, 16368, 4096),
+        (25.0e6, 1, 25000, 4096),
+        (12.000_1e6, 2, 24000, 8192),
+    ] {
+        let e = engine(
+            fs,
+            AcqConfig {
+                coherent_ms: ms,
+                ..AcqConfig::default()
+            },
+        );
+        let l = &e.layout;
+        assert_eq!((l.spec_len, l.inv_len), (spec, inv), "fs {fs} ms {ms}");
+        assert_eq!(l.keep_pos + l.keep_neg, spec.min(inv));
+        assert!((l.lag_samples - spec as f64 / inv as f64).abs() < 1e-12);
     }
 }
 
@@ -305,4 +437,124 @@ fn doppler_step_is_never_wider_than_asked() {
     );
     assert!((e.doppler_step_hz() - 125.0).abs() < 1e-9);
     assert_eq!(e.doppler_range_hz(), (-5000.0, 5000.0));
+}
+
+/// Detection, code phase and Doppler against the truth at front-end rates with 2.5 to 23.5
+/// samples per chip (2.6 and 16.368 MHz: whole periods of awkward length; 12 and 24 MHz: searched
+/// in the 4096 lowest bins per ms), from the grid alone (`refine_ms = 0`: code phase to a
+/// quarter chip, one search lag, and Doppler to a quarter bin) and after the refinement (code
+/// phase to 0.02 chip, Doppler to 3 Hz, C/N0 to 0.8 dB).
+#[test]
+fn finds_signals_at_front_end_rates() {
+    for &(fs, seed) in &[
+        (2.6e6, 31u64),
+        (4.0e6, 32),
+        (12.0e6, 33),
+        (16.368e6, 34),
+        (24.0e6, 35),
+    ] {
+        let period = fs * 1e-3;
+        let sigs = [
+            Sig {
+                prn: 6,
+                tau: 0.123 * period + 0.3,
+                doppler_hz: -1730.0,
+                cn0_dbhz: 44.0,
+            },
+            Sig {
+                prn: 29,
+                tau: 0.777 * period,
+                doppler_hz: 3890.0,
+                cn0_dbhz: 41.0,
+            },
+        ];
+        let full = engine(fs, AcqConfig::default());
+        let x = synth(fs, full.samples_wanted(), &sigs, seed);
+        let targets: Vec<SearchTarget> = [6u8, 29, 13]
+            .iter()
+            .map(|&p| SearchTarget::full(prn(p)))
+            .collect();
+        let coarse = engine(
+            fs,
+            AcqConfig {
+                refine_ms: 0,
+                ..AcqConfig::default()
+            },
+        );
+        for (e, refined) in [(&coarse, false), (&full, true)] {
+            let res = e.search(&x, &targets).unwrap_or_else(|err| panic!("{err}"));
+            for (s, r) in sigs.iter().zip(&res) {
+                assert!(r.detected, "fs {fs}: {r:?}");
+                let d = (r.code_phase_samples - s.tau).abs();
+                let chips = d.min(period - d) * CA_CHIP_RATE_HZ / fs;
+                let dop = r.doppler_hz - s.doppler_hz;
+                println!(
+                    "fs {:.3} MHz PRN {} refined {refined}: code error {chips:.4} chip, \
+                     Doppler error {dop:.2} Hz, C/N0 {:?}, metric/threshold {:.1}",
+                    fs * 1e-6,
+                    s.prn,
+                    r.cn0_dbhz,
+                    r.metric / r.threshold
+                );
+                if refined {
+                    assert!(chips < 0.02, "fs {fs}: {chips} chip {r:?}");
+                    assert!(dop.abs() < 3.0, "fs {fs}: {r:?}");
+                    let cn0 = r.cn0_dbhz.unwrap_or(0.0);
+                    assert!((cn0 - s.cn0_dbhz).abs() < 0.8, "fs {fs}: C/N0 {cn0}");
+                } else {
+                    assert!(chips < 0.25, "fs {fs}: {chips} chip {r:?}");
+                    assert!(dop.abs() < 0.25 * e.doppler_step_hz(), "fs {fs}: {r:?}");
+                }
+            }
+            assert!(!res[2].detected, "fs {fs}: PRN 13 absent but {:?}", res[2]);
+        }
+    }
+}
+
+/// False alarms on pure noise at 4 MHz (the spectrum kept as it is), 12 MHz (truncated to the
+/// 4096 lowest bins per ms) and 2.6 MHz (zero-padded from 2600 to 2688 bins): the rate per PRN
+/// search must match the configured pfa, since the threshold is set by the union bound over the
+/// search's cells (Doppler bins x search lags) and the search lags are about 4 per chip at any
+/// rate above 4 MHz (the same cell correlation as at 4 MHz, where the bound is close to exact).
+///
+/// 40 noise records x 32 PRNs = 1280 PRN searches at pfa = 0.05: 64 expected, binomial sd 7.8.
+/// The seeds are fixed, so the counts are too; the tolerance, 0.7 to 1.3 times the expectation
+/// (about 2.5 sd each way), is what the model allows a fresh set of seeds, and a bound that was
+/// loose (the old 12 MHz grid had 3 times the cells, 12 per chip, strongly correlated) or broken
+/// would fall outside it. At pfa = 0.01 (12.8 expected, Poisson sd 3.6) the count must stay
+/// below twice the expectation.
+#[test]
+fn false_alarm_rate_matches_pfa_at_three_rates() {
+    for &fs in &[4.0e6, 12.0e6, 2.6e6] {
+        let cfg = AcqConfig {
+            pfa: 0.05,
+            refine_ms: 0,
+            xcorr_margin_db: None,
+            doppler_max_hz: 1000.0,
+            ..AcqConfig::default()
+        };
+        let e = engine(fs, cfg);
+        let (lo, hi) = e.doppler_range_hz();
+        let rows = ((hi - lo) / e.doppler_step_hz()).round() as usize + 1;
+        let cells = rows * e.layout.n_lags;
+        let t01 = stats::detection_threshold(10, 0.01, cells) / 10.0;
+        let (mut trials, mut alarms, mut over01) = (0usize, 0usize, 0usize);
+        for seed in 0..40u64 {
+            let x = synth(fs, e.samples_needed(), &[], 1000 + seed);
+            for r in e.search_all(&x).unwrap_or_else(|err| panic!("{err}")) {
+                trials += 1;
+                alarms += usize::from(r.detected);
+                over01 += usize::from(r.metric >= t01);
+            }
+        }
+        let (e05, e01) = (0.05 * trials as f64, 0.01 * trials as f64);
+        println!(
+            "fs {:.1} MHz: {alarms} / {trials} PRN searches over the pfa=0.05 threshold \
+             (expected {e05:.0}), {over01} over 0.01 (expected {e01:.1})",
+            fs * 1e-6,
+        );
+        let a = alarms as f64;
+        assert!(a > 0.7 * e05 && a < 1.3 * e05, "fs {fs}: {alarms} vs {e05}");
+        assert!((over01 as f64) < 2.0 * e01, "fs {fs}: {over01} vs {e01}");
+    }
 }
