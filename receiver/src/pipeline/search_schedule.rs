@@ -47,9 +47,9 @@ pub const UNKNOWN_WAIT_S: f64 = 15.0;
 pub const TICK_S: f64 = 0.1;
 /// Modelled CPU time of a search per sample, Doppler bin and pass, s, for 1 ms coherent
 /// blocks, and divided by the coherent milliseconds for longer ones (measured per PRN over
-/// +-5 kHz at 2.6 MHz on the 2-core development machine: 1 ms x 10 2.2 ms, 10 ms x 10 44 ms,
-/// 10 ms x 40 172 ms).
-pub const COST_S_PER_SAMPLE_BIN: f64 = 3.7e-9;
+/// +-5 kHz at 2.6 MHz on the 2-core development machine: 1 ms x 10 1.2 ms, 10 ms x 10 25 ms,
+/// 10 ms x 40 94 ms).
+pub const COST_S_PER_SAMPLE_BIN: f64 = 2.2e-9;
 /// Largest modelled cost of one batch, s (a block waits for its search).
 pub const MAX_BATCH_S: f64 = 0.3;
 
