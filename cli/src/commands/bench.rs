@@ -12,7 +12,10 @@
 //! - the end-to-end real-time factor: the built-in 4 MHz ci8 12-satellite scenario
 //!   (`samples/scenarios/static-seoul-4msps.toml`) simulated into a temporary directory, then
 //!   [`Receiver::run`] (what `gpsrx run` does) timed from file to fixes, with the peak resident
-//!   memory of that run (`VmHWM` after resetting it through `/proc/self/clear_refs`).
+//!   memory of that run (`VmHWM` after resetting it through `/proc/self/clear_refs`);
+//! - the same for a weak-signal case (`samples/scenarios/weak-mix-2p6msps.toml`: 8 satellites
+//!   from 45 down to 28 dB-Hz at 2.6 MHz, 1.5 times the duration), where the background search
+//!   for the weak satellites runs beside the tracking.
 
 use crate::commands::simulate::simulate;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
@@ -40,6 +43,9 @@ pub use crate::cli::BenchArgs;
 /// The end-to-end scenario: 60 s, 4 MHz ci8, 12 satellites over Seoul.
 const SEOUL_SCENARIO_TOML: &str =
     include_str!("../../../samples/scenarios/static-seoul-4msps.toml");
+
+/// The weak-signal end-to-end scenario: 90 s, 2.6 MHz ci8, 8 satellites at 45-28 dB-Hz.
+const WEAK_SCENARIO_TOML: &str = include_str!("../../../samples/scenarios/weak-mix-2p6msps.toml");
 
 /// Sampling rate of the correlator and acquisition measurements, Hz.
 const BENCH_FS_HZ: f64 = 4.0e6;
@@ -138,6 +144,8 @@ pub struct BenchReport {
     pub realtime_factor: Option<f64>,
     /// The end-to-end run in detail.
     pub end_to_end: Option<EndToEnd>,
+    /// The weak-signal end-to-end run (None with --no-end-to-end).
+    pub weak_end_to_end: Option<EndToEnd>,
 }
 
 /// Runs `gpsrx bench`.
@@ -203,12 +211,25 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
             sim.data_path.display(),
             scenario.duration_s
         ));
-        let week = scenario.start_time()?.week;
-        let llh = match scenario.receiver {
-            ReceiverConfig::Static { llh_deg, .. } => llh_deg,
-            _ => None,
-        };
-        let mut e = bench_end_to_end(&sim.data_path, &dir.join("run"), week, llh)?;
+        let mut e = timed_run(&scenario, &sim.data_path, &dir.join("run"))?;
+        e.satellites_simulated = sim.satellites.len();
+        e.simulate_s = simulate_s;
+        Some(e)
+    };
+    let weak_end_to_end = if args.no_end_to_end {
+        None
+    } else {
+        let mut weak = Scenario::from_toml(WEAK_SCENARIO_TOML)?;
+        weak.duration_s = 1.5 * duration;
+        let weak_dir = dir.join("weak");
+        log(&format!(
+            "simulating and running the weak-signal case ({:.1} s, {})...",
+            weak.duration_s, weak.description
+        ));
+        let t = Instant::now();
+        let sim = simulate(&weak, Path::new(""), &weak_dir, false)?;
+        let simulate_s = t.elapsed().as_secs_f64();
+        let mut e = timed_run(&weak, &sim.data_path, &weak_dir.join("run"))?;
         e.satellites_simulated = sim.satellites.len();
         e.simulate_s = simulate_s;
         Some(e)
@@ -222,6 +243,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
         acquisition,
         realtime_factor: end_to_end.as_ref().map(|e| e.realtime_factor),
         end_to_end,
+        weak_end_to_end,
     })
 }
 
@@ -412,6 +434,17 @@ fn bench_acquisition(file: &Path, runs: usize) -> anyhow::Result<AcquisitionBenc
     })
 }
 
+/// [`bench_end_to_end`] on the recording `file` of `scenario` (its week and, when static,
+/// its antenna position as the truth).
+fn timed_run(scenario: &Scenario, file: &Path, out: &Path) -> anyhow::Result<EndToEnd> {
+    let week = scenario.start_time()?.week;
+    let llh = match scenario.receiver {
+        ReceiverConfig::Static { llh_deg, .. } => llh_deg,
+        _ => None,
+    };
+    bench_end_to_end(file, out, week, llh)
+}
+
 /// Times the receiver ([`Receiver::run`], what `gpsrx run` does) on `file`.
 fn bench_end_to_end(
     file: &Path,
@@ -537,43 +570,53 @@ fn print_report(out: &mut dyn Write, r: &BenchReport) -> std::io::Result<()> {
         a.runs,
         a.detected
     )?;
-    if let Some(e) = &r.end_to_end {
-        writeln!(out)?;
-        writeln!(
-            out,
-            "end to end: {:.1} s of {} at {:.0} MHz, {} satellites simulated ({:.1} s to simulate)",
-            e.duration_s,
-            e.format,
-            e.fs_hz / 1e6,
-            e.satellites_simulated,
-            e.simulate_s
-        )?;
-        writeln!(
-            out,
-            "  file to fixes in {:.2} s: {:.1}x real time; {} satellites tracked, {} fixes{}",
-            e.wall_s,
-            e.realtime_factor,
-            e.satellites_tracked,
-            e.fixes,
-            e.mean_horizontal_error_m.map_or(String::new(), |h| format!(
-                ", mean fix {h:.2} m from the antenna (horizontal)"
-            ))
-        )?;
-        match e.peak_rss_mb {
-            Some(m) => writeln!(
-                out,
-                "  peak resident memory {m:.1} MB{}",
-                if e.peak_rss_reset {
-                    ""
-                } else {
-                    " (could not reset the peak: includes the simulation)"
-                }
-            )?,
-            None => writeln!(
-                out,
-                "  peak resident memory: unknown (no /proc/self/status)"
-            )?,
+    for (name, e) in [
+        ("end to end", &r.end_to_end),
+        ("weak signals", &r.weak_end_to_end),
+    ] {
+        if let Some(e) = e {
+            print_end_to_end(out, name, e)?;
         }
     }
     Ok(())
+}
+
+/// One end-to-end run's lines of the report.
+fn print_end_to_end(out: &mut dyn Write, name: &str, e: &EndToEnd) -> std::io::Result<()> {
+    writeln!(out)?;
+    writeln!(
+        out,
+        "{name}: {:.1} s of {} at {:.1} MHz, {} satellites simulated ({:.1} s to simulate)",
+        e.duration_s,
+        e.format,
+        e.fs_hz / 1e6,
+        e.satellites_simulated,
+        e.simulate_s
+    )?;
+    writeln!(
+        out,
+        "  file to fixes in {:.2} s: {:.1}x real time; {} satellites tracked, {} fixes{}",
+        e.wall_s,
+        e.realtime_factor,
+        e.satellites_tracked,
+        e.fixes,
+        e.mean_horizontal_error_m.map_or(String::new(), |h| format!(
+            ", mean fix {h:.2} m from the antenna (horizontal)"
+        ))
+    )?;
+    match e.peak_rss_mb {
+        Some(m) => writeln!(
+            out,
+            "  peak resident memory {m:.1} MB{}",
+            if e.peak_rss_reset {
+                ""
+            } else {
+                " (could not reset the peak: includes the simulation)"
+            }
+        ),
+        None => writeln!(
+            out,
+            "  peak resident memory: unknown (no /proc/self/status)"
+        ),
+    }
 }
