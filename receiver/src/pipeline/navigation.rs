@@ -11,12 +11,14 @@ use crate::landmarks::LandmarkObservation;
 use crate::output::{ChannelRow, FixQuality};
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::channel_manager::Realigned;
+use crate::pipeline::coarse_fix::{CoarseFixer, CoarseRefusal};
 use crate::pipeline::code_jump::{Collapse, CollapseMonitor};
 use crate::pipeline::discontinuity::{Discontinuity, DiscontinuityMonitor};
 pub use crate::pipeline::fix_output::FixStats;
 use crate::pipeline::fix_output::{fix_of, obs_epoch, passes_integrity};
 use crate::pipeline::navdata::{NavDecoder, NavEvent};
 use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
+use crate::pipeline::quick_sync::{QuickSync, TowCandidate};
 use crate::pipeline::sink::{
     FixReport, NavigationEnd, ObservablesReport, Progress, ReceiverEvent, Sink, SinkError,
 };
@@ -72,6 +74,13 @@ pub struct NavigationProcessor {
     failed_in_row: u32,
     /// A valid fix came since the receiver time was last forgotten.
     time_trusted: bool,
+    /// The coarse-time first fix (approximate time and position given).
+    coarse: Option<CoarseFixer>,
+    /// A refused coarse-time attempt was logged at WARN.
+    coarse_warned: bool,
+    /// Frame sync from one TLM and HOW confirmed across satellites (with ephemerides from a
+    /// navigation file, a fix can follow at once).
+    quick: Option<QuickSync>,
 }
 
 /// Time the code loops of channels that kept their satellites over lost samples need before
@@ -114,6 +123,7 @@ impl NavigationProcessor {
     ) -> Self {
         let builder =
             ObservableBuilder::new(fs_hz, settings.rate_hz).with_min_cn0_dbhz(cn0_lost_dbhz);
+        let nav_assist_given = nav_assist.is_some();
         Self {
             fs_hz,
             settings,
@@ -139,7 +149,41 @@ impl NavigationProcessor {
             last_clock: None,
             failed_in_row: 0,
             time_trusted: false,
+            coarse: None,
+            coarse_warned: false,
+            quick: nav_assist_given.then(QuickSync::default),
         }
+    }
+
+    /// Enables the coarse-time first fix ([`crate::pipeline::coarse_fix`]) when the settings
+    /// hold an approximate position, `start` (the approximate GPS time of sample 0: `--time`,
+    /// else the recording's date) is known and a navigation file gives the ephemerides;
+    /// says why not when the position is given without the rest.
+    pub fn with_coarse_time(mut self, start: Option<gpsrx_nav::time::GpsTime>) -> Self {
+        let Some([lat, lon, h]) = self.settings.approx_llh else {
+            return self;
+        };
+        match (start, &self.nav_assist) {
+            (Some(t), Some(_)) => {
+                tracing::info!(
+                    "coarse time: approximate start {}:{:.1}, position {lat:.4} {lon:.4} {h:.0} m: the first fix comes from the code phases once 5-6 satellites are tracked",
+                    t.week,
+                    t.tow_s
+                );
+                self.coarse = Some(CoarseFixer::new(
+                    self.fs_hz,
+                    t,
+                    gpsrx_nav::frames::Llh::from_degrees(lat, lon, h),
+                ));
+            }
+            (None, _) => tracing::warn!(
+                "--approx-llh without an approximate time (--time WEEK:TOW, or a SigMF core:datetime): no coarse-time fix; the first fix waits for frame sync"
+            ),
+            (_, None) => tracing::warn!(
+                "--approx-llh needs the ephemerides of --nav for a coarse-time fix: the first fix waits for frame sync"
+            ),
+        }
+        self
     }
 
     /// After every channel has reported up to sample `end`: looks for lost samples. On a
@@ -303,6 +347,7 @@ impl NavigationProcessor {
             }
             None => {}
         }
+        self.coarse_step(e, sink)?;
         self.channel_row(channel, e, sink)?;
         self.realign_clock(e, sink)?;
         let ready = match self.decoders.get(&e.prn) {
@@ -341,13 +386,47 @@ impl NavigationProcessor {
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
         let week = self.reference_week;
-        let dec = self
-            .decoders
-            .entry(e.prn)
-            .or_insert_with(|| NavDecoder::new(e.prn, week));
+        let quick = self.quick.is_some();
+        let dec = self.decoders.entry(e.prn).or_insert_with(|| {
+            let mut d = NavDecoder::new(e.prn, week);
+            d.report_tow_candidates(quick);
+            d
+        });
+        let mut coarse_wrong = None;
+        let mut candidate = None;
         if let (Some(b), Some(ms)) = (e.bit, e.bit_start_ms) {
+            let coarse_given = self
+                .coarse
+                .as_ref()
+                .is_some_and(|c| c.given.contains(&e.prn));
+            let mut mismatch = false;
             for ev in dec.push_bit(b.value, ms) {
                 match ev {
+                    NavEvent::TowCandidate { first_ms, tow_s } => {
+                        candidate = Some(TowCandidate::new(e, first_ms, tow_s));
+                    }
+                    NavEvent::Subframe { tow_s, .. } if coarse_given && !mismatch => {
+                        tracing::info!(
+                            "G{:02}: its first HOW (TOW {tow_s} s) confirms the SV time of the coarse-time fix",
+                            e.prn
+                        );
+                        if let Some(c) = self.coarse.as_mut() {
+                            c.given.remove(&e.prn);
+                        }
+                    }
+                    NavEvent::TowMismatch { error_ms } if coarse_given => {
+                        mismatch = true;
+                        coarse_wrong = Some(format!(
+                            "the HOW of G{:02} differs from its SV time by {error_ms:.3} ms",
+                            e.prn
+                        ));
+                    }
+                    NavEvent::BitEdgeMismatch { offset_ms } if coarse_given => {
+                        coarse_wrong = Some(format!(
+                            "the first bit edge of G{:02} falls {offset_ms:+.3} ms off a 20 ms boundary of its SV time",
+                            e.prn
+                        ));
+                    }
                     NavEvent::FrameSync { tow_s } => {
                         tracing::info!("G{:02}: frame sync, TOW {tow_s} s", e.prn);
                         sink.event(&ReceiverEvent::FrameSync {
@@ -398,7 +477,142 @@ impl NavigationProcessor {
                 t_s: e.t_rx_s,
             })?;
         }
+        if let Some(why) = coarse_wrong {
+            self.drop_coarse_times(e.t_rx_s, &why, sink)?;
+        }
+        if let Some(c) = candidate {
+            self.on_tow_candidate(c, sink)?;
+        }
         Ok(())
+    }
+
+    /// A TLM and HOW found while unsynchronised: frame sync on it (and on the waiting
+    /// candidates it agrees with) once another satellite confirms its time
+    /// ([`crate::pipeline::quick_sync`]).
+    fn on_tow_candidate(&mut self, c: TowCandidate, sink: &mut dyn Sink) -> Result<(), SinkError> {
+        let known: Vec<(u8, u64, f64)> = self
+            .decoders
+            .iter()
+            .filter(|(_, d)| d.synced() && !d.time_carried())
+            .filter_map(|(&p, _)| self.sv_time.last_known(p).map(|(k, sv)| (p, k, sv)))
+            .collect();
+        let Some(quick) = self.quick.as_mut() else {
+            return Ok(());
+        };
+        let confirmed = quick.offer(c, &known, self.fs_hz);
+        let by: Vec<String> = confirmed.iter().map(|c| format!("G{:02}", c.prn)).collect();
+        for c in &confirmed {
+            let synced = self
+                .decoders
+                .get_mut(&c.prn)
+                .is_some_and(|d| d.sync_at(c.first_ms, c.tow_s));
+            if synced {
+                tracing::info!(
+                    "G{:02}: frame sync, TOW {} s (TLM and HOW; times agree: {})",
+                    c.prn,
+                    c.tow_s,
+                    if by.len() > 1 {
+                        by.join(" ")
+                    } else {
+                        "with the satellites synchronised".to_string()
+                    }
+                );
+                sink.event(&ReceiverEvent::FrameSync {
+                    prn: c.prn,
+                    tow_s: f64::from(c.tow_s),
+                })?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Feeds the report to the coarse-time fix while no satellite's time is known, and hands
+    /// its SV times to the decoders once it succeeds.
+    fn coarse_step(&mut self, e: &ChannelEpoch, sink: &mut dyn Sink) -> Result<(), SinkError> {
+        if self.coarse.as_ref().is_none_or(|c| c.done) {
+            return Ok(());
+        }
+        if self.decoders.values().any(NavDecoder::synced) {
+            tracing::debug!("coarse time: a satellite's time is known already, no coarse-time fix");
+            if let Some(c) = self.coarse.as_mut() {
+                c.done = true;
+            }
+            return Ok(());
+        }
+        let opts = self.pvt_options();
+        let (Some(cf), Some(nav)) = (self.coarse.as_mut(), self.nav_assist.as_ref()) else {
+            return Ok(());
+        };
+        cf.observe(e);
+        let policy = if self.settings.allow_unhealthy {
+            gpsrx_nav::ephemeris::HealthPolicy::PreferHealthy
+        } else {
+            gpsrx_nav::ephemeris::HealthPolicy::HealthyOnly
+        };
+        let ephemeris = |prn: u8, t| nav.select_with(prn, t, policy).cloned();
+        match cf.attempt(&ephemeris, &opts) {
+            Ok(out) => {
+                for t in &out.sv_times {
+                    if let Some(d) = self.decoders.get_mut(&t.prn) {
+                        d.carry_time(t.ms_count, t.sv_tow_s);
+                    }
+                }
+                tracing::info!(
+                    "coarse-time fix at {:.2} s: {} satellites, time corrected by {:+.3} s, {:.1} km from the approximate position ({}): SV times set, fixes follow",
+                    out.t_s,
+                    out.sv_times.len(),
+                    out.time_correction_s,
+                    out.position_shift_m * 1e-3,
+                    out.check
+                );
+                sink.event(&ReceiverEvent::CoarseTime {
+                    t_s: out.t_s,
+                    satellites: out.sv_times.len(),
+                    time_correction_s: out.time_correction_s,
+                })?;
+            }
+            Err(CoarseRefusal::Waiting) => {}
+            Err(CoarseRefusal::Refused(why)) => {
+                if self.coarse_warned {
+                    tracing::debug!("{:.2} s: no coarse-time fix: {why}", e.t_rx_s);
+                } else {
+                    tracing::warn!(
+                        "{:.2} s: no coarse-time fix: {why}; trying again as satellites come, else the first fix waits for frame sync",
+                        e.t_rx_s
+                    );
+                    self.coarse_warned = true;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The SV times of the coarse-time fix disagree with the signal (`why`): every one not yet
+    /// confirmed by a HOW is dropped (frame sync gives the time).
+    fn drop_coarse_times(
+        &mut self,
+        t_s: f64,
+        why: &str,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        let Some(c) = self.coarse.as_mut() else {
+            return Ok(());
+        };
+        let given = std::mem::take(&mut c.given);
+        tracing::warn!(
+            "{t_s:.2} s: {why}: the SV times of the coarse-time fix are dropped, waiting for frame sync"
+        );
+        for p in given {
+            if let Some(d) = self.decoders.get_mut(&p) {
+                if d.time_carried() {
+                    d.reset_sync();
+                }
+            }
+            self.sv_time.make_rough(Some(p));
+        }
+        self.builder.restart();
+        self.prior = None;
+        sink.event(&ReceiverEvent::CoarseTimeDropped { t_s })
     }
 
     /// After lost samples: every SV time is dropped (the decoders find frame sync again and the
@@ -500,6 +714,9 @@ impl NavigationProcessor {
             .collect();
         if carried.is_empty() {
             return;
+        }
+        if let Some(c) = self.coarse.as_mut() {
+            c.given.clear();
         }
         tracing::warn!(
             "{t_s:.2} s: the solutions fail the integrity test with the SV times carried over the outage (samples lost during it?): those of {} satellites dropped, waiting for frame sync",
@@ -633,6 +850,17 @@ impl NavigationProcessor {
         Some(known.unwrap_or(KlobucharParams::FALLBACK))
     }
 
+    /// The PVT options of the settings, with the ionosphere parameters known now.
+    fn pvt_options(&mut self) -> PvtOptions {
+        PvtOptions {
+            tropo: self.settings.tropo == TropoModel::Saastamoinen,
+            elevation_mask_deg: self.settings.elevation_mask_deg,
+            raim_pfa: self.settings.raim_pfa,
+            iono: self.iono(),
+            ..PvtOptions::default()
+        }
+    }
+
     /// The ephemeris for each satellite of the epoch: decoded, else from the navigation file.
     fn ephemerides(&self, epoch: &ObservableEpoch) -> Vec<(u8, Ephemeris)> {
         epoch
@@ -672,13 +900,7 @@ impl NavigationProcessor {
                 })
             })
             .collect();
-        let opts = PvtOptions {
-            tropo: self.settings.tropo == TropoModel::Saastamoinen,
-            elevation_mask_deg: self.settings.elevation_mask_deg,
-            raim_pfa: self.settings.raim_pfa,
-            iono: self.iono(),
-            ..PvtOptions::default()
-        };
+        let opts = self.pvt_options();
         // Landmark observations of this epoch (receiver time within half an interval; the clock
         // bias is kept below 0.5 ms, far less than that).
         let landmarks: Vec<Landmark> = self
