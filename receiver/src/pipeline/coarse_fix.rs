@@ -249,12 +249,8 @@ impl CoarseFixer {
             CoarseIntegrity::Unverified if edges.len() == n => {
                 format!("{n} satellites (no redundancy), all {n} bit edges agree")
             }
-            _ => {
-                return Err(CoarseRefusal::Refused(format!(
-                    "{n} satellites without redundancy and only {} with bit edges: waiting for another satellite",
-                    edges.len()
-                )))
-            }
+            // Five satellites without all their bit edges: wait for them, or a sixth.
+            _ => return Err(CoarseRefusal::Waiting),
         };
         if edges.len() < MIN_BIT_EDGES.min(n) {
             return Err(CoarseRefusal::Waiting);

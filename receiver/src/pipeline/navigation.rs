@@ -78,6 +78,9 @@ pub struct NavigationProcessor {
     coarse: Option<CoarseFixer>,
     /// A refused coarse-time attempt was logged at WARN.
     coarse_warned: bool,
+    /// No fix from epochs before this sample: the channels reported before the coarse-time
+    /// fix handed out the SV times give nothing to them.
+    fixes_from_sample: f64,
     /// Frame sync from one TLM and HOW confirmed across satellites (with ephemerides from a
     /// navigation file, a fix can follow at once).
     quick: Option<QuickSync>,
@@ -151,6 +154,7 @@ impl NavigationProcessor {
             time_trusted: false,
             coarse: None,
             coarse_warned: false,
+            fixes_from_sample: 0.0,
             quick: nav_assist_given.then(QuickSync::default),
         }
     }
@@ -493,7 +497,7 @@ impl NavigationProcessor {
         let known: Vec<(u8, u64, f64)> = self
             .decoders
             .iter()
-            .filter(|(_, d)| d.synced() && !d.time_carried())
+            .filter(|(_, d)| d.synced())
             .filter_map(|(&p, _)| self.sv_time.last_known(p).map(|(k, sv)| (p, k, sv)))
             .collect();
         let Some(quick) = self.quick.as_mut() else {
@@ -557,6 +561,8 @@ impl NavigationProcessor {
                         d.carry_time(t.ms_count, t.sv_tow_s);
                     }
                 }
+                // A report covers up to 20 ms: later epochs have every channel's observables.
+                self.fixes_from_sample = (out.t_s + 0.025) * self.fs_hz;
                 tracing::info!(
                     "coarse-time fix at {:.2} s: {} satellites, time corrected by {:+.3} s, {:.1} km from the approximate position ({}): SV times set, fixes follow",
                     out.t_s,
@@ -968,6 +974,9 @@ impl NavigationProcessor {
         aiding: Option<&InsFeedForward>,
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
+        if epoch.sample < self.fixes_from_sample {
+            return Ok(());
+        }
         let ephs = self.ephemerides(&epoch);
         let solution = self.solution(&epoch, &ephs);
         let valid = solution.as_ref().is_some_and(passes_integrity);
