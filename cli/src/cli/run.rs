@@ -58,7 +58,8 @@ pub struct RunArgs {
     /// Approximate GPS time of the first sample, `WEEK:TOW` (full week 1024-4096, time of week
     /// 0-604800 s; within a minute), e.g. `2190:538200`. With --approx-llh and --nav the first
     /// fix comes from the code phases alone, about a second after the start, instead of after
-    /// frame sync (6-12 s) [default: the SigMF core:datetime of the recording].
+    /// the first decoded time of week (1.2-7.2 s) [default: the SigMF core:datetime of the
+    /// recording].
     #[arg(long = "time", value_name = "WEEK:TOW", value_parser = parse_week_tow)]
     pub approx_time: Option<gpsrx_nav::time::GpsTime>,
     /// Approximate position `LAT,LON,H` (degrees, degrees, metres above the ellipsoid; within
