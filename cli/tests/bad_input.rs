@@ -307,6 +307,14 @@ fn out_of_range_settings_are_refused_with_the_key_and_range() {
             "[run]\nweek = 99999\n",
             "GPS week 99999 (--week, [run] week): give the full week number, 1024 to 4096",
         ),
+        (
+            "[run]\napprox_llh = [37.5, 200.0, 40.0]\n",
+            "approximate longitude 200 deg (--approx-llh LAT,LON,H, [run] approx_llh): use -180 to 180 deg",
+        ),
+        (
+            "[run]\napprox_time = { week = 2190, tow_s = 700000.0 }\n",
+            "approximate time of week 700000 s (--time WEEK:TOW, [run] approx_time): use 0 to 604800 s",
+        ),
     ];
     for (toml, message) in cases {
         let config = dir.path().join("gpsrx.toml");
@@ -443,4 +451,64 @@ rate_hz = 1.0
     for p in &report.receiver.dropped_prns {
         assert!(seen.contains(p), "G{p:02} has no channel row");
     }
+}
+
+#[test]
+fn bad_approximate_time_and_position_are_usage_errors_with_status_2() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let data = noise_cf32(dir.path());
+    let out = dir.path().join("out");
+    let source = [
+        "run",
+        s(&data),
+        "--format",
+        "cf32_le",
+        "--fs",
+        "2.048e6",
+        "--out",
+        s(&out),
+    ];
+    let cases: [(&[&str], &str); 7] = [
+        (
+            &["--time", "2190"],
+            "give the full GPS week and the time of week in seconds as WEEK:TOW",
+        ),
+        (&["--time", "2190:abc"], "as WEEK:TOW, e.g. 2190:538200"),
+        (
+            &["--time", "190:538200"],
+            "give the full GPS week, 1024 to 4096",
+        ),
+        (&["--time", "2190:604800"], "use 0 to 604800 s"),
+        (
+            &["--approx-llh", "37.5,127"],
+            "as LAT,LON,H, e.g. 37.57,126.98,40",
+        ),
+        (
+            &["--approx-llh", "-91,127,40"],
+            "approximate latitude -91 deg",
+        ),
+        (
+            &["--approx-llh", "37.5,127,1e6"],
+            "approximate height 1000000 m",
+        ),
+    ];
+    for (args, message) in cases {
+        let o = output(&[&source[..], args].concat());
+        let err = expect(&o, 2, &args.join(" "));
+        assert!(
+            err.contains(message),
+            "{args:?}: want `{message}` in\n{err}"
+        );
+    }
+    // Good values pass the parser (the run then ends without a fix: status 2 too, but with
+    // the summary on standard output).
+    let o = output(
+        &[
+            &source[..],
+            &["--time", "2190:538200.5", "--approx-llh", "-33.9,18.4,10"],
+        ]
+        .concat(),
+    );
+    let err = expect(&o, 2, "good values");
+    assert!(!err.contains("error: invalid value"), "{err}");
 }

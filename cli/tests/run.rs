@@ -108,11 +108,11 @@ fn static_receiver_fixes_within_a_metre() {
         &["--nav", nav_file().to_str().unwrap_or_default()],
     );
     // With the ephemerides given, the first fix comes within 1 s of the first decoded TOW: the
-    // subframe starting at 2.07 s (the recording starts 2 s before a subframe boundary) ends at
-    // 8.07 s and is confirmed by the next preamble 160 ms later.
+    // TLM and HOW of the subframe starting at 2.07 s (the recording starts 2 s before a
+    // subframe boundary) end at 3.27 s, confirmed by a second satellite's.
     let first = fixes.first().unwrap_or_else(|| panic!("no fix"));
     let t_first = first.time.tow_s - 538198.0;
-    assert!(t_first < 8.23 + 1.0, "first fix at {t_first:.2} s");
+    assert!(t_first < 3.27 + 1.0, "first fix at {t_first:.2} s");
     let (h, v, vel) = errors(&fixes, &truth(dir.path()));
     eprintln!(
         "static: {} fixes, H RMS {h:.2} m, V RMS {v:.2} m, velocity RMS {vel:.3} m/s",
@@ -450,4 +450,89 @@ almanac = true
     );
     assert!((field("Mean Anom") - want.m0_rad).abs() < 1e-6, "{block}");
     assert_eq!(field("week"), f64::from(2190 % 1024));
+}
+
+/// Valid fixes (quality not `none`) from `t_from_s` to `t_to_s` seconds after the start of a
+/// [`simulate`]d recording (TOW 538198).
+fn fixes_between(fixes: &[Fix], t_from_s: f64, t_to_s: f64) -> Vec<Fix> {
+    fixes
+        .iter()
+        .filter(|f| f.quality != gpsrx_receiver::output::FixQuality::None)
+        .filter(|f| (t_from_s..t_to_s).contains(&(f.time.tow_s - 538198.0)))
+        .cloned()
+        .collect()
+}
+
+/// 3D RMS error of `fixes` against the truth, m.
+fn rms_3d(fixes: &[Fix], truth: &[(f64, [f64; 3], [f64; 3])]) -> f64 {
+    let (h, v, _) = errors(fixes, truth);
+    h.hypot(v)
+}
+
+#[test]
+fn an_approximate_time_and_position_give_the_first_fix_within_two_seconds() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let data = simulate(STATIC_BUSAN, 8.0, dir.path());
+    let truth = truth(dir.path());
+    let nav = nav_file();
+    let nav = nav.to_str().unwrap_or_default();
+    let run_with = |name: &str, extra: &[&str]| {
+        let mut args = vec!["--nav", nav];
+        args.extend_from_slice(extra);
+        let fixes = run(&data, &dir.path().join(name), &args);
+        let valid = fixes_between(&fixes, 0.0, 100.0);
+        let first = valid
+            .first()
+            .map_or(f64::INFINITY, |f| f.time.tow_s - 538198.0);
+        let early = fixes_between(&fixes, first, first + 2.0);
+        let worst = valid
+            .iter()
+            .map(|f| rms_3d(std::slice::from_ref(f), &truth))
+            .fold(0.0, f64::max);
+        let rms = rms_3d(&early, &truth);
+        eprintln!(
+            "{name}: first fix {first:.2} s, first 2 s of fixes 3D RMS {rms:.2} m, all {:.2} m, worst {worst:.2} m, {} fixes",
+            rms_3d(&valid, &truth),
+            valid.len()
+        );
+        (first, rms, worst, rms_3d(&valid, &truth))
+    };
+    // The normal path: frame sync from the first TLM and HOW (the subframe starting at 2 s),
+    // confirmed across satellites.
+    let (first_nav, _, _, rms_nav) = run_with("nav", &[]);
+    assert!(
+        first_nav < 3.2 + 0.5,
+        "--nav alone: first fix at {first_nav:.2} s"
+    );
+    // Coarse time from the SigMF core:datetime (the simulator writes it) and the position 1 km
+    // off; and from --time 25 s off, which overrides the recording's date.
+    let llh = "35.185,129.085,0";
+    for (name, extra) in [
+        ("sigmf", vec!["--approx-llh", llh]),
+        ("time", vec!["--approx-llh", llh, "--time", "2190:538223"]),
+    ] {
+        let (first, rms, worst, _) = run_with(name, &extra);
+        assert!(first <= 2.0, "{name}: first fix at {first:.2} s");
+        assert!(
+            rms <= 2.0 * rms_nav,
+            "{name}: the first 2 s of fixes {rms:.2} m against {rms_nav:.2} m of the normal path"
+        );
+        assert!(worst < 10.0, "{name}: a fix {worst:.2} m off");
+    }
+    // Wrong a-priori values give no fix from the code phases (and no wrong fix): the first
+    // fix waits for frame sync.
+    for (name, extra) in [
+        ("500 km off", vec!["--approx-llh", "39.68,129.08,20"]),
+        (
+            "10 min off",
+            vec!["--approx-llh", llh, "--time", "2190:538798"],
+        ),
+    ] {
+        let (first, _, worst, _) = run_with(name, &extra);
+        assert!(
+            (3.2..3.2 + 0.5).contains(&first),
+            "{name}: first fix at {first:.2} s"
+        );
+        assert!(worst < 10.0, "{name}: a fix {worst:.2} m off");
+    }
 }

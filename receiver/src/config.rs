@@ -67,6 +67,13 @@ pub struct RunSettings {
     pub week: Option<u32>,
     /// PRNs to search for (empty: all 32).
     pub prns: Vec<u8>,
+    /// Approximate GPS time of the recording's first sample (`--time WEEK:TOW`; default: the
+    /// SigMF `core:datetime`), within a minute: with [`RunSettings::approx_llh`] and `--nav`,
+    /// the first fix comes from the code phases alone ([`crate::pipeline::coarse_fix`]).
+    pub approx_time: Option<gpsrx_nav::time::GpsTime>,
+    /// Approximate position, `[latitude deg, longitude deg, height m]` (WGS-84), within
+    /// 100 km (`--approx-llh LAT,LON,H`).
+    pub approx_llh: Option<[f64; 3]>,
 }
 
 impl Default for RunSettings {
@@ -86,6 +93,8 @@ impl Default for RunSettings {
             allow_unhealthy: false,
             week: None,
             prns: Vec::new(),
+            approx_time: None,
+            approx_llh: None,
         }
     }
 }
@@ -303,6 +312,12 @@ impl RunSettings {
         if let Some(p) = self.prns.iter().find(|p| !(1..=32).contains(*p)) {
             return bad(format!("PRN {p}: GPS PRNs are 1 to 32"));
         }
+        if let Some(t) = self.approx_time {
+            check_approx_time(&t).map_err(ConfigError::Invalid)?;
+        }
+        if let Some(llh) = self.approx_llh {
+            check_approx_llh(&llh).map_err(ConfigError::Invalid)?;
+        }
         if let Some(w) = self.week {
             let (lo, hi) = WEEK_RANGE;
             if !(lo..=hi).contains(&w) {
@@ -313,4 +328,50 @@ impl RunSettings {
         }
         Ok(())
     }
+}
+
+/// Valid heights of an approximate position, m (the coarse-time solution wants a position near
+/// the Earth's surface).
+pub const APPROX_HEIGHT_RANGE_M: (f64, f64) = (-1000.0, 100_000.0);
+
+/// Checks an approximate time (`--time`, `[run] approx_time`): a full week in [`WEEK_RANGE`]
+/// and a time of week in [0, 604800) s.
+pub fn check_approx_time(t: &gpsrx_nav::time::GpsTime) -> Result<(), String> {
+    let (lo, hi) = WEEK_RANGE;
+    if !(lo..=hi).contains(&t.week) {
+        return Err(format!(
+            "approximate time week {} (--time WEEK:TOW, [run] approx_time): give the full GPS week, {lo} to {hi} (e.g. 2190:538200)",
+            t.week
+        ));
+    }
+    if !(t.tow_s.is_finite() && (0.0..604_800.0).contains(&t.tow_s)) {
+        return Err(format!(
+            "approximate time of week {} s (--time WEEK:TOW, [run] approx_time): use 0 to 604800 s",
+            t.tow_s
+        ));
+    }
+    Ok(())
+}
+
+/// Checks an approximate position (`--approx-llh`, `[run] approx_llh`): latitude within
+/// +-90 deg, longitude within +-180 deg, height in [`APPROX_HEIGHT_RANGE_M`].
+pub fn check_approx_llh(llh: &[f64; 3]) -> Result<(), String> {
+    let [lat, lon, h] = *llh;
+    let (hlo, hhi) = APPROX_HEIGHT_RANGE_M;
+    if !(lat.is_finite() && lat.abs() <= 90.0) {
+        return Err(format!(
+            "approximate latitude {lat} deg (--approx-llh LAT,LON,H, [run] approx_llh): use -90 to 90 deg"
+        ));
+    }
+    if !(lon.is_finite() && lon.abs() <= 180.0) {
+        return Err(format!(
+            "approximate longitude {lon} deg (--approx-llh LAT,LON,H, [run] approx_llh): use -180 to 180 deg"
+        ));
+    }
+    if !(h.is_finite() && (hlo..=hhi).contains(&h)) {
+        return Err(format!(
+            "approximate height {h} m (--approx-llh LAT,LON,H, [run] approx_llh): use {hlo} to {hhi} m above the ellipsoid"
+        ));
+    }
+    Ok(())
 }

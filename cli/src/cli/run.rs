@@ -55,6 +55,19 @@ pub struct RunArgs {
     /// navigation file; else unknown, and no output is dated until subframe 1 is decoded).
     #[arg(long, value_name = "WEEK")]
     pub week: Option<u32>,
+    /// Approximate GPS time of the first sample, `WEEK:TOW` (full week 1024-4096, time of week
+    /// 0-604800 s; within a minute), e.g. `2190:538200`. With --approx-llh and --nav the first
+    /// fix comes from the code phases alone, about a second after the start, instead of after
+    /// the first decoded time of week (1.2-7.2 s) [default: the SigMF core:datetime of the
+    /// recording].
+    #[arg(long = "time", value_name = "WEEK:TOW", value_parser = parse_week_tow)]
+    pub approx_time: Option<gpsrx_nav::time::GpsTime>,
+    /// Approximate position `LAT,LON,H` (degrees, degrees, metres above the ellipsoid; within
+    /// 100 km), e.g. `37.57,126.98,40`: with --nav and a time (--time or the SigMF
+    /// core:datetime) the first fix comes from the code phases alone (coarse time). A wrong
+    /// one gives no wrong fix: the first fix then waits for frame sync.
+    #[arg(long, value_name = "LAT,LON,H", value_parser = parse_llh, allow_hyphen_values = true)]
+    pub approx_llh: Option<[f64; 3]>,
     /// Doppler search half-width of the acquisition, Hz [default: 5000; 15000 or more for a
     /// front end with a large LO offset, or --doppler-center].
     #[arg(long, value_name = "HZ")]
@@ -185,8 +198,49 @@ impl RunArgs {
         if self.week.is_some() {
             r.week = self.week;
         }
+        if self.approx_time.is_some() {
+            r.approx_time = self.approx_time;
+        }
+        if self.approx_llh.is_some() {
+            r.approx_llh = self.approx_llh;
+        }
         r.allow_unhealthy |= self.allow_unhealthy;
         c.validate()?;
         Ok(c)
     }
+}
+
+/// `--time WEEK:TOW`: a full GPS week and a time of week, checked against their ranges.
+pub fn parse_week_tow(text: &str) -> Result<gpsrx_nav::time::GpsTime, String> {
+    let bad = || {
+        format!(
+            "'{text}': give the full GPS week and the time of week in seconds as WEEK:TOW, e.g. 2190:538200"
+        )
+    };
+    let (w, tow) = text.trim().split_once(':').ok_or_else(bad)?;
+    let week: u32 = w.trim().parse().map_err(|_| bad())?;
+    let tow_s: f64 = tow.trim().parse().map_err(|_| bad())?;
+    let t = gpsrx_nav::time::GpsTime { week, tow_s };
+    config::check_approx_time(&t)?;
+    Ok(t)
+}
+
+/// `--approx-llh LAT,LON,H`: degrees, degrees, metres, checked against their ranges.
+pub fn parse_llh(text: &str) -> Result<[f64; 3], String> {
+    let bad = || {
+        format!(
+            "'{text}': give latitude and longitude in degrees and the height in metres as LAT,LON,H, e.g. 37.57,126.98,40"
+        )
+    };
+    let parts: Vec<f64> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    let [lat, lon, h] = parts[..] else {
+        return Err(bad());
+    };
+    let llh = [lat, lon, h];
+    config::check_approx_llh(&llh)?;
+    Ok(llh)
 }

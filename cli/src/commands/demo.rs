@@ -56,6 +56,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         rate: None,
         // Dated by the recording's SigMF core:datetime, as a user's recording would be.
         week: None,
+        approx_time: None,
+        approx_llh: None,
         doppler_max: None,
         doppler_center: None,
         acq_coherent_ms: None,

@@ -2,7 +2,8 @@
 //!
 //! The signal gives the time of week within seconds of frame sync (the HOW of every subframe),
 //! but the week number only with subframe 1 (every 30 s), and then modulo 1024. Until then
-//! the week comes from, in order: the configuration (`--week`, `[run] week`), the recording's
+//! the week comes from, in order: the configuration (`--week`, `[run] week`), the approximate
+//! time (`--time`, `[run] approx_time`), the recording's
 //! metadata (SigMF `core:datetime`), a navigation file (the week of its first ephemeris). With
 //! none of these the week is *unknown*: the system clock still resolves the 10-bit broadcast
 //! week (the 1024-week era nearest today: right for recordings under 9.8 years old), but it never
@@ -11,6 +12,7 @@
 
 use crate::pipeline::navdata::current_gps_week;
 use gpsrx_nav::rinex_nav::NavData;
+use gpsrx_nav::time::GpsTime;
 use gpsrx_samples::sigmf::RecordingStart;
 
 /// Where the reference week comes from.
@@ -18,6 +20,8 @@ use gpsrx_samples::sigmf::RecordingStart;
 pub enum WeekSource {
     /// `--week` / `[run] week`.
     Configured,
+    /// The approximate time `--time` / `[run] approx_time`.
+    ApproximateTime,
     /// The recording's metadata (the text says which key of which file).
     Recording(String),
     /// The first ephemeris of the navigation file.
@@ -36,14 +40,21 @@ pub struct WeekReference {
 }
 
 impl WeekReference {
-    /// The reference from the configured week, the recording's start and the navigation file,
-    /// in that order (see the module documentation).
+    /// The reference from the configured week, the approximate time, the recording's start
+    /// and the navigation file, in that order (see the module documentation).
     pub fn resolve(
         configured: Option<u32>,
+        approx_time: Option<GpsTime>,
         recording: Option<&RecordingStart>,
         nav: Option<&NavData>,
     ) -> WeekReference {
         let nav_week = nav.and_then(|n| n.ephemerides.first()).map(|e| e.toe.week);
+        if let (None, Some(t)) = (configured, approx_time) {
+            return WeekReference {
+                week: t.week,
+                source: WeekSource::ApproximateTime,
+            };
+        }
         match (configured, recording, nav_week) {
             (Some(week), _, _) => WeekReference {
                 week,
@@ -84,6 +95,10 @@ impl WeekReference {
                 }
                 tracing::info!("GPS week {} (--week) until subframe 1 is decoded", self.week);
             }
+            WeekSource::ApproximateTime => tracing::info!(
+                "GPS week {} (--time) until subframe 1 is decoded",
+                self.week
+            ),
             WeekSource::Recording(origin) => tracing::info!(
                 "GPS week {} from {origin} until subframe 1 is decoded",
                 self.week

@@ -54,6 +54,16 @@ pub enum NavEvent {
         /// HOW time minus the time kept, ms.
         error_ms: f64,
     },
+    /// While unsynchronised, with [`NavDecoder::report_tow_candidates`]: a telemetry word
+    /// with the preamble and a hand-over word ending at the newest bit passed parity. Not yet
+    /// trusted: [`NavDecoder::sync_at`] takes it once another satellite confirms it
+    /// ([`crate::pipeline::quick_sync`]).
+    TowCandidate {
+        /// `ms_count` of the TLM's first bit.
+        first_ms: u64,
+        /// The HOW's time of that subframe start, s.
+        tow_s: u32,
+    },
     /// The channel's data-bit edges disagree with a carried-over SV time (which is dropped).
     BitEdgeMismatch {
         /// SV time at the channel's bit edge modulo 20 ms, folded into [-10, 10), ms.
@@ -93,6 +103,8 @@ pub struct NavDecoder {
     /// that pass parity with a time within the tolerance give frame sync at once
     /// ([`NavDecoder::hint_time`]).
     hint: Option<(u64, f64, f64)>,
+    /// Report TLM and HOW pairs found while unsynchronised ([`NavEvent::TowCandidate`]).
+    tow_candidates: bool,
     reference_week: u32,
     /// Full transmission week from subframe 1 (10-bit week resolved with the reference week).
     week: Option<u32>,
@@ -120,6 +132,7 @@ impl NavDecoder {
             time_tag: None,
             carried: false,
             hint: None,
+            tow_candidates: false,
             reference_week,
             week: None,
             subframes_ok: 0,
@@ -180,6 +193,32 @@ impl NavDecoder {
         if self.time_tag.is_none() {
             self.hint = Some((ms_count, sv_tow_s, tolerance_s));
         }
+    }
+
+    /// Reports every TLM and HOW that pass parity while unsynchronised
+    /// ([`NavEvent::TowCandidate`]), for a frame sync 1.2 s into a subframe once another
+    /// satellite confirms the time ([`NavDecoder::sync_at`]).
+    pub fn report_tow_candidates(&mut self, on: bool) {
+        self.tow_candidates = on;
+    }
+
+    /// Frame sync on the subframe whose first bit started code period `first_ms`, at SV time
+    /// `tow_s` (a [`NavEvent::TowCandidate`] confirmed elsewhere). False when synchronised
+    /// already or when that bit is no longer held.
+    pub fn sync_at(&mut self, first_ms: u64, tow_s: u32) -> bool {
+        if self.time_tag.is_some() {
+            return false;
+        }
+        let Some(idx) = self.bits.iter().position(|&(_, ms)| ms == first_ms) else {
+            return false;
+        };
+        self.bits.drain(..idx);
+        self.hint = None;
+        self.candidate = None;
+        self.time_tag = Some((first_ms, f64::from(tow_s)));
+        self.carried = false;
+        self.next_subframe = Some(0);
+        true
     }
 
     /// Whether a rough time is held ([`NavDecoder::hint_time`]).
@@ -304,6 +343,16 @@ impl NavDecoder {
     fn search(&mut self, events: &mut Vec<NavEvent>) {
         if self.sync_from_hint(events) {
             return;
+        }
+        if self.tow_candidates && self.hint.is_none() && self.bits.len() >= 60 {
+            let n = self.bits.len();
+            let head: Vec<u8> = self.bits.iter().skip(n - 60).map(|&(b, _)| b).collect();
+            if let Some((how, _)) = decode_tlm_how(&head) {
+                events.push(NavEvent::TowCandidate {
+                    first_ms: self.bits[n - 60].1,
+                    tow_s: how.subframe_start_tow_s(),
+                });
+            }
         }
         if let Some((sf, first_ms, polarity)) = self.candidate {
             // The next subframe starts 300 bits (6000 ms) after the candidate's first bit.

@@ -11,12 +11,14 @@ use crate::landmarks::LandmarkObservation;
 use crate::output::{ChannelRow, FixQuality};
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::channel_manager::Realigned;
+use crate::pipeline::coarse_fix::{CoarseFixer, CoarseRefusal};
 use crate::pipeline::code_jump::{Collapse, CollapseMonitor};
 use crate::pipeline::discontinuity::{Discontinuity, DiscontinuityMonitor};
 pub use crate::pipeline::fix_output::FixStats;
 use crate::pipeline::fix_output::{fix_of, obs_epoch, passes_integrity};
 use crate::pipeline::navdata::{NavDecoder, NavEvent};
 use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
+use crate::pipeline::quick_sync::{QuickSync, TowCandidate};
 use crate::pipeline::search_schedule::Visibility;
 use crate::pipeline::sink::{
     FixReport, NavigationEnd, ObservablesReport, Progress, ReceiverEvent, Sink, SinkError,
@@ -76,6 +78,16 @@ pub struct NavigationProcessor {
     failed_in_row: u32,
     /// A valid fix came since the receiver time was last forgotten.
     time_trusted: bool,
+    /// The coarse-time first fix (approximate time and position given).
+    coarse: Option<CoarseFixer>,
+    /// A refused coarse-time attempt was logged at WARN.
+    coarse_warned: bool,
+    /// No fix from epochs before this sample: the channels reported before the coarse-time
+    /// fix handed out the SV times give nothing to them.
+    fixes_from_sample: f64,
+    /// Frame sync from one TLM and HOW confirmed across satellites (with ephemerides from a
+    /// navigation file, a fix can follow at once).
+    quick: Option<QuickSync>,
 }
 
 /// Time the code loops of channels that kept their satellites over lost samples need before
@@ -108,6 +120,12 @@ pub enum BlockEvent {
 pub const PREDICTED_DOPPLER_HZ: f64 = 60.0;
 /// See [`PREDICTED_DOPPLER_HZ`].
 pub const PREDICTED_DOPPLER_RATE_HZ_S: f64 = 50.0;
+/// Doppler uncertainty of a satellite predicted from `--approx-llh` and `--time` alone, Hz:
+/// the receiver clock's frequency error is unknown (a TCXO within 2 ppm: 3.2 kHz).
+pub const APPROX_DOPPLER_HZ: f64 = 3500.0;
+/// Elevation below which a satellite predicted hidden is not searched, deg (margin for an
+/// approximate position or time).
+pub const BELOW_HORIZON_DEG: f64 = -2.0;
 
 /// Solutions failing the integrity test in a row, after a valid one, that make the receiver
 /// time suspect.
@@ -126,6 +144,7 @@ impl NavigationProcessor {
     ) -> Self {
         let builder =
             ObservableBuilder::new(fs_hz, settings.rate_hz).with_min_cn0_dbhz(cn0_lost_dbhz);
+        let nav_assist_given = nav_assist.is_some();
         Self {
             fs_hz,
             settings,
@@ -152,7 +171,42 @@ impl NavigationProcessor {
             last_clock: None,
             failed_in_row: 0,
             time_trusted: false,
+            coarse: None,
+            coarse_warned: false,
+            fixes_from_sample: 0.0,
+            quick: nav_assist_given.then(QuickSync::default),
         }
+    }
+
+    /// Enables the coarse-time first fix ([`crate::pipeline::coarse_fix`]) when the settings
+    /// hold an approximate position, `start` (the approximate GPS time of sample 0: `--time`,
+    /// else the recording's date) is known and a navigation file gives the ephemerides;
+    /// says why not when the position is given without the rest.
+    pub fn with_coarse_time(mut self, start: Option<gpsrx_nav::time::GpsTime>) -> Self {
+        let Some([lat, lon, h]) = self.settings.approx_llh else {
+            return self;
+        };
+        match (start, &self.nav_assist) {
+            (Some(t), Some(_)) => {
+                tracing::info!(
+                    "coarse time: approximate start {}:{:.1}, position {lat:.4} {lon:.4} {h:.0} m: the first fix comes from the code phases once 5-6 satellites are tracked",
+                    t.week,
+                    t.tow_s
+                );
+                self.coarse = Some(CoarseFixer::new(
+                    self.fs_hz,
+                    t,
+                    gpsrx_nav::frames::Llh::from_degrees(lat, lon, h),
+                ));
+            }
+            (None, _) => tracing::warn!(
+                "--approx-llh without an approximate time (--time WEEK:TOW, or a SigMF core:datetime): no coarse-time fix; the first fix waits for frame sync"
+            ),
+            (_, None) => tracing::warn!(
+                "--approx-llh needs the ephemerides of --nav for a coarse-time fix: the first fix waits for frame sync"
+            ),
+        }
+        self
     }
 
     /// After every channel has reported up to sample `end`: looks for lost samples. On a
@@ -253,22 +307,15 @@ impl NavigationProcessor {
     /// [`PREDICTED_DOPPLER_HZ`] plus [`PREDICTED_DOPPLER_RATE_HZ_S`] per second since the fix
     /// ([`crate::pipeline::visibility`]); else nothing.
     pub fn visibility(&self, prn: u8, t_stream_s: f64) -> Visibility {
-        let (Some(fix), Some(t0)) = (self.prior.as_ref(), self.builder.rx_time_origin()) else {
+        let Some((rx, t, drift, half_width_hz)) = self.prediction_origin(t_stream_s) else {
             return Visibility::Unknown;
         };
-        // GPS time: receiver time less the clock bias of the fix.
-        let t = t0.add_seconds(t_stream_s - fix.clock_bias_m / SPEED_OF_LIGHT_MPS);
         let decoded = self.decoders.get(&prn).and_then(|d| d.ephemeris.as_ref());
         let eph = decoded.or_else(|| {
             self.nav_assist
                 .as_ref()
                 .and_then(|n| n.select_with(prn, t, HealthPolicy::PreferHealthy))
         });
-        let rx = gpsrx_core::PosVel {
-            pos_m: fix.pos_ecef_m,
-            vel_mps: fix.vel_ecef_mps.unwrap_or_default(),
-        };
-        let drift = fix.clock_drift_mps.unwrap_or(0.0) / SPEED_OF_LIGHT_MPS;
         // An ephemeris within 4 h, else the decoded almanac (a few hertz worse: margin enough).
         let seen = match eph.filter(|e| e.is_within_s(t, 4.0 * 3600.0)) {
             Some(e) => e.at_reception(t, &rx.pos_m, 0.075, 3),
@@ -278,16 +325,42 @@ impl NavigationProcessor {
             },
         };
         match crate::pipeline::visibility::predict_seen(&seen, &rx, drift) {
-            Some(p) if p.elevation_deg < 0.0 => Visibility::Below,
-            Some(p) => {
-                let age_s = (t.tow_s - fix.time.tow_s).abs();
-                Visibility::Visible {
-                    doppler_hz: p.doppler_hz,
-                    half_width_hz: PREDICTED_DOPPLER_HZ + PREDICTED_DOPPLER_RATE_HZ_S * age_s,
-                }
-            }
+            Some(p) if p.elevation_deg < BELOW_HORIZON_DEG => Visibility::Below,
+            Some(p) => Visibility::Visible {
+                doppler_hz: p.doppler_hz,
+                half_width_hz,
+            },
             None => Visibility::Unknown,
         }
+    }
+
+    /// Where, when and with which clock drift (s/s) the receiver is at stream time
+    /// `t_stream_s`, and the Doppler uncertainty of a prediction from that: the last fix
+    /// (position, velocity, clock bias and drift; [`PREDICTED_DOPPLER_HZ`] growing by
+    /// [`PREDICTED_DOPPLER_RATE_HZ_S`] with its age), else `--approx-llh` and `--time` (the
+    /// receiver clock drift unknown: [`APPROX_DOPPLER_HZ`]).
+    fn prediction_origin(
+        &self,
+        t_stream_s: f64,
+    ) -> Option<(gpsrx_core::PosVel, gpsrx_nav::time::GpsTime, f64, f64)> {
+        if let (Some(fix), Some(t0)) = (self.prior.as_ref(), self.builder.rx_time_origin()) {
+            // GPS time: receiver time less the clock bias of the fix.
+            let t = t0.add_seconds(t_stream_s - fix.clock_bias_m / SPEED_OF_LIGHT_MPS);
+            let rx = gpsrx_core::PosVel {
+                pos_m: fix.pos_ecef_m,
+                vel_mps: fix.vel_ecef_mps.unwrap_or_default(),
+            };
+            let drift = fix.clock_drift_mps.unwrap_or(0.0) / SPEED_OF_LIGHT_MPS;
+            let age_s = (t.tow_s - fix.time.tow_s).abs();
+            let width = PREDICTED_DOPPLER_HZ + PREDICTED_DOPPLER_RATE_HZ_S * age_s;
+            return Some((rx, t, drift, width));
+        }
+        let ([lat, lon, h], t0) = (self.settings.approx_llh?, self.settings.approx_time?);
+        let rx = gpsrx_core::PosVel {
+            pos_m: gpsrx_nav::Llh::from_degrees(lat, lon, h).to_ecef(),
+            vel_mps: gpsrx_nav::Vector3::zeros(),
+        };
+        Some((rx, t0.add_seconds(t_stream_s), 0.0, APPROX_DOPPLER_HZ))
     }
 
     /// The fixes so far, summarised.
@@ -360,6 +433,7 @@ impl NavigationProcessor {
             }
             None => {}
         }
+        self.coarse_step(e, sink)?;
         self.channel_row(channel, e, sink)?;
         self.realign_clock(e, sink)?;
         let ready = match self.decoders.get(&e.prn) {
@@ -398,13 +472,47 @@ impl NavigationProcessor {
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
         let week = self.reference_week;
-        let dec = self
-            .decoders
-            .entry(e.prn)
-            .or_insert_with(|| NavDecoder::new(e.prn, week));
+        let quick = self.quick.is_some();
+        let dec = self.decoders.entry(e.prn).or_insert_with(|| {
+            let mut d = NavDecoder::new(e.prn, week);
+            d.report_tow_candidates(quick);
+            d
+        });
+        let mut coarse_wrong = None;
+        let mut candidate = None;
         if let (Some(b), Some(ms)) = (e.bit, e.bit_start_ms) {
+            let coarse_given = self
+                .coarse
+                .as_ref()
+                .is_some_and(|c| c.given.contains(&e.prn));
+            let mut mismatch = false;
             for ev in dec.push_bit(b.value, ms) {
                 match ev {
+                    NavEvent::TowCandidate { first_ms, tow_s } => {
+                        candidate = Some(TowCandidate::new(e, first_ms, tow_s));
+                    }
+                    NavEvent::Subframe { tow_s, .. } if coarse_given && !mismatch => {
+                        tracing::info!(
+                            "G{:02}: its first HOW (TOW {tow_s} s) confirms the SV time of the coarse-time fix",
+                            e.prn
+                        );
+                        if let Some(c) = self.coarse.as_mut() {
+                            c.given.remove(&e.prn);
+                        }
+                    }
+                    NavEvent::TowMismatch { error_ms } if coarse_given => {
+                        mismatch = true;
+                        coarse_wrong = Some(format!(
+                            "the HOW of G{:02} differs from its SV time by {error_ms:.3} ms",
+                            e.prn
+                        ));
+                    }
+                    NavEvent::BitEdgeMismatch { offset_ms } if coarse_given => {
+                        coarse_wrong = Some(format!(
+                            "the first bit edge of G{:02} falls {offset_ms:+.3} ms off a 20 ms boundary of its SV time",
+                            e.prn
+                        ));
+                    }
                     NavEvent::FrameSync { tow_s } => {
                         tracing::info!("G{:02}: frame sync, TOW {tow_s} s", e.prn);
                         sink.event(&ReceiverEvent::FrameSync {
@@ -464,7 +572,144 @@ impl NavigationProcessor {
                 t_s: e.t_rx_s,
             })?;
         }
+        if let Some(why) = coarse_wrong {
+            self.drop_coarse_times(e.t_rx_s, &why, sink)?;
+        }
+        if let Some(c) = candidate {
+            self.on_tow_candidate(c, sink)?;
+        }
         Ok(())
+    }
+
+    /// A TLM and HOW found while unsynchronised: frame sync on it (and on the waiting
+    /// candidates it agrees with) once another satellite confirms its time
+    /// ([`crate::pipeline::quick_sync`]).
+    fn on_tow_candidate(&mut self, c: TowCandidate, sink: &mut dyn Sink) -> Result<(), SinkError> {
+        let known: Vec<(u8, u64, f64)> = self
+            .decoders
+            .iter()
+            .filter(|(_, d)| d.synced())
+            .filter_map(|(&p, _)| self.sv_time.last_known(p).map(|(k, sv)| (p, k, sv)))
+            .collect();
+        let Some(quick) = self.quick.as_mut() else {
+            return Ok(());
+        };
+        let confirmed = quick.offer(c, &known, self.fs_hz);
+        let by: Vec<String> = confirmed.iter().map(|c| format!("G{:02}", c.prn)).collect();
+        for c in &confirmed {
+            let synced = self
+                .decoders
+                .get_mut(&c.prn)
+                .is_some_and(|d| d.sync_at(c.first_ms, c.tow_s));
+            if synced {
+                tracing::info!(
+                    "G{:02}: frame sync, TOW {} s (TLM and HOW; times agree: {})",
+                    c.prn,
+                    c.tow_s,
+                    if by.len() > 1 {
+                        by.join(" ")
+                    } else {
+                        "with the satellites synchronised".to_string()
+                    }
+                );
+                sink.event(&ReceiverEvent::FrameSync {
+                    prn: c.prn,
+                    tow_s: f64::from(c.tow_s),
+                })?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Feeds the report to the coarse-time fix while no satellite's time is known, and hands
+    /// its SV times to the decoders once it succeeds.
+    fn coarse_step(&mut self, e: &ChannelEpoch, sink: &mut dyn Sink) -> Result<(), SinkError> {
+        if self.coarse.as_ref().is_none_or(|c| c.done) {
+            return Ok(());
+        }
+        if self.decoders.values().any(NavDecoder::synced) {
+            tracing::debug!("coarse time: a satellite's time is known already, no coarse-time fix");
+            if let Some(c) = self.coarse.as_mut() {
+                c.done = true;
+            }
+            return Ok(());
+        }
+        let opts = self.pvt_options();
+        let (Some(cf), Some(nav)) = (self.coarse.as_mut(), self.nav_assist.as_ref()) else {
+            return Ok(());
+        };
+        cf.observe(e);
+        let policy = if self.settings.allow_unhealthy {
+            gpsrx_nav::ephemeris::HealthPolicy::PreferHealthy
+        } else {
+            gpsrx_nav::ephemeris::HealthPolicy::HealthyOnly
+        };
+        let ephemeris = |prn: u8, t| nav.select_with(prn, t, policy).cloned();
+        match cf.attempt(&ephemeris, &opts) {
+            Ok(out) => {
+                for t in &out.sv_times {
+                    if let Some(d) = self.decoders.get_mut(&t.prn) {
+                        d.carry_time(t.ms_count, t.sv_tow_s);
+                    }
+                }
+                // A report covers up to 20 ms: later epochs have every channel's observables.
+                self.fixes_from_sample = (out.t_s + 0.025) * self.fs_hz;
+                tracing::info!(
+                    "coarse-time fix at {:.2} s: {} satellites, time corrected by {:+.3} s, {:.1} km from the approximate position ({}): SV times set, fixes follow",
+                    out.t_s,
+                    out.sv_times.len(),
+                    out.time_correction_s,
+                    out.position_shift_m * 1e-3,
+                    out.check
+                );
+                sink.event(&ReceiverEvent::CoarseTime {
+                    t_s: out.t_s,
+                    satellites: out.sv_times.len(),
+                    time_correction_s: out.time_correction_s,
+                })?;
+            }
+            Err(CoarseRefusal::Waiting) => {}
+            Err(CoarseRefusal::Refused(why)) => {
+                if self.coarse_warned {
+                    tracing::debug!("{:.2} s: no coarse-time fix: {why}", e.t_rx_s);
+                } else {
+                    tracing::warn!(
+                        "{:.2} s: no coarse-time fix: {why}; trying again as satellites come, else the first fix waits for frame sync",
+                        e.t_rx_s
+                    );
+                    self.coarse_warned = true;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The SV times of the coarse-time fix disagree with the signal (`why`): every one not yet
+    /// confirmed by a HOW is dropped (frame sync gives the time).
+    fn drop_coarse_times(
+        &mut self,
+        t_s: f64,
+        why: &str,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        let Some(c) = self.coarse.as_mut() else {
+            return Ok(());
+        };
+        let given = std::mem::take(&mut c.given);
+        tracing::warn!(
+            "{t_s:.2} s: {why}: the SV times of the coarse-time fix are dropped, waiting for frame sync"
+        );
+        for p in given {
+            if let Some(d) = self.decoders.get_mut(&p) {
+                if d.time_carried() {
+                    d.reset_sync();
+                }
+            }
+            self.sv_time.make_rough(Some(p));
+        }
+        self.builder.restart();
+        self.prior = None;
+        sink.event(&ReceiverEvent::CoarseTimeDropped { t_s })
     }
 
     /// After lost samples: every SV time is dropped (the decoders find frame sync again and the
@@ -566,6 +811,9 @@ impl NavigationProcessor {
             .collect();
         if carried.is_empty() {
             return;
+        }
+        if let Some(c) = self.coarse.as_mut() {
+            c.given.clear();
         }
         tracing::warn!(
             "{t_s:.2} s: the solutions fail the integrity test with the SV times carried over the outage (samples lost during it?): those of {} satellites dropped, waiting for frame sync",
@@ -699,6 +947,17 @@ impl NavigationProcessor {
         Some(known.unwrap_or(KlobucharParams::FALLBACK))
     }
 
+    /// The PVT options of the settings, with the ionosphere parameters known now.
+    fn pvt_options(&mut self) -> PvtOptions {
+        PvtOptions {
+            tropo: self.settings.tropo == TropoModel::Saastamoinen,
+            elevation_mask_deg: self.settings.elevation_mask_deg,
+            raim_pfa: self.settings.raim_pfa,
+            iono: self.iono(),
+            ..PvtOptions::default()
+        }
+    }
+
     /// The ephemeris for each satellite of the epoch: decoded, else from the navigation file.
     fn ephemerides(&self, epoch: &ObservableEpoch) -> Vec<(u8, Ephemeris)> {
         epoch
@@ -738,13 +997,7 @@ impl NavigationProcessor {
                 })
             })
             .collect();
-        let opts = PvtOptions {
-            tropo: self.settings.tropo == TropoModel::Saastamoinen,
-            elevation_mask_deg: self.settings.elevation_mask_deg,
-            raim_pfa: self.settings.raim_pfa,
-            iono: self.iono(),
-            ..PvtOptions::default()
-        };
+        let opts = self.pvt_options();
         // Landmark observations of this epoch (receiver time within half an interval; the clock
         // bias is kept below 0.5 ms, far less than that).
         let landmarks: Vec<Landmark> = self
@@ -812,6 +1065,9 @@ impl NavigationProcessor {
         aiding: Option<&InsFeedForward>,
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
+        if epoch.sample < self.fixes_from_sample {
+            return Ok(());
+        }
         let ephs = self.ephemerides(&epoch);
         let solution = self.solution(&epoch, &ephs);
         let valid = solution.as_ref().is_some_and(passes_integrity);

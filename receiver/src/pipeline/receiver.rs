@@ -305,6 +305,7 @@ impl Receiver {
         // file's; else unknown (today's, which resolves the 10-bit week but dates no output).
         let reference = WeekReference::resolve(
             run.week,
+            run.approx_time,
             assistance.recording_start.as_ref(),
             assistance.nav.as_ref(),
         );
@@ -327,7 +328,11 @@ impl Receiver {
             assistance.nav,
             assistance.landmarks,
         )
-        .with_reference_week_known(reference.known());
+        .with_reference_week_known(reference.known())
+        .with_coarse_time(
+            run.approx_time
+                .or(assistance.recording_start.as_ref().map(|r| r.time)),
+        );
         Ok(Self {
             fs_hz,
             block: block_samples(fs_hz),

@@ -98,6 +98,22 @@ pub enum ReceiverEvent {
         /// Samples lost, as time, ms.
         length_ms: f64,
     },
+    /// The satellites' SV times came from their code phases, the approximate time and
+    /// position ([`crate::pipeline::coarse_fix`]), before any time of week was decoded.
+    CoarseTime {
+        /// Stream time of the solution, s.
+        t_s: f64,
+        /// Satellites given a time.
+        satellites: usize,
+        /// Correction to the approximate time, s.
+        time_correction_s: f64,
+    },
+    /// The SV times of the coarse-time fix were dropped (a bit edge or a HOW disagreed, or the
+    /// fixes failed the integrity test): the time comes from frame sync.
+    CoarseTimeDropped {
+        /// Stream time, s.
+        t_s: f64,
+    },
 }
 
 /// Where the processing stands, about five times per second of signal.

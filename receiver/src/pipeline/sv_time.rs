@@ -235,6 +235,15 @@ impl SvTimeKeeper {
         }
     }
 
+    /// Where the SV time of `prn` stood at its last usable report, `(sample, TOW s)`, unless
+    /// it is known only roughly.
+    pub fn last_known(&self, prn: u8) -> Option<(u64, f64)> {
+        self.clocks
+            .get(&prn)
+            .filter(|c| !c.rough)
+            .map(|c| (c.sample, c.sv_tow_s))
+    }
+
     /// Marks the SV time of `prn` (all with `None`) as rough: samples may have been lost.
     pub fn make_rough(&mut self, prn: Option<u8>) {
         for (p, c) in self.clocks.iter_mut() {
