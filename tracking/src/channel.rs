@@ -314,8 +314,8 @@ pub struct Channel {
     bit_sync_origin_ms: u64,
     pull_in_ms: u64,
     cn0_dbhz: f64,
-    /// The C/N0 while the signal was there (estimates above the loss threshold, averaged),
-    /// dB-Hz; NaN before the first.
+    /// The C/N0 while the signal was there (the highest estimate, slowly forgotten), dB-Hz;
+    /// NaN before the first.
     tracked_cn0_dbhz: f64,
     low_cn0_count: u32,
     /// Accumulators of the current interval: E, P, L. The early replica leads the prompt by
@@ -413,9 +413,9 @@ impl Channel {
         self.cn0_dbhz
     }
 
-    /// The C/N0 while the signal was there (the estimates above the loss threshold, averaged;
-    /// the acquisition's before the first), dB-Hz: how hard a search must be to find the
-    /// satellite again once the channel is lost.
+    /// The C/N0 while the signal was there (the highest estimate, forgotten at 0.25 dB/s; the
+    /// acquisition's before the first), dB-Hz: how hard a search must be to find the satellite
+    /// again once the channel is lost.
     pub fn tracked_cn0_dbhz(&self) -> f64 {
         self.tracked_cn0_dbhz
     }
@@ -644,13 +644,13 @@ impl Channel {
     /// [`ChannelConfig::cn0_lost_dbhz`] with the code lock detector out release the channel.
     fn on_cn0_estimate(&mut self, c: f64) {
         self.cn0_dbhz = c;
-        if c >= self.cfg.cn0_lost_dbhz {
-            self.tracked_cn0_dbhz = if self.tracked_cn0_dbhz.is_finite() {
-                self.tracked_cn0_dbhz + 0.2 * (c - self.tracked_cn0_dbhz)
-            } else {
-                c
-            };
-        }
+        // The level the signal had: the highest estimate, forgotten at 0.05 dB per estimate
+        // (0.25 dB/s with 0.2 s estimates), so the fall into a blockage does not lower it.
+        self.tracked_cn0_dbhz = if self.tracked_cn0_dbhz.is_finite() {
+            c.max(self.tracked_cn0_dbhz - 0.05)
+        } else {
+            c
+        };
         if c < self.cfg.weak_enter_dbhz {
             self.weak = true;
         } else if c > self.cfg.weak_leave_dbhz {

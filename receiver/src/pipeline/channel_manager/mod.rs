@@ -37,6 +37,9 @@ use rayon::prelude::*;
 pub const XCORR_MARGIN_DB: f64 = 12.0;
 /// See [`XCORR_MARGIN_DB`], Hz.
 pub const XCORR_DOPPLER_HZ: f64 = 60.0;
+/// A detection whose C/N0 estimate (from the prompts after it) is below this starts no
+/// channel, dB-Hz: no loop tracks it.
+pub const MIN_START_CN0_DBHZ: f64 = 22.0;
 
 /// How the manager searches.
 #[derive(Debug, Clone)]
@@ -380,6 +383,18 @@ impl ChannelManager {
         visibility: &dyn Fn(Prn) -> Visibility,
     ) -> Vec<AcqResult> {
         for d in outcome.results.iter_mut().filter(|d| d.detected) {
+            if d.cn0_dbhz.is_some_and(|c| c < MIN_START_CN0_DBHZ) {
+                // A peak over the threshold whose prompts after it are mostly noise (the signal
+                // returning at the end of the search's samples): searched again next time.
+                tracing::debug!(
+                    "{}: detection at {:.0} Hz with C/N0 {:.1} dB-Hz not started",
+                    d.prn,
+                    d.doppler_hz,
+                    d.cn0_dbhz.unwrap_or(f64::NAN)
+                );
+                d.detected = false;
+                continue;
+            }
             if let Some(strong) = self.cross_correlation(d) {
                 tracing::debug!(
                     "{}: detection at {:.0} Hz, {:.1} dB-Hz taken for a cross-correlation of {strong}",
