@@ -57,7 +57,7 @@ pub struct RunSettings {
     /// whole run (the background search spends it over its searches of that PRN).
     pub acq_pfa: f64,
     /// CPU time the background search may spend per second of signal, s (modelled:
-    /// [`crate::pipeline::search_schedule`]); a first round of searches may spend 3 s at once.
+    /// [`crate::pipeline::search_schedule`]); a first round of searches may spend 2 s at once.
     pub search_budget_s: f64,
     /// Use satellites whose ephemeris says they are unhealthy.
     pub allow_unhealthy: bool,
@@ -89,7 +89,7 @@ impl Default for RunSettings {
             acq_coherent_ms: 1,
             acq_noncoherent: 10,
             acq_pfa: 1e-5,
-            search_budget_s: 0.06,
+            search_budget_s: 0.03,
             allow_unhealthy: false,
             week: None,
             prns: Vec::new(),

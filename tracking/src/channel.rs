@@ -317,6 +317,8 @@ pub struct Channel {
     /// The C/N0 while the signal was there (the highest estimate, slowly forgotten), dB-Hz;
     /// NaN before the first.
     tracked_cn0_dbhz: f64,
+    /// The channel reached the tracking state (its pull-in confirmed the satellite).
+    confirmed: bool,
     low_cn0_count: u32,
     /// Accumulators of the current interval: E, P, L. The early replica leads the prompt by
     /// d/2 chip (its code phase is `c + d/2`), the late one lags it.
@@ -383,6 +385,7 @@ impl Channel {
             pull_in_ms: 0,
             cn0_dbhz: start.cn0_dbhz,
             tracked_cn0_dbhz: start.cn0_dbhz,
+            confirmed: false,
             low_cn0_count: 0,
             acc: [Complex64::new(0.0, 0.0); 3],
             acc_ms: 0,
@@ -418,6 +421,12 @@ impl Channel {
     /// again once the channel is lost.
     pub fn tracked_cn0_dbhz(&self) -> f64 {
         self.tracked_cn0_dbhz
+    }
+
+    /// Whether the channel reached the tracking state (phase lock and bit sync after its
+    /// pull-in): the acquisition that started it found a satellite it could follow.
+    pub fn confirmed(&self) -> bool {
+        self.confirmed
     }
 
     /// The carrier NCO frequency (the Doppler the channel holds), Hz.
@@ -817,6 +826,7 @@ impl Channel {
         let d = loops.el_spacing_chips;
         self.taps = [d / 2.0, 0.0, -d / 2.0];
         self.state = ChannelState::Track;
+        self.confirmed = true;
         self.loops = which;
     }
 

@@ -88,7 +88,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "P")]
     pub acq_pfa: Option<f64>,
     /// CPU time the background search for missing satellites may spend per second of signal,
-    /// s [default: 0.06]: raise it to find weak satellites sooner, lower it for speed.
+    /// s [default: 0.03]: raise it to find weak satellites sooner, lower it for speed.
     #[arg(long, value_name = "S")]
     pub search_budget: Option<f64>,
     /// RAIM false-alarm probability [default: 0.001].

@@ -253,9 +253,13 @@ impl ChannelManager {
         if self.live(prn).is_some() {
             return Liveness::Live;
         }
+        // Only a satellite its channel confirmed is searched at once in its hot window; one
+        // lost in its pull-in (too weak to follow, or a false alarm) waits its turn.
         match self.channels.iter().rev().find(|c| c.prn() == prn) {
-            Some(c) => Liveness::LostAt(c.next_span().0, c.doppler_hz(), c.tracked_cn0_dbhz()),
-            None => Liveness::Never,
+            Some(c) if c.confirmed() => {
+                Liveness::LostAt(c.next_span().0, c.doppler_hz(), c.tracked_cn0_dbhz())
+            }
+            _ => Liveness::Never,
         }
     }
 
