@@ -279,32 +279,11 @@ mod tests {
     use num_complex::Complex64;
 
     fn report(prn: u8, k: u64, amplitude: f64, noise: f64) -> ChannelEpoch {
-        ChannelEpoch {
-            prn,
-            state: ChannelState::Track,
-            sample_index: k * 2048,
-            t_rx_s: k as f64 * 1e-3,
-            code_phase_chips: 0.0,
-            code_rate_chips_s: 1.023e6,
-            carrier_phase_cycles: 0.0,
-            doppler_hz: 1000.0 + f64::from(prn) + 0.5 * k as f64 * 1e-3,
-            cn0_dbhz: 42.0,
-            pll_lock: true,
-            pll_lock_metric: 0.9,
-            code_lock: true,
-            prompt: Complex64::new(amplitude + noise, noise),
-            early: Complex64::new(0.0, 0.0),
-            late: Complex64::new(0.0, 0.0),
-            phase_error_cycles: 0.0,
-            freq_error_hz: 0.0,
-            code_error_chips: 0.0,
-            t_coh_s: 1e-3,
-            feedforward_hz: None,
-            ms_count: k,
-            bit_edge: false,
-            bit: None,
-            bit_start_ms: None,
-        }
+        let doppler = 1000.0 + f64::from(prn) + 0.5 * k as f64 * 1e-3;
+        let prompt = Complex64::new(amplitude + noise, noise);
+        let mut e = crate::pipeline::test_support::report(prn, k, prompt, doppler, 0.0, 42.0);
+        (e.early, e.late) = (Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
+        e
     }
 
     /// Deterministic noise in [-0.5, 0.5).

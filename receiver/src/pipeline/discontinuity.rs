@@ -309,35 +309,9 @@ mod tests {
         let f = FREQS[i];
         let t = k as f64 * 1e-3;
         let amp = (2.0 * 10f64.powf(4.5) * 1e-3 * power).sqrt();
-        let resid = jump_rad;
         let prompt =
-            Complex64::from_polar(amp, resid) + Complex64::new(noise.normal(), noise.normal());
-        ChannelEpoch {
-            prn: i as u8 + 1,
-            state: ChannelState::Track,
-            sample_index: (t * FS) as u64,
-            t_rx_s: t,
-            code_phase_chips: 0.0,
-            code_rate_chips_s: 1.023e6,
-            carrier_phase_cycles: f * t,
-            doppler_hz: f,
-            cn0_dbhz: 45.0,
-            pll_lock: true,
-            pll_lock_metric: 0.9,
-            code_lock: true,
-            prompt,
-            early: prompt,
-            late: prompt,
-            phase_error_cycles: 0.0,
-            freq_error_hz: 0.0,
-            code_error_chips: 0.0,
-            t_coh_s: 1e-3,
-            feedforward_hz: None,
-            ms_count: k,
-            bit_edge: false,
-            bit: None,
-            bit_start_ms: None,
-        }
+            Complex64::from_polar(amp, jump_rad) + Complex64::new(noise.normal(), noise.normal());
+        crate::pipeline::test_support::report(i as u8 + 1, k, prompt, f, f * t, 45.0)
     }
 
     /// Runs 8 satellites for 400 ms; from `at_ms` satellite `i` gets `jump(i)` and `power(i)`.

@@ -41,6 +41,8 @@ pub mod search_schedule;
 pub mod sink;
 pub mod smoothing;
 pub mod sv_time;
+#[cfg(test)]
+mod test_support;
 pub mod tracker;
 pub mod visibility;
 

@@ -14,7 +14,7 @@
 //! code rate `r`, carrier phase by `(t - t_rx) f_D`.
 
 use crate::pipeline::navdata::NavDecoder;
-use crate::pipeline::smoothing::Hatch;
+use crate::pipeline::smoothing::{Hatch, HatchEpoch};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
@@ -251,6 +251,13 @@ impl ObservableBuilder {
                 .smoothing
                 .get(&e.prn)
                 .and_then(|h| self.lost_between(h.t_stream_s, t_stream));
+            let he = HatchEpoch {
+                epoch: n,
+                carrier_cycles,
+                pseudorange_m,
+                steps_ms: steps,
+                t_stream_s: t_stream,
+            };
             let (smoothed, doppler_hz) = match self.smoothing.get_mut(&e.prn) {
                 Some(h) if h.epoch == n - 1 && !lost_flag => {
                     // A clock step is not a Doppler; over the elapsed sample time (an epoch
@@ -259,22 +266,19 @@ impl ObservableBuilder {
                         - h.carrier_cycles
                         - (steps - h.steps_ms) as f64 * 1e-3 * F_L1_HZ;
                     let rate = -dl_signal / (t_stream - h.t_stream_s);
-                    h.update(n, carrier_cycles, pseudorange_m, steps, t_stream, max_m);
+                    h.update(&he, max_m);
                     self.phase_rate.insert((n, e.prn), rate);
                     (h.smoothed_m, rate)
                 }
                 Some(h) => {
-                    let bridged = lost_s.is_some_and(|g| {
-                        h.bridge(n, carrier_cycles, pseudorange_m, steps, t_stream, g, max_m)
-                    });
+                    let bridged = lost_s.is_some_and(|g| h.bridge(&he, g, max_m));
                     if !bridged {
-                        *h = Hatch::start(n, carrier_cycles, pseudorange_m, steps, t_stream);
+                        *h = Hatch::start(&he);
                     }
                     (h.smoothed_m, e.doppler_hz)
                 }
                 None => {
-                    let h = Hatch::start(n, carrier_cycles, pseudorange_m, steps, t_stream);
-                    self.smoothing.insert(e.prn, h);
+                    self.smoothing.insert(e.prn, Hatch::start(&he));
                     (pseudorange_m, e.doppler_hz)
                 }
             };

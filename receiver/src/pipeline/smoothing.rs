@@ -35,6 +35,21 @@ pub const MAX_INNOVATION_M: f64 = 30.0;
 /// signal leaves millimetres; a 10 g manoeuvre's jerk leaves metres over the fit's 3 s).
 pub const MAX_FIT_RMS_CYCLES: f64 = 0.1;
 
+/// One epoch's measurements of a satellite for its Hatch filter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HatchEpoch {
+    /// Epoch index.
+    pub epoch: i64,
+    /// Carrier phase, cycles (RINEX sign, with the clock steps).
+    pub carrier_cycles: f64,
+    /// Raw pseudorange, m.
+    pub pseudorange_m: f64,
+    /// Receiver clock steps so far, ms.
+    pub steps_ms: i64,
+    /// Stream time of the epoch, s.
+    pub t_stream_s: f64,
+}
+
 /// One satellite's Hatch filter.
 #[derive(Debug, Clone)]
 pub struct Hatch {
@@ -73,21 +88,15 @@ struct Snapshot {
 const SNAPSHOTS: usize = 16;
 
 impl Hatch {
-    /// A filter started at this epoch from the raw pseudorange.
-    pub fn start(
-        epoch: i64,
-        carrier_cycles: f64,
-        pseudorange_m: f64,
-        steps_ms: i64,
-        t_stream_s: f64,
-    ) -> Self {
+    /// A filter started at epoch `e` from the raw pseudorange.
+    pub fn start(e: &HatchEpoch) -> Self {
         let mut h = Self {
-            epoch,
-            carrier_cycles,
-            smoothed_m: pseudorange_m,
+            epoch: e.epoch,
+            carrier_cycles: e.carrier_cycles,
+            smoothed_m: e.pseudorange_m,
             m: 1,
-            steps_ms,
-            t_stream_s,
+            steps_ms: e.steps_ms,
+            t_stream_s: e.t_stream_s,
             history: VecDeque::new(),
             snapshots: VecDeque::new(),
         };
@@ -142,26 +151,10 @@ impl Hatch {
     }
 
     /// The next epoch in lock: the usual update, up to `max_m` epochs averaged.
-    pub fn update(
-        &mut self,
-        epoch: i64,
-        carrier_cycles: f64,
-        pseudorange_m: f64,
-        steps_ms: i64,
-        t_stream_s: f64,
-        max_m: u32,
-    ) {
+    pub fn update(&mut self, e: &HatchEpoch, max_m: u32) {
         let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
-        let dl = carrier_cycles - self.carrier_cycles;
-        self.advance(
-            epoch,
-            lambda * dl,
-            carrier_cycles,
-            pseudorange_m,
-            steps_ms,
-            t_stream_s,
-            max_m,
-        );
+        let dl = e.carrier_cycles - self.carrier_cycles;
+        self.advance(e, lambda * dl, max_m);
         self.remember();
     }
 
@@ -197,60 +190,34 @@ impl Hatch {
         )
     }
 
-    /// Continues the filter over a break in lock (the pseudorange being continuous): `lost_s`
-    /// of samples lost since the last epoch. Returns false (the caller restarts the filter)
-    /// when the break cannot be bridged or the bridged prediction misses the new code.
-    #[allow(clippy::too_many_arguments)]
-    pub fn bridge(
-        &mut self,
-        epoch: i64,
-        carrier_cycles: f64,
-        pseudorange_m: f64,
-        steps_ms: i64,
-        t_stream_s: f64,
-        lost_s: f64,
-        max_m: u32,
-    ) -> bool {
-        let elapsed = t_stream_s - self.t_stream_s + lost_s;
-        let Some(change) = self.bridge_change_m(elapsed, lost_s, steps_ms - self.steps_ms) else {
+    /// Continues the filter over a break in lock (the pseudorange being continuous) to epoch
+    /// `e`, `lost_s` of samples lost since the last epoch. Returns false (the caller restarts
+    /// the filter) when the break cannot be bridged or the bridged prediction misses the new
+    /// code.
+    pub fn bridge(&mut self, e: &HatchEpoch, lost_s: f64, max_m: u32) -> bool {
+        let elapsed = e.t_stream_s - self.t_stream_s + lost_s;
+        let Some(change) = self.bridge_change_m(elapsed, lost_s, e.steps_ms - self.steps_ms) else {
             return false;
         };
-        if (self.smoothed_m + change - pseudorange_m).abs() > MAX_INNOVATION_M {
+        if (self.smoothed_m + change - e.pseudorange_m).abs() > MAX_INNOVATION_M {
             return false;
         }
-        self.advance(
-            epoch,
-            change,
-            carrier_cycles,
-            pseudorange_m,
-            steps_ms,
-            t_stream_s,
-            max_m,
-        );
+        self.advance(e, change, max_m);
         // A new lock period: its carrier starts a new history.
         self.history.clear();
         self.remember();
         true
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn advance(
-        &mut self,
-        epoch: i64,
-        change_m: f64,
-        carrier_cycles: f64,
-        pseudorange_m: f64,
-        steps_ms: i64,
-        t_stream_s: f64,
-        max_m: u32,
-    ) {
+    /// The filter moved to epoch `e` with the range change `change_m` since the last one.
+    fn advance(&mut self, e: &HatchEpoch, change_m: f64, max_m: u32) {
         self.m = (self.m + 1).min(max_m);
         let mf = f64::from(self.m);
-        self.smoothed_m = pseudorange_m / mf + (mf - 1.0) / mf * (self.smoothed_m + change_m);
-        self.epoch = epoch;
-        self.carrier_cycles = carrier_cycles;
-        self.steps_ms = steps_ms;
-        self.t_stream_s = t_stream_s;
+        self.smoothed_m = e.pseudorange_m / mf + (mf - 1.0) / mf * (self.smoothed_m + change_m);
+        self.epoch = e.epoch;
+        self.carrier_cycles = e.carrier_cycles;
+        self.steps_ms = e.steps_ms;
+        self.t_stream_s = e.t_stream_s;
     }
 }
 
@@ -305,12 +272,19 @@ mod tests {
                 s.range(t_true) / lambda
             };
             let l = l_sig + steps as f64 * 1e-3 * F_L1_HZ;
+            let e = HatchEpoch {
+                epoch: k,
+                carrier_cycles: l,
+                pseudorange_m: p,
+                steps_ms: steps,
+                t_stream_s: t_stream,
+            };
             match h.as_mut() {
-                None => h = Some(Hatch::start(k, l, p, steps, t_stream)),
+                None => h = Some(Hatch::start(&e)),
                 Some(f) if (t_stream - t_gap).abs() < 1e-9 => {
-                    assert!(f.bridge(k, l, p, steps, t_stream, lost, 100), "bridged");
+                    assert!(f.bridge(&e, lost, 100), "bridged");
                 }
-                Some(f) => f.update(k, l, p, steps, t_stream, 100),
+                Some(f) => f.update(&e, 100),
             }
             if let Some(f) = &h {
                 last_err = f.smoothed_m - s.range(t_true) - clock_m;
@@ -325,21 +299,22 @@ mod tests {
 
     #[test]
     fn a_bridge_that_misses_the_new_code_or_is_too_long_is_refused() {
-        let mut h = Hatch::start(0, 0.0, 20e6, 0, 0.0);
+        let at = |k: i64, l: f64, p: f64, t: f64| HatchEpoch {
+            epoch: k,
+            carrier_cycles: l,
+            pseudorange_m: p,
+            steps_ms: 0,
+            t_stream_s: t,
+        };
+        let mut h = Hatch::start(&at(0, 0.0, 20e6, 0.0));
         for k in 1..10 {
-            h.update(
-                k,
-                -(k as f64) * 100.0,
-                20e6 - k as f64 * 19.0,
-                0,
-                k as f64 * 0.1,
-                100,
-            );
+            let kf = k as f64;
+            h.update(&at(k, -kf * 100.0, 20e6 - kf * 19.0, kf * 0.1), 100);
         }
         // A carried time 1 ms wrong: 300 km off the prediction.
         let mut wrong = h.clone();
-        assert!(!wrong.bridge(20, 0.0, 20e6 - 300_000.0, 0, 2.0, 0.0, 100));
+        assert!(!wrong.bridge(&at(20, 0.0, 20e6 - 300_000.0, 2.0), 0.0, 100));
         // Too long a break.
-        assert!(!h.bridge(60, 0.0, 20e6 - 1000.0, 0, 6.0, 0.0, 100));
+        assert!(!h.bridge(&at(60, 0.0, 20e6 - 1000.0, 6.0), 0.0, 100));
     }
 }
