@@ -960,6 +960,13 @@ impl NavigationProcessor {
 
     /// The ephemeris for each satellite of the epoch: decoded, else from the navigation file.
     fn ephemerides(&self, epoch: &ObservableEpoch) -> Vec<(u8, Ephemeris)> {
+        // With `--allow-unhealthy` an unhealthy satellite's ephemeris is taken from the file too
+        // (before, only its decoded one: it waited 18-30 s for subframes 1-3).
+        let policy = if self.settings.allow_unhealthy {
+            HealthPolicy::PreferHealthy
+        } else {
+            HealthPolicy::HealthyOnly
+        };
         epoch
             .sats
             .iter()
@@ -969,7 +976,7 @@ impl NavigationProcessor {
                     .or_else(|| {
                         self.nav_assist
                             .as_ref()
-                            .and_then(|n| n.select(s.prn, epoch.rx_time).cloned())
+                            .and_then(|n| n.select_with(s.prn, epoch.rx_time, policy).cloned())
                     })
                     .map(|e| (s.prn, e))
             })
