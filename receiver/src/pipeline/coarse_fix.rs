@@ -59,7 +59,7 @@ pub const MIN_BIT_EDGES: usize = 3;
 /// Reports older than this at the common sample are not used, s (a report covers 1-20 ms).
 const MAX_REPORT_AGE_S: f64 = 0.025;
 /// Stream time between two attempts, s.
-const RETRY_S: f64 = 0.2;
+pub const RETRY_S: f64 = 0.2;
 /// Chips in a C/A code period.
 const CODE_CHIPS: f64 = 1023.0;
 /// Milliseconds in a GPS week.

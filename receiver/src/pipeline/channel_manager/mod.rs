@@ -15,7 +15,7 @@
 //! - Work: every channel processes the code periods the sample window holds, in parallel
 //!   (rayon), concurrently with a due search (rayon `join`).
 
-mod realign;
+pub mod realign;
 
 pub use realign::{Realigned, REALIGN_DOPPLER_HZ};
 

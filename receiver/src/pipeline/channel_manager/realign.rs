@@ -2,7 +2,7 @@
 //! ([`crate::pipeline::code_jump`]: samples lost by a fraction of a code period, or tenths of a
 //! second), every tracked satellite is searched at once in a narrow window around the Doppler
 //! it held, and the channels whose code shifts one gap length explains are moved onto it
-//! ([`Channel::realign_code`]).
+//! ([`gpsrx_tracking::Channel::realign_code`]).
 
 use super::{ChannelManager, DueSearch, SearchOutcome};
 use crate::pipeline::code_jump::{fit_code_gap, Collapse, CollapsedSat, POWER_REPORTS};
