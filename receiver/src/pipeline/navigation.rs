@@ -123,6 +123,9 @@ pub const PREDICTED_DOPPLER_RATE_HZ_S: f64 = 50.0;
 /// Doppler uncertainty of a satellite predicted from `--approx-llh` and `--time` alone, Hz:
 /// the receiver clock's frequency error is unknown (a TCXO within 2 ppm: 3.2 kHz).
 pub const APPROX_DOPPLER_HZ: f64 = 3500.0;
+/// How long the first fix is awaited with `--nav` before the background search's most
+/// sensitive level runs without a prediction, s of signal.
+pub const PENDING_FOR_S: f64 = 30.0;
 /// Elevation below which a satellite predicted hidden is not searched, deg (margin for an
 /// approximate position or time).
 pub const BELOW_HORIZON_DEG: f64 = -2.0;
@@ -308,7 +311,13 @@ impl NavigationProcessor {
     /// ([`crate::pipeline::visibility`]); else nothing.
     pub fn visibility(&self, prn: u8, t_stream_s: f64) -> Visibility {
         let Some((rx, t, drift, half_width_hz)) = self.prediction_origin(t_stream_s) else {
-            return Visibility::Unknown;
+            // With ephemerides from `--nav`, the first fix (a few seconds away) will tell.
+            let soon = self.nav_assist.is_some() && t_stream_s < PENDING_FOR_S;
+            return if soon {
+                Visibility::Pending
+            } else {
+                Visibility::Unknown
+            };
         };
         let decoded = self.decoders.get(&prn).and_then(|d| d.ephemeris.as_ref());
         let eph = decoded.or_else(|| {

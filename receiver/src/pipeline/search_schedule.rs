@@ -11,7 +11,9 @@
 //!    position), in their predicted Doppler window, never left more than [`PREDICTED_WAIT_S`];
 //! 3. the others over the whole Doppler range, the least recently searched first, waiting
 //!    [`UNKNOWN_WAIT_S`] once the most sensitive search has failed. Satellites predicted below
-//!    the horizon are not searched.
+//!    the horizon are not searched, and while a prediction is about to come
+//!    ([`Visibility::Pending`]: ephemerides at hand, no fix yet) the most sensitive search
+//!    waits for it (most of the 32 PRNs are below the horizon).
 //!
 //! **CPU budget.** Searches spend a budget of modelled CPU time ([`SearchBudget`]: a bucket
 //! that refills by a fixed amount per second of *signal*, so a post-processing run stays as
@@ -43,6 +45,9 @@ pub const HOT_DOPPLER_RATE_HZ_S: f64 = 25.0;
 pub const PREDICTED_WAIT_S: f64 = 2.0;
 /// Wait after the most sensitive search of an unpredicted satellite failed, s.
 pub const UNKNOWN_WAIT_S: f64 = 15.0;
+/// Wait of a satellite whose most sensitive search awaits a prediction
+/// ([`Visibility::Pending`]), s.
+pub const PENDING_WAIT_S: f64 = 1.0;
 /// Seconds of signal between two scheduling decisions.
 pub const TICK_S: f64 = 0.1;
 /// Modelled CPU time of a search per sample, Doppler bin and pass, s, for 1 ms coherent
@@ -86,6 +91,9 @@ pub enum Visibility {
     },
     /// Below the horizon.
     Below,
+    /// Not yet known, but soon (ephemerides are at hand; the receiver's position and time are
+    /// not yet): the cheap searches go on, the most sensitive one waits for the prediction.
+    Pending,
     /// Nothing known.
     Unknown,
 }
@@ -279,7 +287,13 @@ impl Scheduler {
                 s.level,
                 SearchTarget::around(p, doppler_hz, half_width_hz),
             ),
-            (None, Visibility::Unknown) => (2, s.level, SearchTarget::full(p)),
+            (None, Visibility::Pending) if s.level >= LEVELS.len() => {
+                self.prns[p.index()].not_before = now + (PENDING_WAIT_S * self.fs_hz) as u64;
+                return None;
+            }
+            (None, Visibility::Pending | Visibility::Unknown) => {
+                (2, s.level, SearchTarget::full(p))
+            }
         };
         let level = level.min(engines.len().saturating_sub(1));
         let engine = engines.get(level)?;
