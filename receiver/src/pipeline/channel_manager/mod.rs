@@ -31,12 +31,15 @@ use gpsrx_tracking::{
 use num_complex::Complex32;
 use rayon::prelude::*;
 
-/// A detection this many dB below a tracked satellite, at its Doppler modulo 1 kHz (within
-/// [`XCORR_DOPPLER_HZ`]), is taken for its cross-correlation (C/A codes cross-correlate at
-/// -21 to -24 dB, at Doppler differences that are whole kHz).
+/// A detection this many dB or more below a tracked satellite, at its Doppler modulo 1 kHz
+/// (within [`XCORR_DOPPLER_HZ`]), is taken for its cross-correlation: C/A codes
+/// cross-correlate at -17 to -24 dB (measured: a 28 dB-Hz one of a 45 dB-Hz satellite), at
+/// Doppler differences that are whole kHz. The narrow Doppler band keeps a real satellite
+/// near such a line (a 31 dB-Hz one 54 Hz off was refused with a 60 Hz band); one within it
+/// is found once the Dopplers drift apart.
 pub const XCORR_MARGIN_DB: f64 = 12.0;
-/// See [`XCORR_MARGIN_DB`], Hz.
-pub const XCORR_DOPPLER_HZ: f64 = 60.0;
+/// See [`XCORR_MARGIN_DB`], Hz (the refined Doppler of a detection is good to a few hertz).
+pub const XCORR_DOPPLER_HZ: f64 = 25.0;
 /// A detection whose C/N0 estimate (from the prompts after it) is below this starts no
 /// channel, dB-Hz: no loop tracks it.
 pub const MIN_START_CN0_DBHZ: f64 = 22.0;
