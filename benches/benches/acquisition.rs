@@ -11,43 +11,17 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
-use gpsrx_dsp::{CaCode, Prn};
 use num_complex::Complex32;
 
 /// 10 ms at 4 MHz: unit-variance noise (SplitMix64 + Box-Muller) and three satellites at
 /// 45 dB-Hz, so the refinement after detection is part of the timing as in real use.
 fn samples(n: usize, fs: f64) -> Vec<Complex32> {
-    let mut state = 42u64;
-    let mut uniform = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        (((z ^ (z >> 31)) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    };
-    let mut x: Vec<Complex32> = (0..n)
-        .map(|_| {
-            let r = (-uniform().ln()).sqrt();
-            let t = 2.0 * std::f64::consts::PI * uniform();
-            Complex32::new((r * t.cos()) as f32, (r * t.sin()) as f32)
-        })
-        .collect();
-    let amp = (10f64.powf(4.5) / fs).sqrt();
-    for (prn, delay, dop) in [
+    let sats = [
         (5u8, 1234.0, 1500.0),
         (12, 333.0, -2750.0),
         (30, 3900.0, 4100.0),
-    ] {
-        let Ok(prn) = Prn::new(prn) else { continue };
-        let code = CaCode::new(prn);
-        for (k, v) in x.iter_mut().enumerate() {
-            let chip = ((k as f64 - delay) * 1.023e6 / fs).rem_euclid(1023.0) as usize;
-            let ph = 2.0 * std::f64::consts::PI * dop * k as f64 / fs;
-            let a = amp * f64::from(code.chip(chip));
-            *v += Complex32::new((a * ph.cos()) as f32, (a * ph.sin()) as f32);
-        }
-    }
-    x
+    ];
+    gpsrx_dsp::synthetic::noisy_ca_signal(n, fs, &sats, 45.0, 42)
 }
 
 fn bench_cold_search(c: &mut Criterion) {

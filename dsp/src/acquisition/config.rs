@@ -198,64 +198,7 @@ pub(crate) struct Layout {
 
 impl Layout {
     pub(crate) fn new(fs_hz: f64, cfg: &AcqConfig) -> Result<Self, AcqError> {
-        if !(CA_CHIP_RATE_HZ..=200e6).contains(&fs_hz) {
-            return Err(bad(
-                "fs_hz",
-                fs_hz,
-                "use a sampling rate between 1.023 MHz and 200 MHz",
-            ));
-        }
-        if !(1..=MAX_COHERENT_MS).contains(&cfg.coherent_ms) {
-            return Err(bad(
-                "coherent_ms",
-                cfg.coherent_ms,
-                format!("use 1 to {MAX_COHERENT_MS} ms"),
-            ));
-        }
-        if !(1..=100_000).contains(&cfg.noncoherent) {
-            return Err(bad(
-                "noncoherent",
-                cfg.noncoherent,
-                "use 1 to 100000 blocks",
-            ));
-        }
-        if !(cfg.pfa > 0.0 && cfg.pfa < 1.0) {
-            return Err(bad(
-                "pfa",
-                cfg.pfa,
-                "use a probability in (0, 1), e.g. 1e-5",
-            ));
-        }
-        if !cfg.doppler_center_hz.is_finite() || cfg.doppler_center_hz.abs() > fs_hz / 2.0 {
-            return Err(bad(
-                "doppler_center_hz",
-                cfg.doppler_center_hz,
-                "use |centre| < fs/2",
-            ));
-        }
-        if !cfg.doppler_max_hz.is_finite()
-            || cfg.doppler_max_hz < 0.0
-            || cfg.doppler_max_hz > fs_hz / 2.0
-        {
-            return Err(bad(
-                "doppler_max_hz",
-                cfg.doppler_max_hz,
-                "use a half-width between 0 and fs/2",
-            ));
-        }
-        if cfg
-            .xcorr_margin_db
-            .is_some_and(|m| !(m.is_finite() && m >= 0.0))
-        {
-            return Err(bad(
-                "xcorr_margin_db",
-                format!("{:?}", cfg.xcorr_margin_db),
-                "use a non-negative number of dB (15 is typical) or none",
-            ));
-        }
-        if cfg.refine_ms > 10_000 {
-            return Err(bad("refine_ms", cfg.refine_ms, "use 0 to 10000 ms"));
-        }
+        validate(fs_hz, cfg)?;
         let period_samples = fs_hz * CA_CODE_PERIOD_S;
         let m = cfg.coherent_ms as usize;
         let integer_period = (period_samples - period_samples.round()).abs() < 1e-6;
@@ -273,49 +216,13 @@ impl Layout {
             ((period_samples / lag_samples).ceil() as usize).min(inv_len)
         };
         let t_block_s = block_len as f64 / fs_hz;
-        let max_step = 2.0 / (3.0 * t_block_s);
-        let subdivision = match cfg.doppler_step_hz {
-            None => 2,
-            Some(s) => {
-                if !(s.is_finite() && s > 0.0 && s <= max_step * (1.0 + 1e-9)) {
-                    return Err(bad(
-                        "doppler_step_hz",
-                        s,
-                        format!("use a bin width in (0, 2/(3T)] = (0, {max_step:.1}] Hz"),
-                    ));
-                }
-                let q = (1.0 / (t_block_s * s) - 1e-9).ceil().max(2.0) as usize;
-                if q > MAX_DOPPLER_SUBDIVISION {
-                    let min_step = 1.0 / (MAX_DOPPLER_SUBDIVISION as f64 * t_block_s);
-                    return Err(bad(
-                        "doppler_step_hz",
-                        s,
-                        format!(
-                            "use at least 1/(8T) = {min_step:.1} Hz (finer is done by refinement)"
-                        ),
-                    ));
-                }
-                q
-            }
-        };
+        let subdivision = doppler_subdivision(cfg.doppler_step_hz, t_block_s)?;
         let doppler_step_hz = 1.0 / (subdivision as f64 * t_block_s);
         let lo = cfg.doppler_center_hz - cfg.doppler_max_hz;
         let hi = cfg.doppler_center_hz + cfg.doppler_max_hz;
         let bin_min = (lo / doppler_step_hz - 1e-9).ceil() as i64;
         let bin_max = ((hi / doppler_step_hz + 1e-9).floor() as i64).max(bin_min);
-        let passes: Vec<u32> = if cfg.uses_bit_edge_offsets() {
-            vec![0, cfg.coherent_ms / 2]
-        } else {
-            vec![0]
-        };
-        let block_start_ms: Vec<Vec<u32>> = passes
-            .iter()
-            .map(|&off| {
-                (0..cfg.noncoherent)
-                    .map(|b| b * cfg.coherent_ms + off)
-                    .collect()
-            })
-            .collect();
+        let block_start_ms = block_starts_ms(cfg);
         let last_start = block_start_ms
             .iter()
             .filter_map(|p| p.last())
@@ -366,4 +273,114 @@ impl Layout {
     pub(crate) fn t_block_s(&self, fs_hz: f64) -> f64 {
         self.block_len as f64 / fs_hz
     }
+}
+
+/// Checks the settings against the sampling rate `fs_hz`: every field in its range, or an
+/// error naming it and what to use.
+fn validate(fs_hz: f64, cfg: &AcqConfig) -> Result<(), AcqError> {
+    if !(CA_CHIP_RATE_HZ..=200e6).contains(&fs_hz) {
+        return Err(bad(
+            "fs_hz",
+            fs_hz,
+            "use a sampling rate between 1.023 MHz and 200 MHz",
+        ));
+    }
+    if !(1..=MAX_COHERENT_MS).contains(&cfg.coherent_ms) {
+        return Err(bad(
+            "coherent_ms",
+            cfg.coherent_ms,
+            format!("use 1 to {MAX_COHERENT_MS} ms"),
+        ));
+    }
+    if !(1..=100_000).contains(&cfg.noncoherent) {
+        return Err(bad(
+            "noncoherent",
+            cfg.noncoherent,
+            "use 1 to 100000 blocks",
+        ));
+    }
+    if !(cfg.pfa > 0.0 && cfg.pfa < 1.0) {
+        return Err(bad(
+            "pfa",
+            cfg.pfa,
+            "use a probability in (0, 1), e.g. 1e-5",
+        ));
+    }
+    if !cfg.doppler_center_hz.is_finite() || cfg.doppler_center_hz.abs() > fs_hz / 2.0 {
+        return Err(bad(
+            "doppler_center_hz",
+            cfg.doppler_center_hz,
+            "use |centre| < fs/2",
+        ));
+    }
+    if !cfg.doppler_max_hz.is_finite()
+        || cfg.doppler_max_hz < 0.0
+        || cfg.doppler_max_hz > fs_hz / 2.0
+    {
+        return Err(bad(
+            "doppler_max_hz",
+            cfg.doppler_max_hz,
+            "use a half-width between 0 and fs/2",
+        ));
+    }
+    if cfg
+        .xcorr_margin_db
+        .is_some_and(|m| !(m.is_finite() && m >= 0.0))
+    {
+        return Err(bad(
+            "xcorr_margin_db",
+            format!("{:?}", cfg.xcorr_margin_db),
+            "use a non-negative number of dB (15 is typical) or none",
+        ));
+    }
+    if cfg.refine_ms > 10_000 {
+        return Err(bad("refine_ms", cfg.refine_ms, "use 0 to 10000 ms"));
+    }
+    Ok(())
+}
+
+/// Doppler bins per `1 / T` (`T = t_block_s`): 2 by default, else the least that gives a bin no
+/// wider than `step_hz` (at most 2/(3T), at least 1/(8T)).
+fn doppler_subdivision(step_hz: Option<f64>, t_block_s: f64) -> Result<usize, AcqError> {
+    let max_step = 2.0 / (3.0 * t_block_s);
+    match step_hz {
+        None => Ok(2),
+        Some(s) => {
+            if !(s.is_finite() && s > 0.0 && s <= max_step * (1.0 + 1e-9)) {
+                return Err(bad(
+                    "doppler_step_hz",
+                    s,
+                    format!("use a bin width in (0, 2/(3T)] = (0, {max_step:.1}] Hz"),
+                ));
+            }
+            let q = (1.0 / (t_block_s * s) - 1e-9).ceil().max(2.0) as usize;
+            if q > MAX_DOPPLER_SUBDIVISION {
+                let min_step = 1.0 / (MAX_DOPPLER_SUBDIVISION as f64 * t_block_s);
+                return Err(bad(
+                    "doppler_step_hz",
+                    s,
+                    format!("use at least 1/(8T) = {min_step:.1} Hz (finer is done by refinement)"),
+                ));
+            }
+            Ok(q)
+        }
+    }
+}
+
+/// Per pass (blocks from the first sample; with the bit-edge guard also blocks shifted by
+/// half a coherent block), the code period at which each non-coherent block starts.
+fn block_starts_ms(cfg: &AcqConfig) -> Vec<Vec<u32>> {
+    let passes: Vec<u32> = if cfg.uses_bit_edge_offsets() {
+        vec![0, cfg.coherent_ms / 2]
+    } else {
+        vec![0]
+    };
+    passes
+        .iter()
+        .map(|&off| {
+            (0..cfg.noncoherent)
+                .map(|b| b * cfg.coherent_ms + off)
+                .collect()
+        })
+        .collect()
 }
