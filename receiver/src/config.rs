@@ -57,7 +57,8 @@ pub struct RunSettings {
     /// whole run (the background search spends it over its searches of that PRN).
     pub acq_pfa: f64,
     /// CPU time the background search may spend per second of signal, s (modelled:
-    /// [`crate::pipeline::search_schedule`]); a first round of searches may spend 2 s at once.
+    /// [`crate::pipeline::search_schedule`]); a first round of searches may spend 2 s at
+    /// once. 0: no background search, only the re-acquisition of lost satellites.
     pub search_budget_s: f64,
     /// Use satellites whose ephemeris says they are unhealthy.
     pub allow_unhealthy: bool,

@@ -9,7 +9,7 @@ pub const MAX_COHERENT_MS: u32 = 10;
 /// Largest number of fractional Doppler offsets (Doppler step down to 1/(8T)): finer bins buy
 /// nothing, the refinement after detection does the fine part.
 pub const MAX_DOPPLER_SUBDIVISION: usize = 8;
-/// Upper limit of the block spectra an engine keeps for one search, bytes.
+/// Upper limit of the block spectra an engine keeps for one pass of a search, bytes.
 pub const MAX_SPECTRA_BYTES: usize = 1 << 30;
 
 /// Settings of the code-phase / Doppler search.
@@ -230,8 +230,8 @@ impl Layout {
             .copied()
             .unwrap_or(0);
         let samples_needed = (f64::from(last_start) * period_samples).round() as usize + block_len;
-        let spectra_bytes = block_start_ms.len()
-            * cfg.noncoherent as usize
+        // The spectra of one pass are held at a time.
+        let spectra_bytes = cfg.noncoherent as usize
             * subdivision
             * block_len
             * std::mem::size_of::<num_complex::Complex32>();

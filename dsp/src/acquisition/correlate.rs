@@ -8,24 +8,22 @@ use num_complex::Complex32;
 use rayon::prelude::*;
 
 impl AcquisitionEngine {
-    /// Forward FFTs of every block of every pass at every fractional Doppler offset, stored
-    /// polyphase (`X[D j + r]` at `r * spec_len + j`) so that the decimated reads are contiguous.
-    pub(super) fn block_spectra(&self, samples: &[Complex32]) -> Vec<Complex32> {
+    /// Forward FFTs of every block of `pass` at every fractional Doppler offset, into
+    /// `spectra`, stored polyphase (`X[D j + r]` at `r * spec_len + j`) so that the decimated
+    /// reads are contiguous.
+    pub(super) fn block_spectra(
+        &self,
+        samples: &[Complex32],
+        pass: usize,
+        spectra: &mut Vec<Complex32>,
+    ) {
         let l = &self.layout;
         let n = l.block_len;
         let q_total = l.subdivision;
-        let starts: Vec<usize> = l
-            .block_start_ms
+        let starts: Vec<usize> = l.block_start_ms[pass]
             .iter()
-            .flatten()
             .map(|&ms| l.block_start_sample(ms))
             .collect();
-        let mut spectra = self
-            .spectra_pool
-            .lock()
-            .ok()
-            .and_then(|mut p| p.pop())
-            .unwrap_or_default();
         spectra.resize(starts.len() * q_total * n, Complex32::new(0.0, 0.0));
         spectra.par_chunks_mut(n).enumerate().for_each(|(i, out)| {
             let (blk, q) = (i / q_total, i % q_total);
@@ -50,11 +48,10 @@ impl AcquisitionEngine {
             }
             self.give_scratch(s);
         });
-        spectra
     }
 
-    /// Non-coherent power grid of one PRN and one pass into `s.grid` (rows = Doppler bins
-    /// `b0..=b1`, columns = code lags referred to the first sample).
+    /// Non-coherent power grid of one PRN into `s.grid` from the `spectra` of `pass` (rows =
+    /// Doppler bins `b0..=b1`, columns = code lags referred to the first sample).
     pub(super) fn fill_grid(
         &self,
         spectra: &[Complex32],
@@ -72,7 +69,6 @@ impl AcquisitionEngine {
         s.grid.clear();
         s.grid.resize(rows * lags, 0.0);
         let replica = &self.replicas[prn.index()];
-        let blocks_per_pass = l.block_start_ms.first().map_or(0, Vec::len);
         let starts = &l.block_start_ms[pass];
         for (row, bin) in (b0..=b1).enumerate() {
             let q = bin.rem_euclid(q_total as i64) as usize;
@@ -82,7 +78,7 @@ impl AcquisitionEngine {
             let f_hz = bin as f64 * l.doppler_step_hz;
             let grid_row = &mut s.grid[row * lags..(row + 1) * lags];
             for (b, &ms) in starts.iter().enumerate() {
-                let base = ((pass * blocks_per_pass + b) * q_total + q) * n + r * sl;
+                let base = (b * q_total + q) * n + r * sl;
                 let src = &spectra[base..base + sl];
                 // Y[j] = X[D (j + a) + r] conj(C[j]) / len: the Doppler shift is a rotation;
                 // the lowest kp non-negative and kn negative frequencies j (relative to the
@@ -112,7 +108,7 @@ impl AcquisitionEngine {
 
     /// Noise power of a full-band correlation over that of the search's band-limited one at
     /// Doppler bin `bin`: `sum_j P[j] W[j] / sum_{j kept} P[j] W[j]`, with `P` the power
-    /// spectrum of the first pass's blocks (relative to the bin's Doppler) and `W` the mean
+    /// spectrum of the pass's blocks (relative to the bin's Doppler) and `W` the mean
     /// replica power spectrum. 1 when the search keeps the whole spectrum. The grid floor times
     /// this is the noise of the prompts of the refinement, which correlate at the input rate,
     /// whatever the front-end filter (white noise gives 1/(fraction of the replica's power in

@@ -28,6 +28,17 @@ pub(super) struct Scratch {
     floors: Vec<f64>,
 }
 
+/// The best of one target's passes so far.
+#[derive(Debug, Clone, Copy)]
+struct PassPeak {
+    peak: Peak,
+    /// The pass (index into the layout's block starts).
+    pass: usize,
+    /// Full-band over in-band noise power at the peak's Doppler (see
+    /// [`AcquisitionEngine::band_noise_ratio`]).
+    band: f64,
+}
+
 /// A parallel FFT code-phase search for GPS L1 C/A at one sampling rate and one setting.
 ///
 /// Build it once ([`AcquisitionEngine::new`] plans the FFTs and transforms the 32 replicas), then
@@ -155,25 +166,57 @@ impl AcquisitionEngine {
             .iter()
             .map(|t| self.bins_for(t))
             .collect::<Result<Vec<_>, _>>()?;
-        let mut spectra = self.block_spectra(samples);
+        let thresholds: Vec<f64> = targets
+            .iter()
+            .zip(&rows)
+            .map(|(t, &bins)| self.threshold(t, bins))
+            .collect();
+        // One pass's spectra at a time (half the memory of keeping both): each target keeps
+        // its best pass.
+        let mut best: Vec<Option<PassPeak>> = vec![None; targets.len()];
+        let mut spectra = self
+            .spectra_pool
+            .lock()
+            .ok()
+            .and_then(|mut p| p.pop())
+            .unwrap_or_default();
+        for pass in 0..self.layout.block_start_ms.len() {
+            self.block_spectra(samples, pass, &mut spectra);
+            best.par_iter_mut()
+                .zip(targets.par_iter())
+                .zip(rows.par_iter().zip(thresholds.par_iter()))
+                .with_max_len(1)
+                .for_each(|((kept, t), (&(b0, b1), &threshold))| {
+                    let mut s = self.take_scratch();
+                    let peak = self.pass_peak(&spectra, t.prn, (b0, b1), pass, threshold, &mut s);
+                    if kept
+                        .as_ref()
+                        .is_none_or(|k| peak.peak.metric > k.peak.metric)
+                    {
+                        *kept = Some(peak);
+                    }
+                    self.give_scratch(s);
+                });
+        }
+        spectra.clear();
+        if let Ok(mut pool) = self.spectra_pool.lock() {
+            pool.push(spectra);
+        }
         let mut results: Vec<AcqResult> = targets
             .par_iter()
-            .zip(rows.par_iter())
+            .zip(best.par_iter())
+            .zip(rows.par_iter().zip(thresholds.par_iter()))
             .with_max_len(1)
-            .map(|(t, &(b0, b1))| {
+            .filter_map(|((t, kept), (&(b0, _), &threshold))| {
+                let kept = kept.as_ref()?;
                 let mut s = self.take_scratch();
-                let pfa = t.pfa.unwrap_or(self.config.pfa);
-                let r = self.search_prn(samples, &spectra, t.prn, (b0, b1), pfa, &mut s);
+                let r = self.decide(samples, t.prn, b0, kept, threshold, &mut s);
                 self.give_scratch(s);
-                r
+                Some(r)
             })
             .collect();
         if let Some(margin) = self.config.xcorr_margin_db {
             mark_cross_correlations(&mut results, margin);
-        }
-        spectra.clear();
-        if let Ok(mut pool) = self.spectra_pool.lock() {
-            pool.push(std::mem::take(&mut spectra));
         }
         Ok(results)
     }
@@ -189,7 +232,8 @@ impl AcquisitionEngine {
     pub fn grid(&self, samples: &[Complex32], target: &SearchTarget) -> Result<AcqGrid, AcqError> {
         self.check_len(samples)?;
         let (b0, b1) = self.bins_for(target)?;
-        let spectra = self.block_spectra(samples);
+        let mut spectra = Vec::new();
+        self.block_spectra(samples, 0, &mut spectra);
         let mut s = self.take_scratch();
         self.fill_grid(&spectra, target.prn, b0, b1, 0, &mut s);
         let step = self.layout.doppler_step_hz;
@@ -273,35 +317,54 @@ impl AcquisitionEngine {
         }
     }
 
-    fn search_prn(
+    /// The detection threshold of a search of `t` over Doppler bins `b0..=b1`: on the
+    /// per-block mean of the grid over its floor, for the target's false-alarm probability
+    /// spread over every cell of every pass.
+    fn threshold(&self, t: &SearchTarget, (b0, b1): (i64, i64)) -> f64 {
+        let l = &self.layout;
+        let nc = self.config.noncoherent;
+        let cells = (b1 - b0 + 1) as usize * l.n_lags * l.block_start_ms.len();
+        let pfa = t.pfa.unwrap_or(self.config.pfa);
+        detection_threshold(nc, pfa, cells) / f64::from(nc)
+    }
+
+    /// One pass's grid of `prn` over Doppler bins `b0..=b1`, analysed; the band-noise ratio
+    /// at its peak is taken while the pass's spectra are at hand, when the peak is a detection.
+    fn pass_peak(
         &self,
-        samples: &[Complex32],
         spectra: &[Complex32],
         prn: Prn,
         (b0, b1): (i64, i64),
-        pfa: f64,
+        pass: usize,
+        threshold: f64,
+        s: &mut Scratch,
+    ) -> PassPeak {
+        let l = &self.layout;
+        let rows = (b1 - b0 + 1) as usize;
+        // One chip in search lags.
+        let exclusion = (self.fs_hz / CA_CHIP_RATE_HZ / l.lag_samples).ceil() as usize;
+        self.fill_grid(spectra, prn, b0, b1, pass, s);
+        let peak = analyse(&s.grid, rows, l.n_lags, exclusion, &mut s.floors);
+        let band = if peak.metric >= threshold {
+            self.band_noise_ratio(spectra, b0 + peak.row as i64)
+        } else {
+            1.0
+        };
+        PassPeak { peak, pass, band }
+    }
+
+    /// The result of `prn` from its best pass: detected when over `threshold`, then refined.
+    fn decide(
+        &self,
+        samples: &[Complex32],
+        prn: Prn,
+        b0: i64,
+        kept: &PassPeak,
+        threshold: f64,
         s: &mut Scratch,
     ) -> AcqResult {
         let l = &self.layout;
-        let rows = (b1 - b0 + 1) as usize;
-        let passes = l.block_start_ms.len();
-        // One chip in search lags.
-        let exclusion = (self.fs_hz / CA_CHIP_RATE_HZ / l.lag_samples).ceil() as usize;
-        self.fill_grid(spectra, prn, b0, b1, 0, s);
-        let (mut peak, mut pass) = (
-            analyse(&s.grid, rows, l.n_lags, exclusion, &mut s.floors),
-            0,
-        );
-        for other in 1..passes {
-            self.fill_grid(spectra, prn, b0, b1, other, s);
-            let p = analyse(&s.grid, rows, l.n_lags, exclusion, &mut s.floors);
-            if p.metric > peak.metric {
-                (peak, pass) = (p, other);
-            }
-        }
-        let nc = self.config.noncoherent;
-        let cells = rows * l.n_lags * passes;
-        let threshold = detection_threshold(nc, pfa, cells) / f64::from(nc);
+        let peak = &kept.peak;
         let detected = peak.metric >= threshold;
         let step = l.doppler_step_hz;
         let coarse_hz = (b0 as f64 + peak.row as f64 + peak.row_frac) * step;
@@ -318,13 +381,12 @@ impl AcquisitionEngine {
             metric: peak.metric,
             threshold,
             peak_ratio: peak.peak_ratio,
-            bit_offset_ms: l.block_start_ms[pass].first().copied().unwrap_or(0),
+            bit_offset_ms: l.block_start_ms[kept.pass].first().copied().unwrap_or(0),
             refine_ms: 0,
             cross_correlation_of: None,
         };
         if detected {
-            let band = self.band_noise_ratio(spectra, b0 + peak.row as i64);
-            self.refine(samples, &peak, band, &mut result, s);
+            self.refine(samples, peak, kept.band, &mut result, s);
         }
         result
     }

@@ -280,10 +280,7 @@ impl Receiver {
                 ..AcqConfig::default()
             },
             weak_fallback: true,
-            background: Some(SearchBudget {
-                per_signal_s: run.search_budget_s,
-                ..SearchBudget::default()
-            }),
+            background: Some(SearchBudget::per_signal(run.search_budget_s)),
             prns: run.prns.iter().filter_map(|&p| Prn::new(p).ok()).collect(),
             cold_targets: None,
         }

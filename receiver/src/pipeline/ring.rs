@@ -5,8 +5,8 @@
 //!
 //! Memory is bounded: samples older than the slowest channel's next integration are dropped.
 //! Nothing is allocated or zeroed per block in the steady state: the buffer keeps its size and
-//! the live samples are moved to its front only when the dropped prefix is four times their
-//! length.
+//! the live samples are moved to its front only when the dropped prefix is as long as they
+//! are.
 
 use gpsrx_samples::{SampleError, SampleSource};
 use num_complex::Complex32;
@@ -112,10 +112,10 @@ impl SampleWindow {
         }
         self.head += (index - self.start) as usize;
         self.start = index;
-        // Compact when the dropped prefix is four times the live samples: a quarter of a
-        // copy per sample dropped, and the buffer stays within five times the live span plus
-        // one block.
-        if self.head >= 4 * (self.tail - self.head) {
+        // Compact when the dropped prefix is as long as the live samples: at most one copy per
+        // sample dropped, and the buffer stays within twice the live span plus one block (the
+        // background search holds up to half a second: 32 MB at 4 MHz, not 80).
+        if self.head >= self.tail - self.head {
             self.data.copy_within(self.head..self.tail, 0);
             self.tail -= self.head;
             self.head = 0;
@@ -253,7 +253,7 @@ mod tests {
             // Keep the last 45 samples, as a slow channel would.
             w.discard_before(w.end().saturating_sub(45));
             assert!(
-                w.data.len() <= 5 * 45 + 30 + 30,
+                w.data.len() <= 2 * 45 + 30 + 30,
                 "buffer {} grew",
                 w.data.len()
             );

@@ -61,7 +61,12 @@ pub const COST_S_PER_SAMPLE_FFT: f64 = 2.4e-8;
 /// Largest modelled cost of one batch, s (a block waits for its search).
 pub const MAX_BATCH_S: f64 = 0.5;
 
-/// The CPU time searches may spend.
+/// Capacity of the bucket, CPU s: a first round of searches at the start (every PRN up to
+/// 10 ms x 10, most of them 10 ms x 40, at 2.6-4 MHz).
+pub const BURST_S: f64 = 2.0;
+
+/// The CPU time searches may spend. Searches of a satellite lost in the last [`HOT_FOR_S`] at
+/// the configured level (narrow and cheap: re-acquisition) are not charged.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SearchBudget {
     /// Refill per second of signal, CPU s (0.03: searching costs at most 3 % of a core).
@@ -70,12 +75,21 @@ pub struct SearchBudget {
     pub burst_s: f64,
 }
 
-impl Default for SearchBudget {
-    fn default() -> Self {
+impl SearchBudget {
+    /// A budget of `per_signal_s` CPU s per second of signal, [`BURST_S`] of which may go at
+    /// once (0: no background search, only the re-acquisition of satellites just lost).
+    pub fn per_signal(per_signal_s: f64) -> Self {
         Self {
-            per_signal_s: 0.03,
-            burst_s: 2.0,
+            per_signal_s,
+            burst_s: if per_signal_s > 0.0 { BURST_S } else { 0.0 },
         }
+    }
+}
+
+impl Default for SearchBudget {
+    /// 0.03 CPU s per second of signal, 2 s at once.
+    fn default() -> Self {
+        Self::per_signal(0.03)
     }
 }
 
@@ -136,6 +150,8 @@ struct PrnState {
 /// A candidate for the next batch: priority (lower first), its level, target and cost.
 struct Candidate {
     hot: bool,
+    /// Not charged to the budget: a hot search at the configured level.
+    free: bool,
     priority: (u8, u64),
     level: usize,
     target: SearchTarget,
@@ -216,16 +232,24 @@ impl Scheduler {
             .filter_map(|p| self.candidate(p, now, engines, live(p), visibility(p)))
             .collect();
         candidates.sort_by_key(|c| c.priority);
-        let level = candidates.first()?.level;
+        let (level, free) = candidates.first().map(|c| (c.level, c.free))?;
         let engine = engines.get(level)?;
         let len = engine.samples_wanted() as u64;
         if window < len {
             return None;
         }
-        let mut spent = fixed_cost_s(engine);
+        let mut spent = if free { 0.0 } else { fixed_cost_s(engine) };
         let mut targets = Vec::new();
         let mut hot = Vec::new();
         for c in candidates.into_iter().filter(|c| c.level == level) {
+            if free {
+                // A batch of re-acquisitions alone (they come first).
+                if c.free {
+                    hot.push(true);
+                    targets.push(c.target.with_pfa(self.pfa_of(c.target.prn)));
+                }
+                continue;
+            }
             if spent + c.cost_s > self.tokens_s.min(MAX_BATCH_S) && !targets.is_empty() {
                 break;
             }
@@ -299,6 +323,7 @@ impl Scheduler {
         let engine = engines.get(level)?;
         Some(Candidate {
             hot: rank == 0,
+            free: rank == 0 && level == 0,
             priority: (rank, s.not_before),
             level,
             cost_s: cost_s(engine, &target),
@@ -448,6 +473,44 @@ mod tests {
             now += block;
         }
         log
+    }
+
+    #[test]
+    fn without_a_budget_only_satellites_just_lost_are_searched_again_free_of_charge() {
+        let engines = engines();
+        let mut s = Scheduler::new(FS, SearchBudget::per_signal(0.0), 1e-3, &[], 0);
+        let block = (0.01 * FS) as u64;
+        // G05 was lost at 0.5 s, tracked strong (45 dB-Hz); the others were never seen.
+        let lost = (0.5 * FS) as u64;
+        let live = |p: Prn| {
+            if p.get() == 5 {
+                Liveness::LostAt(lost, 1000.0, 45.0)
+            } else {
+                Liveness::Never
+            }
+        };
+        let vis = |_: Prn| Visibility::Unknown;
+        let mut searched = Vec::new();
+        let mut now = lost + block;
+        while (now as f64) < 5.5 * FS {
+            if let Some(b) = s.due(now, now, &engines, &live, &vis) {
+                searched.extend(b.targets.iter().map(|t| (b.level, t.prn.get(), now)));
+                let results: Vec<AcqResult> =
+                    b.targets.iter().map(|t| result(t.prn, false)).collect();
+                s.record(&b, &results, now, &vis);
+            }
+            now += block;
+        }
+        assert!(
+            searched
+                .iter()
+                .all(|&(level, prn, _)| level == 0 && prn == 5),
+            "{searched:?}"
+        );
+        // Every HOT_INTERVAL_S over the 5 s.
+        let want = (5.0 / HOT_INTERVAL_S) as usize;
+        assert!(searched.len() + 1 >= want, "{} searches", searched.len());
+        assert_eq!(s.tokens_s(), 0.0);
     }
 
     #[test]
