@@ -11,8 +11,16 @@ use std::path::Path;
 const FS_HZ: f64 = 2.048e6;
 
 /// Runs the receiver over `n` samples made by `fill(first index, buffer)`; returns the sink.
-fn run(n: u64, mut fill: impl FnMut(u64, &mut Vec<Complex32>)) -> MemorySink {
-    let mut rx = crate::pipeline::receiver(FS_HZ);
+fn run(n: u64, fill: impl FnMut(u64, &mut Vec<Complex32>)) -> MemorySink {
+    run_with(crate::pipeline::receiver(FS_HZ), n, fill)
+}
+
+/// [`run`] with the receiver `rx`.
+fn run_with(
+    mut rx: gpsrx_receiver::pipeline::Receiver,
+    n: u64,
+    mut fill: impl FnMut(u64, &mut Vec<Complex32>),
+) -> MemorySink {
     let mut sink = MemorySink::new();
     let chunk = (0.1 * FS_HZ) as u64;
     let mut buf = Vec::new();
@@ -49,16 +57,48 @@ fn noise_alone_gives_no_satellite_however_long_it_is_searched() {
     // probability (1e-5 per PRN): the chance of any false satellite in these three runs is
     // below 1e-3, so one is a defect.
     for seed in [1u64, 2, 3] {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        let sink =
-            run((8.0 * FS_HZ) as u64, |_, buf| {
-                buf.extend((0..(0.1 * FS_HZ) as usize).map(|_| {
-                    Complex32::new(rng.sample(StandardNormal), rng.sample(StandardNormal))
-                }));
-            });
+        let sink = run((8.0 * FS_HZ) as u64, noise(seed));
         let found = acquired(&sink);
         assert!(found.is_empty(), "seed {seed}: false satellites {found:?}");
     }
+}
+
+/// `seconds` of white Gaussian noise from `seed`, pushed 0.1 s at a time.
+fn noise(seed: u64) -> impl FnMut(u64, &mut Vec<Complex32>) {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    move |_, buf| {
+        buf.extend(
+            (0..(0.1 * FS_HZ) as usize)
+                .map(|_| Complex32::new(rng.sample(StandardNormal), rng.sample(StandardNormal))),
+        );
+    }
+}
+
+#[test]
+fn the_run_false_alarm_probability_is_honoured_end_to_end_on_noise() {
+    // `acq_pfa` is the probability that an absent PRN is reported (acquired) at all over a
+    // run, however often it is searched: the cold start and each background search spend
+    // their share (pfa 6 / (pi^2 k^2) for the k-th). At pfa = 0.1, 8 runs x 32 PRNs: the
+    // count of PRNs acquired is binomial with p at most 0.1 (about 0.9 x 0.1 for the searches
+    // a 6 s run makes: mean about 23, sd 4.6). More than 42 means the searches' shares add up
+    // to more than the run's pfa (the cold start at the full pfa before it had a share gave
+    // about twice as many); fewer than 5 means thresholds far more conservative than asked.
+    let (runs, pfa) = (8u64, 0.1);
+    let mut false_prns = 0;
+    for seed in 0..runs {
+        let rx = crate::pipeline::receiver_with(FS_HZ, |c| c.run.acq_pfa = pfa);
+        let sink = run_with(rx, (6.0 * FS_HZ) as u64, noise(100 + seed));
+        false_prns += acquired(&sink).len();
+        // None of them is confirmed: no fix, no observable.
+        assert!(sink.fixes.is_empty(), "seed {seed}: a fix from noise");
+    }
+    let n = (runs * 32) as f64;
+    let bound = n * pfa + 4.0 * (n * pfa * (1.0 - pfa)).sqrt();
+    eprintln!("{false_prns} of {n} PRN-runs acquired at pfa {pfa}");
+    assert!(
+        (5..=bound as usize).contains(&false_prns),
+        "{false_prns} of {n} PRN-runs acquired at pfa {pfa} (want 5..={bound:.0})"
+    );
 }
 
 #[test]

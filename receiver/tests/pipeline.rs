@@ -96,7 +96,13 @@ impl SampleSource for SimSource<'_> {
 /// A receiver with the built-in broadcast ephemerides as `--nav`, week 2190, no troposphere
 /// model (the simulator has none).
 pub(crate) fn receiver(fs_hz: f64) -> Receiver {
+    receiver_with(fs_hz, |_| ())
+}
+
+/// [`receiver`] with its configuration changed by `edit` first.
+pub(crate) fn receiver_with(fs_hz: f64, edit: impl FnOnce(&mut ReceiverConfig)) -> Receiver {
     let mut config = ReceiverConfig::default();
+    edit(&mut config);
     config.run.tropo = gpsrx_receiver::config::TropoModel::None;
     config.run.week = Some(2190);
     let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));

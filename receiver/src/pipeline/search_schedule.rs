@@ -196,10 +196,18 @@ impl Scheduler {
         self.tokens_s
     }
 
+    /// Counts the cold start's search of `searched` (made at [`search_pfa`]`(pfa, 1)`): their
+    /// next search is their second.
+    pub fn with_searched(mut self, searched: &[Prn]) -> Self {
+        for p in searched {
+            self.prns[p.index()].searches = self.prns[p.index()].searches.max(1);
+        }
+        self
+    }
+
     /// The false-alarm probability of the next search of `prn`.
     fn pfa_of(&self, prn: Prn) -> f64 {
-        let k = f64::from(self.prns[prn.index()].searches + 1);
-        self.pfa * 6.0 / (std::f64::consts::PI.powi(2) * k * k)
+        search_pfa(self.pfa, self.prns[prn.index()].searches + 1)
     }
 
     /// The batch due at sample `now`, if any: `engines` are the levels' engines, `window` the
@@ -363,6 +371,13 @@ impl Scheduler {
             s.not_before = now + (wait_s * self.fs_hz) as u64;
         }
     }
+}
+
+/// The false-alarm probability of the `k`-th search (from 1) of a PRN when the whole run may
+/// spend `pfa` on it: `pfa 6 / (pi^2 k^2)`, whose sum over all `k` is `pfa`.
+pub fn search_pfa(pfa: f64, k: u32) -> f64 {
+    let k = f64::from(k.max(1));
+    pfa * 6.0 / (std::f64::consts::PI.powi(2) * k * k)
 }
 
 /// The least sensitive level that finds a satellite of `cn0_dbhz` (the C/N0 its channel

@@ -21,7 +21,7 @@ pub use realign::{Realigned, REALIGN_DOPPLER_HZ};
 
 use crate::pipeline::ring::SampleView;
 use crate::pipeline::search_schedule::{
-    Batch, Liveness, Scheduler, SearchBudget, Visibility, LEVELS,
+    search_pfa, Batch, Liveness, Scheduler, SearchBudget, Visibility, LEVELS,
 };
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::Prn;
@@ -210,11 +210,21 @@ impl ChannelManager {
             .as_ref()
             .map(|s| s.prns.clone())
             .unwrap_or_default();
-        let targets: Vec<SearchTarget> =
+        let mut targets: Vec<SearchTarget> =
             match self.settings.as_ref().and_then(|s| s.cold_targets.clone()) {
                 Some(t) => t,
                 None => wanted_prns(&prns).map(SearchTarget::full).collect(),
             };
+        let background = self
+            .settings
+            .as_ref()
+            .and_then(|s| s.background.map(|b| (b, s.acq.pfa)));
+        if let Some((_, pfa)) = background {
+            // The first of the run's searches of each PRN: its share of the run's pfa.
+            for t in &mut targets {
+                *t = t.with_pfa(search_pfa(t.pfa.unwrap_or(pfa), 1));
+            }
+        }
         let found = engine.search(&samples[..n.min(engine.samples_wanted())], &targets)?;
         for d in found.iter().filter(|d| d.detected) {
             let start = ChannelStart::from_acquisition(d, first_index);
@@ -227,13 +237,11 @@ impl ChannelManager {
                 d.cn0_dbhz.unwrap_or(f64::NAN)
             );
         }
-        if let Some((budget, s)) = self
-            .settings
-            .as_ref()
-            .and_then(|s| s.background.map(|b| (b, s)))
-        {
+        if let Some((budget, pfa)) = background {
             let end = first_index + engine.samples_wanted().min(n) as u64;
-            self.schedule = Some(Scheduler::new(self.fs_hz, budget, s.acq.pfa, &prns, end));
+            let searched: Vec<Prn> = targets.iter().map(|t| t.prn).collect();
+            self.schedule =
+                Some(Scheduler::new(self.fs_hz, budget, pfa, &prns, end).with_searched(&searched));
         }
         Ok(found.into_iter().filter(|d| d.detected).collect())
     }
