@@ -101,13 +101,13 @@ fn the_run_false_alarm_probability_is_honoured_end_to_end_on_noise() {
     );
 }
 
-#[test]
-fn weak_satellites_are_found_within_seconds_beside_strong_ones() {
-    // Eight satellites from 45 down to 30 dB-Hz: the 1 ms x 10 cold start finds the strong
-    // ones; the background search escalates for the rest at once.
-    let text = r#"
-duration_s = 6.0
-seed = 5
+/// Eight satellites over Seoul at 2.048 MHz from `seed`, for `duration_s`, with the C/N0 list
+/// `cn0` (TOML array of `{ prn, dbhz }`); returns the simulator and the receiver's sink.
+fn simulate_and_run(seed: u64, duration_s: f64, cn0: &str) -> (Simulator, MemorySink) {
+    let text = format!(
+        r#"
+duration_s = {duration_s}
+seed = {seed}
 nav = "builtin:brdc0010.22n"
 [start]
 week = 2190
@@ -119,18 +119,10 @@ fs_hz = 2.048e6
 kind = "static"
 llh_deg = [37.5665, 126.9780, 40.0]
 [satellites]
-cn0 = [
-  { prn = 31, dbhz = 45.0 },
-  { prn = 26, dbhz = 43.0 },
-  { prn = 32, dbhz = 41.0 },
-  { prn = 25, dbhz = 39.0 },
-  { prn = 29, dbhz = 34.0 },
-  { prn = 22, dbhz = 32.0 },
-  { prn = 3, dbhz = 31.0 },
-  { prn = 16, dbhz = 30.0 },
-]
-"#;
-    let sc = Scenario::from_toml(text).unwrap_or_else(|e| panic!("{e}"));
+cn0 = {cn0}
+"#
+    );
+    let sc = Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
     let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
     let chunk = sim.chunk_samples() as u64;
     let mut pending: Vec<Complex32> = Vec::new();
@@ -147,14 +139,58 @@ cn0 = [
         let take = want.min(pending.len());
         buf.extend(pending.drain(..take));
     });
-    let found = acquired(&sink);
+    (sim, sink)
+}
+
+/// Asserts that every PRN acquired or tracked is one the simulator put in the sky.
+fn assert_no_false_satellite(sim: &Simulator, sink: &MemorySink, what: &str) {
     let truth: Vec<u8> = sim.satellites.iter().map(|s| s.prn.get()).collect();
-    for (prn, t) in &found {
+    for (prn, t) in acquired(sink) {
         assert!(
-            truth.contains(prn),
-            "G{prn:02} acquired at {t:.1} s: not in the sky"
+            truth.contains(&prn),
+            "{what}: G{prn:02} acquired at {t:.1} s: not in the sky"
         );
     }
+    for row in &sink.channels {
+        assert!(
+            truth.contains(&row.prn),
+            "{what}: G{:02} has a channel in state {:?}: not in the sky",
+            row.prn,
+            row.state
+        );
+    }
+}
+
+#[test]
+fn strong_satellites_give_no_cross_correlation_satellite() {
+    // Six satellites at 48-52 dB-Hz: their C/A cross-correlations with absent PRNs come 21-29
+    // dB below them, 26-39 Hz off whole-kHz Doppler differences, strong enough for the 10 ms
+    // searches; before the wide rule, one of five seeds at 2.6 MHz confirmed such a channel.
+    let cn0 = "[{ prn = 31, dbhz = 52.0 }, { prn = 26, dbhz = 51.0 }, { prn = 32, dbhz = 50.0 },
+        { prn = 25, dbhz = 49.0 }, { prn = 29, dbhz = 48.0 }, { prn = 22, dbhz = 48.0 }]";
+    for seed in [2u64, 3, 5, 7] {
+        let (sim, sink) = simulate_and_run(seed, 3.0, cn0);
+        assert_no_false_satellite(&sim, &sink, &format!("seed {seed}"));
+    }
+}
+
+#[test]
+fn weak_satellites_are_found_within_seconds_beside_strong_ones() {
+    // Eight satellites from 45 down to 30 dB-Hz: the 1 ms x 10 cold start finds the strong
+    // ones; the background search escalates for the rest at once.
+    let cn0 = "[
+  { prn = 31, dbhz = 45.0 },
+  { prn = 26, dbhz = 43.0 },
+  { prn = 32, dbhz = 41.0 },
+  { prn = 25, dbhz = 39.0 },
+  { prn = 29, dbhz = 34.0 },
+  { prn = 22, dbhz = 32.0 },
+  { prn = 3, dbhz = 31.0 },
+  { prn = 16, dbhz = 30.0 },
+]";
+    let (sim, sink) = simulate_and_run(5, 6.0, cn0);
+    assert_no_false_satellite(&sim, &sink, "seed 5");
+    let found = acquired(&sink);
     for prn in [31u8, 26, 32, 25, 29, 22, 3, 16] {
         let t = found.iter().find(|f| f.0 == prn).map(|f| f.1);
         assert!(

@@ -319,6 +319,8 @@ pub struct Channel {
     tracked_cn0_dbhz: f64,
     /// The channel reached the tracking state (its pull-in confirmed the satellite).
     confirmed: bool,
+    /// [`Channel::release`] was called: the channel ends with its current interval.
+    release_requested: bool,
     low_cn0_count: u32,
     /// Accumulators of the current interval: E, P, L. The early replica leads the prompt by
     /// d/2 chip (its code phase is `c + d/2`), the late one lags it.
@@ -386,6 +388,7 @@ impl Channel {
             cn0_dbhz: start.cn0_dbhz,
             tracked_cn0_dbhz: start.cn0_dbhz,
             confirmed: false,
+            release_requested: false,
             low_cn0_count: 0,
             acc: [Complex64::new(0.0, 0.0); 3],
             acc_ms: 0,
@@ -515,6 +518,9 @@ impl Channel {
         self.update_detectors(p, timing.next_is_edge);
         if !self.interval_complete(ms_index, timing) {
             return None;
+        }
+        if self.release_requested {
+            self.state = ChannelState::Lost;
         }
         let bit = self.pending_bit.take();
         let (co, cl) = self.update_loops();
@@ -878,6 +884,13 @@ impl Channel {
         let d = loops.el_spacing_chips;
         self.taps = [d / 2.0, 0.0, -d / 2.0];
         self.loops = which;
+    }
+
+    /// Ends the channel from outside (its receiver found it follows another satellite's
+    /// cross-correlation): its report at the end of the current integration interval is its
+    /// last, in state [`ChannelState::Lost`].
+    pub fn release(&mut self) {
+        self.release_requested = true;
     }
 
     /// Whether the channel is running its aided tracking loops.

@@ -40,6 +40,29 @@ use rayon::prelude::*;
 pub const XCORR_MARGIN_DB: f64 = 12.0;
 /// See [`XCORR_MARGIN_DB`], Hz (the refined Doppler of a detection is good to a few hertz).
 pub const XCORR_DOPPLER_HZ: f64 = 25.0;
+/// A detection or unconfirmed channel this many dB or more below a tracked satellite is taken
+/// for its cross-correlation within the wider [`XCORR_WIDE_DOPPLER_HZ`] of a kHz line: no
+/// real satellite is that much weaker near a line by chance often, and cross-correlations
+/// of 48-52 dB-Hz satellites were measured 21-29 dB below them, 26-39 Hz off the line (the
+/// codes slide against each other at the difference of their code Dopplers, which moves the
+/// phase of the cross-correlation).
+pub const XCORR_WIDE_MARGIN_DB: f64 = 18.0;
+/// See [`XCORR_WIDE_MARGIN_DB`], Hz.
+pub const XCORR_WIDE_DOPPLER_HZ: f64 = 60.0;
+
+/// Whether a signal `margin_db` below another, `apart_hz` from it in Doppler, may be that
+/// one's cross-correlation ([`XCORR_MARGIN_DB`], [`XCORR_WIDE_MARGIN_DB`]).
+pub fn may_be_cross_correlation(apart_hz: f64, margin_db: f64) -> bool {
+    let off_line_hz = off_line_hz(apart_hz);
+    (off_line_hz <= XCORR_DOPPLER_HZ && margin_db >= XCORR_MARGIN_DB)
+        || (off_line_hz <= XCORR_WIDE_DOPPLER_HZ && margin_db >= XCORR_WIDE_MARGIN_DB)
+}
+
+/// How far a Doppler difference is from the nearest whole kHz, Hz.
+fn off_line_hz(apart_hz: f64) -> f64 {
+    (apart_hz - (apart_hz / 1000.0).round() * 1000.0).abs()
+}
+
 /// A detection whose C/N0 estimate (from the prompts after it) is below this starts no
 /// channel, dB-Hz: no loop tracks it.
 pub const MIN_START_CN0_DBHZ: f64 = 22.0;
@@ -334,7 +357,7 @@ impl ChannelManager {
             Some(s) => s.batch.as_ref().and_then(|b| self.engines.get(b.level)),
             None => None,
         };
-        match (engine, search) {
+        let outcome = match (engine, search) {
             (Some(engine), Some(s)) => {
                 let samples = window.get(s.first, s.len).unwrap_or(&[]);
                 let (results, ()) = rayon::join(|| engine.search(samples, &s.targets), run_all);
@@ -352,7 +375,9 @@ impl ChannelManager {
                 run_all();
                 None
             }
-        }
+        };
+        self.release_cross_correlations();
+        outcome
     }
 
     /// Hands the reports of the last [`ChannelManager::work`] to `f` as `(channel index,
@@ -382,12 +407,47 @@ impl ChannelManager {
         self.channels
             .iter()
             .filter(|c| c.state() != ChannelState::Lost && c.prn() != d.prn)
-            .find(|c| {
-                let apart = d.doppler_hz - c.doppler_hz();
-                let off_khz = apart - (apart / 1000.0).round() * 1000.0;
-                off_khz.abs() <= XCORR_DOPPLER_HZ && c.cn0_dbhz() - cn0 >= XCORR_MARGIN_DB
-            })
+            .find(|c| may_be_cross_correlation(d.doppler_hz - c.doppler_hz(), c.cn0_dbhz() - cn0))
             .map(Channel::prn)
+    }
+
+    /// Releases the channels still in their pull-in that follow a cross-correlation of a
+    /// confirmed channel: within [`XCORR_WIDE_DOPPLER_HZ`] of its kHz lines and
+    /// [`XCORR_WIDE_MARGIN_DB`] below it (the highest C/N0 the pull-in measured: a failing
+    /// pull-in's last estimate is no measure, and its Doppler wanders, so the tight rule for
+    /// detections is not used). A false channel locks on the strong satellite's carrier and
+    /// data and must never be confirmed (measured: one 29 dB below a 52 dB-Hz satellite
+    /// reached tracking).
+    fn release_cross_correlations(&mut self) {
+        let sources: Vec<(Prn, f64, f64)> = self
+            .channels
+            .iter()
+            .filter(|c| c.confirmed() && c.state() != ChannelState::Lost)
+            .map(|c| (c.prn(), c.doppler_hz(), c.cn0_dbhz()))
+            .collect();
+        for c in self
+            .channels
+            .iter_mut()
+            .filter(|c| !c.confirmed() && c.state() != ChannelState::Lost)
+        {
+            let own_cn0 = match c.tracked_cn0_dbhz() {
+                x if x.is_finite() => x.max(c.cn0_dbhz()),
+                _ => c.cn0_dbhz(),
+            };
+            let of = sources.iter().find(|&&(prn, doppler_hz, cn0)| {
+                prn != c.prn()
+                    && off_line_hz(c.doppler_hz() - doppler_hz) <= XCORR_WIDE_DOPPLER_HZ
+                    && cn0 - own_cn0 >= XCORR_WIDE_MARGIN_DB
+            });
+            if let Some(&(prn, _, cn0)) = of {
+                tracing::info!(
+                    "{}: released: its channel ({:.0} Hz, at most {own_cn0:.1} dB-Hz) follows a cross-correlation of {prn} ({cn0:.1} dB-Hz)",
+                    c.prn(),
+                    c.doppler_hz(),
+                );
+                c.release();
+            }
+        }
     }
 
     /// Starts channels for what a search found (`visibility` as in
