@@ -2,7 +2,8 @@
 //! and Q sign, from the configuration first, then SigMF metadata, then a WAV header.
 //!
 //! Metadata lookup for a path `P`:
-//! - `P` ends in `.sigmf-meta`: the data is `P` with `.sigmf-data` (an error if missing);
+//! - `P` ends in `.sigmf-meta`: the data is the file its `core:dataset` names beside it, else
+//!   `P` with `.sigmf-data` (an error if missing);
 //! - otherwise the metadata is `P` with its extension replaced by `.sigmf-meta` (what
 //!   [`crate::sigmf::write_sigmf_meta`] writes), or else `P` + `.sigmf-meta`, if either exists;
 //! - without metadata, a file starting with a RIFF/WAVE header is read as WAV.
@@ -56,7 +57,8 @@ fn has_extension(path: &Path, ext: &str) -> bool {
 /// Finds the data file and its metadata file for `path`.
 pub(crate) fn locate(path: &Path) -> Result<(PathBuf, Option<PathBuf>), SampleError> {
     if has_extension(path, "sigmf-meta") {
-        let data = path.with_extension("sigmf-data");
+        let data =
+            crate::sigmf::dataset_path(path)?.unwrap_or_else(|| path.with_extension("sigmf-data"));
         if !data.is_file() {
             return Err(SampleError::SigmfMissingData {
                 meta: path.to_path_buf(),

@@ -54,6 +54,7 @@ const KNOWN_GLOBAL_KEYS: &[&str] = &[
     "gpsrx:invert_q",
     "gpsrx:packed_map",
     "core:datetime",
+    "core:dataset",
 ];
 
 /// The parts of a SigMF metadata file gpsrx uses.
@@ -289,6 +290,14 @@ pub fn write_sigmf_meta(data_path: &Path, meta: &SigmfMeta) -> Result<PathBuf, S
         "core:extensions".into(),
         json!([{ "name": "gpsrx", "version": env!("CARGO_PKG_VERSION"), "optional": true }]),
     );
+    // SigMF names the data `STEM.sigmf-data`; a data file named by its format (`signal.ci8`)
+    // is a "non-conforming dataset", named in `core:dataset` so that other readers find it.
+    let conforming = data_path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("sigmf-data"));
+    if let (false, Some(name)) = (conforming, data_path.file_name().and_then(|n| n.to_str())) {
+        global.insert("core:dataset".into(), json!(name));
+    }
     global.insert("gpsrx:if_hz".into(), json!(meta.if_hz));
     global.insert("gpsrx:invert_q".into(), json!(meta.invert_q));
     if let Some(map) = meta.packed_map {
@@ -314,6 +323,22 @@ pub fn write_sigmf_meta(data_path: &Path, meta: &SigmfMeta) -> Result<PathBuf, S
     })?;
     std::fs::write(&meta_path, text + "\n").map_err(|e| SampleError::io("write", &meta_path, e))?;
     Ok(meta_path)
+}
+
+/// The data file a `.sigmf-meta` file names in `global.core:dataset` (a "non-conforming
+/// dataset", beside the metadata), if it names one.
+pub fn dataset_path(meta_path: &Path) -> Result<Option<PathBuf>, SampleError> {
+    let text =
+        std::fs::read_to_string(meta_path).map_err(|e| SampleError::io("read", meta_path, e))?;
+    let doc: Value = serde_json::from_str(&text).map_err(|e| SampleError::SigmfInvalid {
+        path: meta_path.to_path_buf(),
+        reason: format!("not valid JSON ({e})"),
+    })?;
+    let name = doc
+        .get("global")
+        .and_then(|g| g.get("core:dataset"))
+        .and_then(Value::as_str);
+    Ok(name.map(|n| meta_path.parent().unwrap_or(Path::new("")).join(n)))
 }
 
 /// Reads a `.sigmf-meta` file. Requires `global.core:datatype`; everything else is optional.

@@ -683,6 +683,13 @@ fn sigmf_round_trip_and_open_from_metadata() {
     .expect("meta");
     let mut src = open_source(&SourceConfig::new(&raw)).expect("open");
     assert_eq!(read_all(src.as_mut()).expect("read")[0], c(1.0, -2.0));
+    // The metadata names its non-conforming data file (SigMF core:dataset), so the recording
+    // opens from the .sigmf-meta too (as sigmf-python opens it).
+    let meta_path = raw.with_extension("sigmf-meta");
+    let text = std::fs::read_to_string(&meta_path).expect("meta text");
+    assert!(text.contains(r#""core:dataset": "cap.ci8""#), "{text}");
+    let mut src = open_source(&SourceConfig::new(&meta_path)).expect("open by its meta");
+    assert_eq!(read_all(src.as_mut()).expect("read")[0], c(1.0, -2.0));
     // --fs overriding the metadata is allowed, with a warning.
     let src = open_source(&SourceConfig::new(&raw).with_fs_hz(2.0e6)).expect("open");
     assert!(
