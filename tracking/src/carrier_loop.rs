@@ -134,6 +134,26 @@ impl CarrierLoop {
         }
     }
 
+    /// The same loop with the settings `cfg` (another bandwidth or order): the frequency it
+    /// holds and, from a 3rd-order loop to a 3rd-order loop, the Doppler rate it holds carry
+    /// over, so that the switch itself moves the NCO by nothing (a bumpless transfer). The
+    /// FLL history restarts.
+    ///
+    /// Errors: `cfg` out of range.
+    pub fn retuned(&self, cfg: &LoopConfig) -> Result<Self, ConfigError> {
+        let mut next = Self::new(cfg, self.frequency_memory_hz())?;
+        if let Some(rate) = self.filter.rate_memory() {
+            next.preset_doppler_rate(rate);
+        }
+        Ok(next)
+    }
+
+    /// Moves the Doppler-rate memory of a 3rd-order loop by `delta_hz_s` (see
+    /// [`LoopFilter::shift_rate`]), as [`CarrierLoop::shift_base_hz`] moves its frequency.
+    pub fn shift_doppler_rate(&mut self, delta_hz_s: f64) {
+        self.filter.shift_rate(delta_hz_s);
+    }
+
     /// Presets the Doppler-rate memory of a 3rd-order loop (Hz/s); see
     /// [`LoopFilter::preset_rate`].
     pub fn preset_doppler_rate(&mut self, rate_hz_s: f64) {

@@ -29,6 +29,7 @@ use gpsrx_dsp::correlator::{Correlator, PackedCode, ReplicaState, SampleSlice};
 use num_complex::{Complex32, Complex64};
 use serde::{Deserialize, Serialize};
 
+mod narrowing;
 mod realign;
 pub use realign::CodeShift;
 
@@ -302,6 +303,8 @@ pub struct Channel {
     aid: Option<(DopplerAid, f64)>,
     /// The feed-forward contained in the current NCO frequency, Hz (None: unaided).
     ff_applied_hz: Option<f64>,
+    /// The Doppler rate of the last feed-forward applied, Hz/s (0 unaided).
+    ff_rate_applied_hz_s: f64,
     /// Which tracking loops run (after pull-in).
     loops: TrackLoops,
     /// The C/N0 has fallen below [`ChannelConfig::weak_enter_dbhz`] (and not yet climbed back
@@ -321,6 +324,8 @@ pub struct Channel {
     confirmed: bool,
     /// [`Channel::release`] was called: the channel ends with its current interval.
     release_requested: bool,
+    /// The carrier loop is being narrowed in stages to its tracking loops.
+    narrowing: Option<narrowing::Narrowing>,
     low_cn0_count: u32,
     /// Accumulators of the current interval: E, P, L. The early replica leads the prompt by
     /// d/2 chip (its code phase is `c + d/2`), the late one lags it.
@@ -379,6 +384,7 @@ impl Channel {
             carrier_freq_hz: start.doppler_hz,
             aid: None,
             ff_applied_hz: None,
+            ff_rate_applied_hz_s: 0.0,
             loops: TrackLoops::Normal,
             weak: start.cn0_dbhz < cfg.weak_enter_dbhz,
             acc_feedforward_hz: None,
@@ -389,6 +395,7 @@ impl Channel {
             tracked_cn0_dbhz: start.cn0_dbhz,
             confirmed: false,
             release_requested: false,
+            narrowing: None,
             low_cn0_count: 0,
             acc: [Complex64::new(0.0, 0.0); 3],
             acc_ms: 0,
@@ -529,6 +536,7 @@ impl Channel {
         self.acc_ms = 0;
         self.maybe_hand_over(timing.next_is_edge);
         self.maybe_switch_loops(timing.next_is_edge);
+        self.maybe_narrow(timing.next_is_edge);
         Some(epoch)
     }
 
@@ -720,10 +728,23 @@ impl Channel {
     fn update_loops(&mut self) -> (CarrierOutput, CodeOutput) {
         let [ea, pa, la] = self.acc;
         let ff_opt = self.feedforward_hz(self.carrier.t_coh_s());
+        // The aid coming or going: the loop stops or starts holding what the feed-forward
+        // supplies, its Doppler and its Doppler rate, so the NCO does not move (bumpless).
+        // Keeping the rate a 3rd-order loop learned in a turn would count it twice.
+        let ff_rate = self.aid.map_or(0.0, |(a, _)| a.doppler_rate_hz_s);
         match (self.ff_applied_hz, ff_opt) {
-            (None, Some(f)) => self.carrier.shift_base_hz(-f),
-            (Some(f), None) => self.carrier.shift_base_hz(f),
-            _ => {}
+            (None, Some(f)) => {
+                self.carrier.shift_base_hz(-f);
+                self.carrier.shift_doppler_rate(-ff_rate);
+                self.ff_rate_applied_hz_s = ff_rate;
+            }
+            (Some(f), None) => {
+                self.carrier.shift_base_hz(f);
+                self.carrier.shift_doppler_rate(self.ff_rate_applied_hz_s);
+                self.ff_rate_applied_hz_s = 0.0;
+            }
+            (Some(_), Some(_)) => self.ff_rate_applied_hz_s = ff_rate,
+            (None, None) => {}
         }
         self.ff_applied_hz = ff_opt;
         let ff = ff_opt.unwrap_or(0.0);
@@ -816,10 +837,8 @@ impl Channel {
         }
         let which = self.wanted_loops();
         let loops = self.loop_config(which);
-        let (Ok(carrier), Ok(code_loop)) = (
-            CarrierLoop::new(&loops, self.carrier.frequency_memory_hz()),
-            CodeLoop::new(&loops),
-        ) else {
+        let (Some(carrier), Ok(code_loop)) = (self.carrier_toward(&loops), CodeLoop::new(&loops))
+        else {
             return; // validated at construction; keep pulling in otherwise
         };
         self.carrier = carrier;
@@ -873,10 +892,8 @@ impl Channel {
             return;
         }
         let loops = self.loop_config(which);
-        let (Ok(carrier), Ok(code_loop)) = (
-            CarrierLoop::new(&loops, self.carrier.frequency_memory_hz()),
-            CodeLoop::new(&loops),
-        ) else {
+        let (Some(carrier), Ok(code_loop)) = (self.carrier_toward(&loops), CodeLoop::new(&loops))
+        else {
             return;
         };
         self.carrier = carrier;

@@ -257,6 +257,22 @@ impl LoopFilter {
         }
     }
 
+    /// The rate memory of a two-integrator filter (a 3rd-order PLL's Doppler rate, Hz/s, held
+    /// by its inner integrator); `None` for filters with fewer integrators.
+    pub fn rate_memory(&self) -> Option<f64> {
+        (self.n_int == 2).then_some(self.y[0])
+    }
+
+    /// Moves the rate memory of a two-integrator filter by `delta` (Hz/s): when a
+    /// feed-forward starts supplying a Doppler rate the loop had learned (or stops), the loop
+    /// must stop (or start) holding it. No effect on filters with fewer integrators.
+    pub fn shift_rate(&mut self, delta: f64) {
+        if self.n_int == 2 && delta.is_finite() {
+            self.y[0] += delta;
+            self.x_prev[1] += delta;
+        }
+    }
+
     /// Clears the integrators.
     pub fn reset(&mut self) {
         self.y = [0.0; 2];
