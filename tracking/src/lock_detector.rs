@@ -8,6 +8,15 @@
 //! and `E[NBP] = M^2 A^2 + 2M`, so the indicator reads `cos(2 phi) * rho/(rho + 1)` with
 //! `rho = M C/N0 T`: the coherent sum keeps that factor near 1 (0.95 at 30 dB-Hz, M T = 20 ms).
 //!
+//! A loop that tracks with a steady phase offset (a 2nd-order loop under a constant Doppler
+//! rate, e.g. the ramp an INS accelerometer bias leaves in the feed-forward: `B / (lambda w0^2)`
+//! cycles, 0.1-0.16 cycle at 0.4 Hz for 1 mg) reads a low `cos 2phi` although it holds the
+//! signal. The lock test therefore asks whether the phase is *steady*: with also
+//! `NBS = 2 I Q` low-passed, `|(NBD, NBS)| / NBP` estimates `|E[exp(2 j phi)]|` (1 for any steady
+//! phase, 0 for a wandering one) and `atan2(NBS, NBD) / 2` the steady offset, which must stay
+//! within [`PllLockConfig::max_offset_cycles`] of zero (a Costas discriminator slips at 1/4
+//! cycle). Without an offset the test is the classic `cos 2phi >= threshold`.
+//!
 //! Code lock: the C/N0 estimate (see [`crate::cn0`]) against a threshold.
 //!
 //! Both decisions go through a [`Hysteresis`] up/down counter: lock is declared when the counter
@@ -73,6 +82,8 @@ pub struct PllLockConfig {
     pub threshold: f64,
     /// Hysteresis counter length, tests.
     pub count: u32,
+    /// Largest steady phase offset still counted as lock, cycles.
+    pub max_offset_cycles: f64,
 }
 
 impl Default for PllLockConfig {
@@ -82,6 +93,7 @@ impl Default for PllLockConfig {
             alpha: 0.1,
             threshold: 0.7,
             count: 10,
+            max_offset_cycles: 0.2,
         }
     }
 }
@@ -93,6 +105,7 @@ pub struct PllLockDetector {
     sum: Complex64,
     n: u32,
     nbd: f64,
+    nbs: f64,
     nbp: f64,
     primed: bool,
     hyst: Hysteresis,
@@ -116,6 +129,7 @@ impl PllLockDetector {
             sum: Complex64::new(0.0, 0.0),
             n: 0,
             nbd: 0.0,
+            nbs: 0.0,
             nbp: 0.0,
             primed: false,
             hyst: Hysteresis::new(cfg.count),
@@ -134,15 +148,33 @@ impl PllLockDetector {
         let (i, q) = (self.sum.re, self.sum.im);
         self.sum = Complex64::new(0.0, 0.0);
         self.n = 0;
-        let (nbd, nbp) = (i * i - q * q, i * i + q * q);
+        let (nbd, nbs, nbp) = (i * i - q * q, 2.0 * i * q, i * i + q * q);
         if self.primed {
             self.nbd += self.cfg.alpha * (nbd - self.nbd);
+            self.nbs += self.cfg.alpha * (nbs - self.nbs);
             self.nbp += self.cfg.alpha * (nbp - self.nbp);
         } else {
-            (self.nbd, self.nbp, self.primed) = (nbd, nbp, true);
+            (self.nbd, self.nbs, self.nbp, self.primed) = (nbd, nbs, nbp, true);
         }
-        let c = self.cos_2phi();
-        self.hyst.update(c >= self.cfg.threshold)
+        let steady = self.phase_steadiness() >= self.cfg.threshold
+            && self.phase_offset_cycles().abs() <= self.cfg.max_offset_cycles;
+        self.hyst.update(steady)
+    }
+
+    /// `|E[exp(2 j phi)]|` estimated as `|(NBD, NBS)| / NBP`: 1 for a steady phase (whatever
+    /// its offset), 0 for a wandering one (0 before the first test).
+    pub fn phase_steadiness(&self) -> f64 {
+        if self.nbp > 0.0 {
+            self.nbd.hypot(self.nbs) / self.nbp
+        } else {
+            0.0
+        }
+    }
+
+    /// The steady phase offset, `atan2(NBS, NBD) / 2`, cycles in `(-1/4, 1/4]` (a data bit
+    /// flips the sign of the prompt: the offset is known modulo a half cycle).
+    pub fn phase_offset_cycles(&self) -> f64 {
+        0.5 * self.nbs.atan2(self.nbd) / std::f64::consts::TAU
     }
 
     /// The filtered `cos(2 phi)` indicator (0 before the first test).
@@ -216,8 +248,36 @@ mod tests {
                 d.update(Complex64::from_polar(bit * 5.0, deg.to_radians()));
             }
             assert!((d.cos_2phi() - (2.0 * deg.to_radians()).cos()).abs() < 1e-9);
-            assert_eq!(d.locked(), deg < 22.0);
+            // A steady phase up to max_offset_cycles (72 deg) is lock.
+            assert_eq!(d.locked(), deg < 72.0);
         }
+    }
+
+    #[test]
+    fn a_steady_offset_within_the_limit_is_lock_and_a_wandering_phase_is_not() {
+        // A 2nd-order loop's static offset of 0.12 cycle (43 deg): cos 2phi = 0.13, yet the
+        // phase is steady; 0.23 cycle is too near the Costas slip at 1/4.
+        for (offset, want) in [(0.12_f64, true), (-0.15, true), (0.23, false)] {
+            let mut d = PllLockDetector::new(PllLockConfig::default());
+            for k in 0..2000 {
+                let bit = if (k / 20) % 3 == 0 { -1.0 } else { 1.0 };
+                d.update(Complex64::from_polar(
+                    bit * 5.0,
+                    offset * std::f64::consts::TAU,
+                ));
+            }
+            assert!((d.phase_offset_cycles() - offset).abs() < 1e-9, "{offset}");
+            assert!((d.phase_steadiness() - 1.0).abs() < 1e-9);
+            assert_eq!(d.locked(), want, "offset {offset} cycle");
+        }
+        // A phase turning at 2 Hz (a frequency error): never steady.
+        let mut d = PllLockDetector::new(PllLockConfig::default());
+        for k in 0..2000 {
+            let phi = std::f64::consts::TAU * 2.0 * f64::from(k) * 1e-3;
+            d.update(Complex64::from_polar(5.0, phi));
+        }
+        assert!(d.phase_steadiness() < 0.3, "{}", d.phase_steadiness());
+        assert!(!d.locked());
     }
 
     #[test]

@@ -48,7 +48,7 @@ pub enum Command {
     Track(TrackArgs),
     /// Process a recording into position fixes and standard files (RINEX, NMEA, GeoJSON, KML, CSV).
     #[command(after_help = RUN_EXIT_STATUS)]
-    Run(RunArgs),
+    Run(Box<RunArgs>),
     /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
     Config(ConfigArgs),
     /// Loop studies: steady-state errors, bandwidth vs noise, high dynamics (seed 004).

@@ -95,6 +95,10 @@ pub struct RunArgs {
     /// RAIM false-alarm probability [default: 0.001].
     #[arg(long, value_name = "P")]
     pub raim_pfa: Option<f64>,
+    /// Largest PDOP of a valid fix [default: 20]: worse geometries are written flagged
+    /// (quality `none`), as their errors are the code noise times the PDOP.
+    #[arg(long, value_name = "PDOP")]
+    pub max_pdop: Option<f64>,
     /// Landmark range observations, CSV `tow_s,x_m,y_m,z_m,range_m,sigma_m` (seed 001): added to
     /// the fixes without a clock term, so 3 satellites and 1 landmark give a fix.
     #[arg(long, value_name = "FILE")]
@@ -180,6 +184,7 @@ impl RunArgs {
         set(&mut r.rate_hz, self.rate);
         set(&mut r.elevation_mask_deg, self.elevation_mask);
         set(&mut r.raim_pfa, self.raim_pfa);
+        set(&mut r.max_pdop, self.max_pdop);
         set(&mut r.acq_pfa, self.acq_pfa);
         set(&mut r.search_budget_s, self.search_budget);
         set(&mut r.doppler_max_hz, self.doppler_max);

@@ -63,6 +63,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         acq_coherent_ms: None,
         acq_noncoherent: None,
         raim_pfa: None,
+        max_pdop: None,
         acq_pfa: None,
         search_budget: None,
         allow_unhealthy: false,

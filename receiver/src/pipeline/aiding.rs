@@ -50,7 +50,7 @@ const RATE_STEP_S: f64 = 0.01;
 /// A band limiter that has not been stepped for this long restarts from its input, s.
 const LIMITER_RESTART_S: f64 = 1.0;
 /// Time constant of the receiver clock drift smoothing, s.
-pub const DRIFT_SMOOTHING_S: f64 = 1.0;
+pub const DRIFT_SMOOTHING_S: f64 = 30.0;
 
 /// What the receiver has learned that the feed-forward needs; updated as the run goes.
 #[derive(Debug, Clone, Default)]

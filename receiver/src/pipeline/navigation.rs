@@ -51,6 +51,8 @@ pub struct NavigationProcessor {
     iono_fallback_said: bool,
     /// The RAIM outcome last logged (transitions are logged).
     last_raim: Option<RaimStatus>,
+    /// A too-poor geometry has been logged and has not improved since.
+    poor_geometry_logged: bool,
     /// Per channel: receive time of its last channel row.
     last_row_t: BTreeMap<usize, f64>,
     /// Latest sample index a progress report was made for.
@@ -161,6 +163,7 @@ impl NavigationProcessor {
             prior: None,
             iono_fallback_said: false,
             last_raim: None,
+            poor_geometry_logged: false,
             last_row_t: BTreeMap::new(),
             progress_at: 0,
             stats: FixStats::default(),
@@ -1039,6 +1042,18 @@ impl NavigationProcessor {
         }
     }
 
+    /// Logs the start of a stretch of solutions whose geometry is too poor to hand out
+    /// ([`RunSettings::max_pdop`]).
+    fn log_poor_geometry(&mut self, t_stream_s: f64, pdop: f64, n_sv: usize) {
+        if !self.poor_geometry_logged {
+            tracing::info!(
+                "{t_stream_s:.2} s: PDOP {pdop:.1} with {n_sv} satellites is above the largest PDOP {} (--max-pdop): fixes flagged invalid until the geometry improves",
+                self.settings.max_pdop
+            );
+            self.poor_geometry_logged = true;
+        }
+    }
+
     /// Logs a change of the RAIM outcome at INFO: an exclusion (with the residuals of the
     /// rest), a fault that could not be excluded, and the return to a clean test.
     fn log_raim(&mut self, t_stream_s: f64, sol: &PvtSolution) {
@@ -1086,7 +1101,14 @@ impl NavigationProcessor {
         }
         let ephs = self.ephemerides(&epoch);
         let solution = self.solution(&epoch, &ephs);
-        let valid = solution.as_ref().is_some_and(passes_integrity);
+        let max_pdop = self.settings.max_pdop;
+        let integrity_ok = solution.as_ref().is_some_and(passes_integrity);
+        let valid = integrity_ok && solution.as_ref().is_some_and(|s| s.dop.pdop <= max_pdop);
+        if let Some(s) = solution.as_ref().filter(|s| s.dop.pdop > max_pdop) {
+            self.log_poor_geometry(epoch.sample / self.fs_hz, s.dop.pdop, s.n_sv);
+        } else {
+            self.poor_geometry_logged = false;
+        }
         sink.observables(&ObservablesReport {
             epoch: obs_epoch(&epoch),
             fix_position_m: solution
@@ -1101,7 +1123,12 @@ impl NavigationProcessor {
         };
         let t_stream_s = epoch.sample / self.fs_hz;
         self.log_raim(t_stream_s, &sol);
-        self.failed_in_row = if valid { 0 } else { self.failed_in_row + 1 };
+        // A poor geometry is no sign of a wrong time: only integrity failures count.
+        self.failed_in_row = if integrity_ok {
+            0
+        } else {
+            self.failed_in_row + 1
+        };
         if self.failed_in_row >= 3 {
             self.drop_carried_times(t_stream_s);
         }
