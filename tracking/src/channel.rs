@@ -97,10 +97,16 @@ impl Default for ChannelConfig {
                 ..LoopConfig::default()
             },
             aided_track: None,
-            // Below 32 dB-Hz: 20 ms coherent (bit-aligned), 2nd-order PLL at 5 Hz, DLL 0.5 Hz.
+            // Below 32 dB-Hz: 20 ms coherent (bit-aligned), 3rd-order PLL at 6 Hz, DLL 0.5 Hz.
+            // 3rd order: no steady-state phase error under a constant LOS acceleration (a 2nd
+            // order loop at 5 Hz lags `(a/lambda)/wn^2` = 32 deg at 1.5 m/s^2, past the lock
+            // indicator's 22.8 deg, so a weak satellite of an accelerating car was dropped
+            // from the fixes); a 0.5 s jerk ramp to 1.5 m/s^2 (3 m/s^3 = 15.8 Hz/s^2) costs
+            // `j/wn^3` = 0.035 cycle (wn = 6/0.7845 = 7.65 rad/s); thermal jitter at 28 dB-Hz
+            // 6.4 deg with the realised Bn (7.6 Hz at Bn T = 0.12, tracking/README.md).
             weak_track: Some(LoopConfig {
-                pll_order: 2,
-                pll_bw_hz: 5.0,
+                pll_order: 3,
+                pll_bw_hz: 6.0,
                 fll_order: 0,
                 fll_bw_hz: 0.0,
                 dll_order: 1,

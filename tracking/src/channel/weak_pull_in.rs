@@ -29,10 +29,15 @@
 //!    which a 28 dB-Hz signal reaches in about 2.5 s (the true bin gains `1/2 - q` = 0.23 per
 //!    bit on the others).
 //! 2. **Phase** ([`WeakPullInConfig::pll`]), from the first bit edge after synchronisation:
-//!    bit-aligned 20 ms sums, a 2nd-order Costas PLL at 3 Hz assisted by a 1st-order FLL at
-//!    1.5 Hz (`Bn T` = 0.06 and 0.03, stable to 0.3: `tracking/README.md`) for
-//!    [`WeakPullInConfig::fll_assist_s`], then the PLL alone. Thermal jitter
-//!    `sqrt(Bn/(C/N0) (1 + 1/(2 T C/N0)))` = 0.070 rad = 4.0 deg at 28 dB-Hz.
+//!    bit-aligned 20 ms sums, a 3rd-order Costas PLL at 5 Hz assisted by a 2nd-order FLL at
+//!    2.5 Hz (`Bn T` = 0.1; this pair goes unstable at 0.37, `tracking/README.md`) for
+//!    [`WeakPullInConfig::fll_assist_s`], then the PLL alone. The FLL discriminator on
+//!    consecutive bit-aligned 20 ms sums is data-insensitive over +-12.5 Hz, five times the
+//!    frequency stage's residual. Third order: a constant line-of-sight acceleration leaves
+//!    no phase error (a 2nd-order loop at 3 Hz would lag `(a/lambda)/wn^2` = 0.25 cycle at
+//!    1.5 m/s^2, 7.9 Hz/s: measured, the weak satellites of an accelerating car slipped).
+//!    Thermal jitter `sqrt(Bn/(C/N0) (1 + 1/(2 T C/N0)))` with the realised Bn (1.22 x 5 Hz at
+//!    `Bn T` = 0.1) = 0.100 rad = 5.7 deg at 28 dB-Hz.
 //! 3. **Hand-over** to the weak tracking loops ([`super::ChannelConfig::weak_track`]) once the
 //!    PLL lock indicator (`cos 2 phi` of 20 ms sums, [`crate::lock_detector`]) says locked.
 //!    It reads `cos(2 phi) rho/(rho + 1)` with `rho = 20 C/N0 T`: 0.93 x cos(8 deg) at
@@ -108,10 +113,10 @@ impl Default for WeakPullInConfig {
                 ..LoopConfig::default()
             },
             pll: LoopConfig {
-                pll_order: 2,
-                pll_bw_hz: 3.0,
-                fll_order: 1,
-                fll_bw_hz: 1.5,
+                pll_order: 3,
+                pll_bw_hz: 5.0,
+                fll_order: 2,
+                fll_bw_hz: 2.5,
                 dll_order: 1,
                 dll_bw_hz: 0.5,
                 t_coh_s: 20.0e-3,
