@@ -14,7 +14,8 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 const FS: f64 = 2.048e6;
 const PRN: u8 = 11;
 const DOPPLER_HZ: f64 = -1234.5;
-/// The first data-bit edge falls at the start of code period 7 of the signal.
+/// The first data-bit edge falls at the start of code period 7 of the signal (unless a test
+/// moves it: [`Signal::edge_period`]).
 const EDGE_PERIOD: u64 = 7;
 
 /// A signal at `cn0_dbhz` (`None`: noise alone) against noise of unit total variance:
@@ -25,6 +26,8 @@ struct Signal {
     bits: Vec<f64>,
     rng: Xoshiro256PlusPlus,
     next: u64,
+    /// Data-bit edges fall at the starts of code periods `edge_period mod 20`.
+    edge_period: u64,
 }
 
 impl Signal {
@@ -39,12 +42,13 @@ impl Signal {
             bits,
             rng,
             next: 0,
+            edge_period: EDGE_PERIOD,
         }
     }
 
     /// The data bit of code period `m` (bit 0 before the first edge).
     fn bit_of_period(&self, m: u64) -> f64 {
-        let idx = (m + 20 - EDGE_PERIOD) / 20;
+        let idx = (m + 20 - self.edge_period) / 20;
         self.bits[idx as usize % self.bits.len()]
     }
 
@@ -218,4 +222,45 @@ fn strong_acquisitions_keep_the_normal_pull_in_and_weak_settings_are_checked() {
     assert!(msg.contains("patience_s"), "{msg}");
     // The lead threshold of the weak bit synchroniser (module documentation): 18 at 26 dB-Hz.
     assert_eq!(WeakPullInConfig::default().bit_sync_config().min_lead, 18);
+}
+
+#[test]
+fn the_weak_pull_in_holds_28_and_30_dbhz_whatever_the_seed_edge_and_doppler_error() {
+    // Six runs at each C/N0: other noise and data, bit edges at other code periods, the
+    // acquisition's Doppler -8 to +12 Hz off. Every run is held for 10 s with the true edges.
+    let mut summary = Vec::new();
+    for (cn0, first_seed) in [(28.0, 100u64), (30.0, 200)] {
+        let mut handovers = Vec::new();
+        for seed in first_seed..first_seed + 6 {
+            let mut sig = Signal::new(Some(cn0), seed);
+            sig.edge_period = (seed * 7) % 20;
+            let off_hz = (seed % 6) as f64 * 4.0 - 8.0;
+            let cfg = ChannelConfig::default();
+            let mut ch =
+                Channel::new(&start(DOPPLER_HZ + off_hz, cn0 + 1.0), FS, &cfg).expect("channel");
+            let reports = run(&mut ch, &mut sig, 10.0);
+            assert_eq!(
+                ch.state(),
+                ChannelState::Track,
+                "{cn0} dB-Hz, seed {seed}, {off_hz} Hz off: not held"
+            );
+            let edges_ok = reports
+                .iter()
+                .filter_map(|e| e.bit_start_ms)
+                .all(|m| m % 20 == sig.edge_period);
+            assert!(edges_ok, "{cn0} dB-Hz, seed {seed}: wrong bit edges");
+            let t = reports
+                .iter()
+                .find(|e| e.state == ChannelState::Track)
+                .map_or(f64::NAN, |e| e.t_rx_s);
+            assert!(t < 7.0, "{cn0} dB-Hz, seed {seed}: hand-over at {t} s");
+            handovers.push(t);
+        }
+        let mean = handovers.iter().sum::<f64>() / handovers.len() as f64;
+        let max = handovers.iter().copied().fold(0.0, f64::max);
+        summary.push(format!(
+            "{cn0} dB-Hz: hand-over mean {mean:.2} s, max {max:.2} s"
+        ));
+    }
+    eprintln!("{}", summary.join("; "));
 }
