@@ -2,7 +2,9 @@
 //! code period over a shared window of samples.
 //!
 //! States: [`ChannelState::PullIn`] (1 ms integration, the wide FLL-assisted pull-in loops,
-//! bit synchronisation) -> [`ChannelState::Track`] (the user's loops and integration time,
+//! bit synchronisation; or, for an acquisition below [`WeakPullInConfig::enter_dbhz`], the
+//! weak-signal pull-in of [`weak_pull_in`](WeakPullInConfig): FLL on 10 ms sums, differential
+//! bit synchronisation, bit-aligned 20 ms PLL) -> [`ChannelState::Track`] (the user's loops and integration time,
 //! integrations aligned to data-bit edges) -> [`ChannelState::Lost`] (C/N0 below the threshold for
 //! too long: the channel is released and the satellite goes back to acquisition).
 //!
@@ -198,7 +200,8 @@ impl ChannelConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ChannelState {
-    /// Wide loops at 1 ms, waiting for phase lock and bit synchronisation.
+    /// Wide loops at 1 ms (or the weak-signal pull-in's 10 ms FLL and 20 ms PLL), waiting for
+    /// phase lock and bit synchronisation.
     PullIn,
     /// The user's loops, integrations aligned to data bits.
     Track,
