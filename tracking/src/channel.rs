@@ -4,9 +4,10 @@
 //! States: [`ChannelState::PullIn`] (1 ms integration, the wide FLL-assisted pull-in loops,
 //! bit synchronisation; or, for an acquisition below [`WeakPullInConfig::enter_dbhz`], the
 //! weak-signal pull-in of [`weak_pull_in`](WeakPullInConfig): FLL on 10 ms sums, differential
-//! bit synchronisation, bit-aligned 20 ms PLL) -> [`ChannelState::Track`] (the user's loops and integration time,
-//! integrations aligned to data-bit edges) -> [`ChannelState::Lost`] (C/N0 below the threshold for
-//! too long: the channel is released and the satellite goes back to acquisition).
+//! bit synchronisation, bit-aligned 20 ms PLL) -> [`ChannelState::Track`] (the user's loops
+//! and integration time, integrations aligned to data-bit edges) -> [`ChannelState::Lost`]
+//! (C/N0 below the threshold for too long: the channel is released and the satellite goes back
+//! to acquisition).
 //!
 //! Every integration starts at the first sample of a C/A code period of the replica: the span of
 //! a period is `n = ceil((1023 - c0) fs / r)` samples for a code phase `c0` (chips, in [0, 1))
@@ -517,9 +518,9 @@ impl Channel {
     /// Forgets the data-bit edges (after samples were lost, the bits no longer fall where they
     /// did): the bit synchroniser starts again on the coming prompts; the loops keep running.
     /// Only a channel integrating 1 ms: longer integrations are aligned to the bit edges and
-    /// would stop until new ones are found.
+    /// would stop until new ones are found (a weak pull-in goes back to its frequency stage,
+    /// whose sums need no edges).
     pub fn restart_bit_sync(&mut self) {
-        // A weak pull-in goes back to its frequency stage (unaligned sums) instead.
         if self.weak_stage.is_none() && (self.carrier.t_coh_s() * 1e3).round() as usize != 1 {
             return;
         }

@@ -116,6 +116,24 @@ fn a_28_dbhz_signal_is_pulled_in_bit_synchronised_and_held() {
         confirmed_at.is_some_and(|t| t < 8.0),
         "hand-over at {confirmed_at:?} s (want within 8 s)"
     );
+    // Before the bit edges are known, the unaligned 10 ms NWPR estimate (after its first
+    // 0.2 s) reads the C/N0 to within 2.5 dB on average (its edge loss at this C/N0: module
+    // documentation) and never as low as the loss threshold.
+    let presync: Vec<f64> = reports
+        .iter()
+        .filter(|e| e.t_coh_s < 0.015 && e.t_rx_s > 0.2 && e.state == ChannelState::PullIn)
+        .map(|e| e.cn0_dbhz)
+        .collect();
+    let presync_mean = presync.iter().sum::<f64>() / presync.len().max(1) as f64;
+    assert!(
+        presync.len() > 50
+            && (presync_mean - 28.0).abs() < 2.5
+            && presync
+                .iter()
+                .all(|&c| c > WeakPullInConfig::default().lost_dbhz),
+        "pre-sync C/N0 {presync_mean:.2} dB-Hz over {} reports",
+        presync.len()
+    );
     // The bit edges found are the true ones: every bit starts on a code period m with
     // m = EDGE_PERIOD mod 20 (the channel's code periods are the signal's: code start 0).
     let bits: Vec<(u64, i8)> = reports
@@ -153,7 +171,7 @@ fn a_28_dbhz_signal_is_pulled_in_bit_synchronised_and_held() {
         "phase lock through the last 5 s"
     );
     eprintln!(
-        "28 dB-Hz: hand-over at {confirmed_at:?} s, {} bits, agreement {agree:.4}, C/N0 {cn0:.2} dB-Hz, Doppler error {df:.3} Hz",
+        "28 dB-Hz: pre-sync C/N0 {presync_mean:.2} dB-Hz, hand-over at {confirmed_at:?} s, {} bits, agreement {agree:.4}, C/N0 {cn0:.2} dB-Hz, Doppler error {df:.3} Hz",
         bits.len()
     );
 }
