@@ -69,7 +69,7 @@ pub fn default_toml() -> anyhow::Result<String> {
          # while the bits are synchronised differentially, then a bit-aligned 20 ms PLL, then\n\
          # [tracking.weak_track]. Remove the section's keys to keep its defaults.\n\
          [tracking.weak_pull_in]\n\
-         enter_dbhz = {:?}         # acquisition C/N0 below which a channel takes this pull-in, dB-Hz\n\
+         enter_dbhz = {:?}         # acquisition C/N0 below which a channel takes this pull-in, dB-Hz (0: never)\n\
          fll_assist_s = {:?}        # the phase stage's FLL assist is switched off after this, s\n\
          bit_sync_dbhz = {:?}      # design C/N0 of the bit synchroniser's threshold, dB-Hz\n\
          p_false_sync = {:?}    # false bit-synchronisation probability it is sized for\n\

@@ -84,7 +84,8 @@ pub const PRESYNC_BLOCK_PROMPTS: u32 = 10;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct WeakPullInConfig {
-    /// Acquisition C/N0 below which a channel takes the weak pull-in, dB-Hz.
+    /// Acquisition C/N0 below which a channel takes the weak pull-in, dB-Hz (0: never, as
+    /// [`super::ChannelConfig::weak_pull_in`] `= None`; a start without a C/N0 never does).
     pub enter_dbhz: f64,
     /// Frequency stage: an FLL alone (`pll_order = 0`), unaligned sums.
     pub fll: LoopConfig,
