@@ -334,8 +334,10 @@ pub fn track_config(order: u8, bn_hz: f64, t_coh_s: f64, dll_bn_hz: f64) -> Chan
             t_coh_s,
             ..base.track
         },
-        // A loop study measures the loops it names: no switch to the weak-signal loops.
+        // A loop study measures the loops it names: no switch to the weak-signal loops, no
+        // weak-signal pull-in.
         weak_track: None,
+        weak_pull_in: None,
         ..base
     }
 }

@@ -2,9 +2,12 @@
 //! code period over a shared window of samples.
 //!
 //! States: [`ChannelState::PullIn`] (1 ms integration, the wide FLL-assisted pull-in loops,
-//! bit synchronisation) -> [`ChannelState::Track`] (the user's loops and integration time,
-//! integrations aligned to data-bit edges) -> [`ChannelState::Lost`] (C/N0 below the threshold for
-//! too long: the channel is released and the satellite goes back to acquisition).
+//! bit synchronisation; or, for an acquisition below [`WeakPullInConfig::enter_dbhz`], the
+//! weak-signal pull-in of [`weak_pull_in`](WeakPullInConfig): FLL on 10 ms sums, differential
+//! bit synchronisation, bit-aligned 20 ms PLL) -> [`ChannelState::Track`] (the user's loops
+//! and integration time, integrations aligned to data-bit edges) -> [`ChannelState::Lost`]
+//! (C/N0 below the threshold for too long: the channel is released and the satellite goes back
+//! to acquisition).
 //!
 //! Every integration starts at the first sample of a C/A code period of the replica: the span of
 //! a period is `n = ceil((1023 - c0) fs / r)` samples for a code phase `c0` (chips, in [0, 1))
@@ -31,7 +34,10 @@ use serde::{Deserialize, Serialize};
 
 mod narrowing;
 mod realign;
+mod weak_pull_in;
 pub use realign::CodeShift;
+use weak_pull_in::WeakStage;
+pub use weak_pull_in::{WeakPullInConfig, PRESYNC_BLOCK_PROMPTS, PRESYNC_EDGE_LOSS_DB};
 
 /// Channel settings: the pull-in and tracking loops and the lock thresholds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -69,6 +75,11 @@ pub struct ChannelConfig {
     pub cn0_window_s: f64,
     /// How many consecutive C/N0 estimates below the threshold release the channel.
     pub lost_estimates: u32,
+    /// The weak-signal pull-in (`None`: every channel takes the `pull_in` loops): a channel
+    /// whose acquisition C/N0 is below [`WeakPullInConfig::enter_dbhz`] pulls in with an FLL on
+    /// 10 ms sums, differential bit synchronisation and a bit-aligned 20 ms PLL instead, then
+    /// tracks with `weak_track` ([`weak_pull_in`](crate::channel::WeakPullInConfig)).
+    pub weak_pull_in: Option<WeakPullInConfig>,
 }
 
 impl Default for ChannelConfig {
@@ -90,10 +101,16 @@ impl Default for ChannelConfig {
                 ..LoopConfig::default()
             },
             aided_track: None,
-            // Below 32 dB-Hz: 20 ms coherent (bit-aligned), 2nd-order PLL at 5 Hz, DLL 0.5 Hz.
+            // Below 32 dB-Hz: 20 ms coherent (bit-aligned), 3rd-order PLL at 6 Hz, DLL 0.5 Hz.
+            // 3rd order: no steady-state phase error under a constant LOS acceleration (a 2nd
+            // order loop at 5 Hz lags `(a/lambda)/wn^2` = 32 deg at 1.5 m/s^2, past the lock
+            // indicator's 22.8 deg, so a weak satellite of an accelerating car was dropped
+            // from the fixes); a 0.5 s jerk ramp to 1.5 m/s^2 (3 m/s^3 = 15.8 Hz/s^2) costs
+            // `j/wn^3` = 0.035 cycle (wn = 6/0.7845 = 7.65 rad/s); thermal jitter at 28 dB-Hz
+            // 6.4 deg with the realised Bn (7.6 Hz at Bn T = 0.12, tracking/README.md).
             weak_track: Some(LoopConfig {
-                pll_order: 2,
-                pll_bw_hz: 5.0,
+                pll_order: 3,
+                pll_bw_hz: 6.0,
                 fll_order: 0,
                 fll_bw_hz: 0.0,
                 dll_order: 1,
@@ -109,6 +126,7 @@ impl Default for ChannelConfig {
             cn0_lost_dbhz: 25.0,
             cn0_window_s: 0.2,
             lost_estimates: 5,
+            weak_pull_in: Some(WeakPullInConfig::default()),
         }
     }
 }
@@ -117,6 +135,9 @@ impl ChannelConfig {
     /// Checks both loop configurations and the thresholds.
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.pull_in.validate()?;
+        if let Some(w) = &self.weak_pull_in {
+            w.validate()?;
+        }
         let others = self.aided_track.iter().chain(self.weak_track.iter());
         for l in std::iter::once(&self.track).chain(others) {
             l.validate()?;
@@ -181,7 +202,8 @@ impl ChannelConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ChannelState {
-    /// Wide loops at 1 ms, waiting for phase lock and bit synchronisation.
+    /// Wide loops at 1 ms (or the weak-signal pull-in's 10 ms FLL and 20 ms PLL), waiting for
+    /// phase lock and bit synchronisation.
     PullIn,
     /// The user's loops, integrations aligned to data bits.
     Track,
@@ -340,6 +362,11 @@ pub struct Channel {
     /// A completed bit and the `ms_count` of its first code period, waiting for the end of the
     /// integration interval.
     pending_bit: Option<(Bit, u64)>,
+    /// The stage of a weak-signal pull-in (`None`: the normal pull-in, or after the hand-over).
+    weak_stage: Option<WeakStage>,
+    /// The weak pull-in's C/N0 estimator before bit synchronisation (NWPR over unaligned
+    /// blocks of [`PRESYNC_BLOCK_PROMPTS`] prompts).
+    presync_cn0: SmoothedNwpr,
 }
 
 impl Channel {
@@ -353,9 +380,15 @@ impl Channel {
                 valid: "> 0".into(),
             });
         }
-        let carrier = CarrierLoop::new(&cfg.pull_in, start.doppler_hz)?;
-        let code_loop = CodeLoop::new(&cfg.pull_in)?;
-        let d = cfg.pull_in.el_spacing_chips;
+        // A weak acquisition (C/N0 below the weak pull-in's threshold; NaN is not) starts with
+        // the weak pull-in's frequency stage and its bit synchroniser.
+        let weak_pull_in = cfg.weak_pull_in.filter(|w| start.cn0_dbhz < w.enter_dbhz);
+        let first_loops = weak_pull_in.map_or(cfg.pull_in, |w| w.fll);
+        let bit_sync_cfg = weak_pull_in.map_or(BitSyncConfig::default(), |w| w.bit_sync_config());
+        let carrier = CarrierLoop::new(&first_loops, start.doppler_hz)?;
+        let code_loop = CodeLoop::new(&first_loops)?;
+        let d = first_loops.el_spacing_chips;
+        let cn0_window_blocks = ((cfg.cn0_window_s / 0.02).round() as u32).max(1);
         Ok(Self {
             prn: start.prn,
             packed_code: PackedCode::new(CaCode::new(start.prn).chips()),
@@ -369,14 +402,14 @@ impl Channel {
             fade: FadeDetector::new(),
             code_lock: CodeLockDetector::new(cfg.cn0_lost_dbhz, cfg.lost_estimates),
             cn0_started: false,
-            cn0_window_blocks: ((cfg.cn0_window_s / 0.02).round() as u32).max(1),
+            cn0_window_blocks,
             cn0: SmoothedNwpr::new(
                 1e-3,
                 20,
                 ((cfg.cn0_window_s / 0.02).round() as u32).max(1),
                 5,
             ),
-            bit_sync: BitSync::new(BitSyncConfig::default()),
+            bit_sync: BitSync::new(bit_sync_cfg),
             next_sample: start.code_start_sample,
             code_phase_chips: 0.0,
             code_rate_chips_s: CA_CHIP_RATE_HZ * (1.0 + start.doppler_hz / F_L1_HZ),
@@ -386,7 +419,7 @@ impl Channel {
             ff_applied_hz: None,
             ff_rate_applied_hz_s: 0.0,
             loops: TrackLoops::Normal,
-            weak: start.cn0_dbhz < cfg.weak_enter_dbhz,
+            weak: start.cn0_dbhz < cfg.weak_enter_dbhz || weak_pull_in.is_some(),
             acc_feedforward_hz: None,
             ms_count: 0,
             bit_sync_origin_ms: 0,
@@ -403,6 +436,13 @@ impl Channel {
             taps: [d / 2.0, 0.0, -d / 2.0],
             rate_fit: [0.0; 5],
             pending_bit: None,
+            weak_stage: weak_pull_in.map(|_| WeakStage::Frequency),
+            presync_cn0: SmoothedNwpr::new(
+                1e-3,
+                PRESYNC_BLOCK_PROMPTS,
+                2 * cn0_window_blocks,
+                cn0_window_blocks,
+            ),
         })
     }
 
@@ -482,16 +522,19 @@ impl Channel {
         self.carrier.reset_history();
         self.bit_sync.reset();
         self.bit_sync_origin_ms = self.ms_count;
+        self.weak_restart_frequency_stage();
     }
 
     /// Forgets the data-bit edges (after samples were lost, the bits no longer fall where they
     /// did): the bit synchroniser starts again on the coming prompts; the loops keep running.
     /// Only a channel integrating 1 ms: longer integrations are aligned to the bit edges and
-    /// would stop until new ones are found.
+    /// would stop until new ones are found (a weak pull-in goes back to its frequency stage,
+    /// whose sums need no edges).
     pub fn restart_bit_sync(&mut self) {
-        if (self.carrier.t_coh_s() * 1e3).round() as usize != 1 {
+        if self.weak_stage.is_none() && (self.carrier.t_coh_s() * 1e3).round() as usize != 1 {
             return;
         }
+        self.weak_restart_frequency_stage();
         self.bit_sync.reset();
         self.bit_sync_origin_ms = self.ms_count;
         self.pending_bit = None;
@@ -523,6 +566,9 @@ impl Channel {
         let (p, t_start_s, ms_index) = self.correlate_period(samples);
         let timing = self.update_bit_sync(p, t_start_s, ms_index);
         self.update_detectors(p, timing.next_is_edge);
+        if self.state == ChannelState::PullIn && self.weak_pull_in_step(timing.next_is_edge) {
+            return None;
+        }
         if !self.interval_complete(ms_index, timing) {
             return None;
         }
@@ -582,7 +628,10 @@ impl Channel {
         self.ms_count += 1;
         if self.state == ChannelState::PullIn {
             self.pull_in_ms += 1;
-            if self.pull_in_ms == (self.cfg.fll_assist_s * 1e3).round() as u64 {
+            // (A weak pull-in switches its own assist: [`Channel::weak_pull_in_step`].)
+            if self.pull_in_ms == (self.cfg.fll_assist_s * 1e3).round() as u64
+                && self.weak_stage.is_none()
+            {
                 self.carrier.set_fll_assist(false);
             }
         }
@@ -646,12 +695,18 @@ impl Channel {
         let estimate = if self.cn0_started {
             self.cn0.push(p)
         } else {
+            if self.weak_stage.is_some() {
+                if let Some(c) = self.presync_cn0.push(p) {
+                    self.on_presync_estimate(c);
+                }
+            }
             None
         };
         if next_is_edge {
             if !self.cn0_started {
                 self.cn0_started = true;
                 self.cn0.reset();
+                self.low_cn0_count = 0;
             }
             self.cn0.align_block();
         }
@@ -701,12 +756,16 @@ impl Channel {
     fn interval_complete(&mut self, ms_index: u64, timing: BitTiming) -> bool {
         let t_coh_ms = (self.carrier.t_coh_s() * 1e3).round() as usize;
         let aligned = t_coh_ms == 1
+            || self.weak_frequency_stage()
             || timing.next_is_edge
             || timing.edge_phase.is_some_and(|edge| {
                 let k = (ms_index + 1 + MS_PER_BIT as u64 - edge as u64 % MS_PER_BIT as u64)
                     % MS_PER_BIT as u64;
                 k.is_multiple_of(t_coh_ms as u64)
             });
+        if self.state == ChannelState::Lost && self.acc_ms > 0 {
+            return true; // report the loss (a weak pull-in can end mid-interval)
+        }
         if self.acc_ms < t_coh_ms || !aligned {
             if self.acc_ms >= t_coh_ms {
                 // Not aligned to a bit boundary yet (only after a switch): drop the partial sum.
@@ -766,6 +825,7 @@ impl Channel {
     #[inline]
     fn accumulate_rate_fit(&mut self, nco_freq_hz: f64, ff: f64) {
         if self.state == ChannelState::PullIn
+            && self.weak_stage.is_none()
             && self.pull_in_ms > (self.cfg.fll_assist_s * 1e3) as u64
         {
             let t = self.pull_in_ms as f64 * 1e-3;
@@ -832,9 +892,10 @@ impl Channel {
             return;
         }
         let min_ms = (self.cfg.min_pull_in_s * 1e3) as u64;
-        if self.pull_in_ms < min_ms || !self.pll_lock.locked() {
+        if self.pull_in_ms < min_ms || !self.pll_lock.locked() || !self.weak_ready_for_hand_over() {
             return;
         }
+        self.weak_stage = None;
         let which = self.wanted_loops();
         let loops = self.loop_config(which);
         let (Some(carrier), Ok(code_loop)) = (self.carrier_toward(&loops), CodeLoop::new(&loops))

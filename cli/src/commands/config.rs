@@ -19,6 +19,7 @@ pub fn run(args: &ConfigArgs) -> anyhow::Result<()> {
 /// The default configuration as commented TOML (valid input to `--config`).
 pub fn default_toml() -> anyhow::Result<String> {
     let c = ChannelConfig::default();
+    let w = c.weak_pull_in.unwrap_or_default();
     let loops = |name: &str, l: &gpsrx_tracking::LoopConfig| -> anyhow::Result<String> {
         Ok(format!(
             "[tracking.{name}]\n\
@@ -64,6 +65,19 @@ pub fn default_toml() -> anyhow::Result<String> {
          # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n\
          # 3rd order at 18 Hz follows 10 g manoeuvres.\n{}\n\
          # Tracking loops for weak signals (C/N0 below weak_enter_dbhz): 20 ms, narrow.\n{}\n\
+         # Weak-signal pull-in (acquisition C/N0 below enter_dbhz): an FLL alone on 10 ms sums\n\
+         # while the bits are synchronised differentially, then a bit-aligned 20 ms PLL, then\n\
+         # [tracking.weak_track]. Remove the section's keys to keep its defaults.\n\
+         [tracking.weak_pull_in]\n\
+         enter_dbhz = {:?}         # acquisition C/N0 below which a channel takes this pull-in, dB-Hz (0: never)\n\
+         fll_assist_s = {:?}        # the phase stage's FLL assist is switched off after this, s\n\
+         bit_sync_dbhz = {:?}      # design C/N0 of the bit synchroniser's threshold, dB-Hz\n\
+         p_false_sync = {:?}    # false bit-synchronisation probability it is sized for\n\
+         lost_dbhz = {:?}          # C/N0 before bit sync below which the pull-in fails, dB-Hz\n\
+         patience_s = {:?}         # longest weak pull-in, s\n\
+         \n\
+         # Frequency stage: FLL alone (pll_order = 0), 10 ms sums not aligned to the bits.\n{}\n\
+         # Phase stage: bit-aligned 20 ms, FLL-assisted 3rd-order PLL.\n{}\n\
          # Tracking loops while an INS feed-forward aids the channel (gpsrx run --ins; optional,\n\
          # default: the same as [tracking.track]; --aided-pll-bw, --aided-pll-order):\n\
          # [tracking.aided_track]\n\
@@ -102,6 +116,14 @@ pub fn default_toml() -> anyhow::Result<String> {
         loops("pull_in", &c.pull_in)?,
         loops("track", &c.track)?,
         loops("weak_track", &c.weak_track.unwrap_or(c.track))?,
+        w.enter_dbhz,
+        w.fll_assist_s,
+        w.bit_sync_dbhz,
+        w.p_false_sync,
+        w.lost_dbhz,
+        w.patience_s,
+        loops("weak_pull_in.fll", &w.fll)?,
+        loops("weak_pull_in.pll", &w.pll)?,
     );
     Ok(text)
 }

@@ -35,6 +35,7 @@ pub fn cell_channel_config(order: u8, bn_hz: f64, t_s: f64) -> ChannelConfig {
         fll_assist_s: 0.0,
         cn0_lost_dbhz: 20.0,
         weak_track: None,
+        weak_pull_in: None,
         ..ChannelConfig::default()
     }
 }
