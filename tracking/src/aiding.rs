@@ -92,10 +92,36 @@ pub fn doppler_rate_hz_s(range_accel_mps2: f64) -> f64 {
     -range_accel_mps2 / LAMBDA_L1_M
 }
 
+/// The steady phase error (cycles) an aided PLL of `order` at `bn_hz` keeps when the
+/// feed-forward's error grows at a constant rate, as an INS accelerometer bias `bias_mps2` on
+/// the line of sight makes it (velocity error `B t`: a Doppler ramp `B / lambda` Hz/s).
+/// 2nd order: `B / (lambda w0^2)`, `w0 = Bn / 0.53` (Kaplan Table 5.6; seed 004 Table 1);
+/// 3rd order: 0 (it follows a ramp); 1st order: none (the error grows without bound).
+pub fn static_phase_offset_cycles(order: u8, bn_hz: f64, bias_mps2: f64) -> Option<f64> {
+    match order {
+        2 => {
+            let w0 = crate::loop_filter::omega0(2, bn_hz);
+            Some(bias_mps2 / (LAMBDA_L1_M * w0 * w0))
+        }
+        3 => Some(0.0),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use gpsrx_dsp::constants::F_L1_HZ;
+
+    #[test]
+    fn a_1_mg_bias_leaves_a_2nd_order_0p4_hz_loop_a_tenth_of_a_cycle() {
+        // w0 = 0.4 / 0.53 = 0.755 rad/s: 9.81e-3 / (0.1903 x 0.570) = 0.0905 cycle; the issue's
+        // 0.1-0.16 cycle for 1 mg on each of 3 axes (up to sqrt 3 on a line of sight).
+        let c = static_phase_offset_cycles(2, 0.4, 9.80665e-3).unwrap_or(f64::NAN);
+        assert!((c - 0.0905).abs() < 5e-4, "{c}");
+        assert_eq!(static_phase_offset_cycles(3, 0.4, 9.80665e-3), Some(0.0));
+        assert_eq!(static_phase_offset_cycles(1, 0.4, 9.80665e-3), None);
+    }
 
     #[test]
     fn code_aiding_is_doppler_over_1540() {

@@ -308,6 +308,9 @@ impl Receiver {
         );
         reference.log(assistance.recording_start.as_ref());
         let reference_week = reference.week;
+        if assistance.ins.is_some() {
+            log_aided_static_offset(&config.tracking);
+        }
         let aiding = match assistance.ins {
             Some(ins) => Some(Self::feedforward(
                 ins,
@@ -642,4 +645,27 @@ fn gated_aid<'a>(
         port,
         permission: monitor.permission(),
     })
+}
+
+/// Logs what an INS accelerometer bias of 1 mg per axis (up to sqrt 3 mg on a line of sight)
+/// does to the aided carrier loops: the static phase offset of a 2nd-order loop (seed 004
+/// Table 1; the lock test allows 0.2 cycle, a Costas loop slips at 0.25), none for 3rd order.
+fn log_aided_static_offset(tracking: &gpsrx_tracking::ChannelConfig) {
+    let loops = tracking.aided_track.unwrap_or(tracking.track);
+    let bias_mps2 = 3f64.sqrt() * 9.80665e-3;
+    match gpsrx_tracking::aiding::static_phase_offset_cycles(loops.pll_order, loops.pll_bw_hz, bias_mps2) {
+        Some(c) if c > 0.0 => tracing::info!(
+            "aided loops: 2nd-order PLL at {} Hz: an INS accelerometer bias of 1 mg per axis leaves up to {c:.3} cycle of static phase offset (B / (lambda w0^2); lock allows 0.2, slips at 0.25): a 3rd-order aided loop leaves none (--aided-pll-order 3)",
+            loops.pll_bw_hz
+        ),
+        Some(_) => tracing::info!(
+            "aided loops: {}-order PLL at {} Hz: no static phase offset from an INS accelerometer bias",
+            if loops.pll_order == 3 { "3rd" } else { "other" },
+            loops.pll_bw_hz
+        ),
+        None => tracing::warn!(
+            "aided loops: a 1st-order PLL at {} Hz drifts with an INS accelerometer bias (its phase error grows without bound): use --aided-pll-order 2 or 3",
+            loops.pll_bw_hz
+        ),
+    }
 }
