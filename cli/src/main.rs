@@ -2,7 +2,7 @@
 //!
 //! Exit status (see [`gpsrx_cli::exit`]): 0 done (also when standard output is closed early, as
 //! by `| head`), 1 an error (one line on standard error), 2 `gpsrx run` or `gpsrx demo` made
-//! no valid fix.
+//! no valid fix; `gpsrx batch`: 1 when every entry failed.
 
 use clap::Parser;
 use gpsrx_cli::cli::{Cli, Command};
@@ -29,6 +29,7 @@ fn main() -> ExitCode {
         Command::Acquire(args) => done(commands::acquire::run(&args)),
         Command::Track(args) => done(commands::track::run(&args)),
         Command::Run(args) => commands::run::run(&args),
+        Command::Batch(args) => commands::batch::run(&args),
         Command::Config(args) => done(commands::config::run(&args)),
         Command::Study(args) => done(gpsrx_studies::run(&args)),
         Command::Bench(args) => done(commands::bench::run(&args)),

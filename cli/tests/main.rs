@@ -6,6 +6,7 @@ mod common;
 mod acquisition;
 mod aided_run;
 mod bad_input;
+mod batch;
 mod bench;
 mod dating;
 mod dr_run;

@@ -4,7 +4,8 @@
 //! - [`pipeline`]: [`Receiver`], its channel manager and navigation processor, [`Sink`]s;
 //! - [`output`]: RINEX, NMEA, GeoJSON, KML and CSV writers;
 //! - [`fusion`]: GNSS/dead-reckoning fusion after tracking (seeds 000 and 002);
-//! - [`landmarks`]: landmark range observations for the solver (seed 001).
+//! - [`landmarks`]: landmark range observations for the solver (seed 001);
+//! - [`batch`]: batches of recordings from a manifest (`gpsrx batch`, the Python package).
 //!
 //! # Example: the whole receiver in memory
 //!
@@ -62,6 +63,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod batch;
 pub mod config;
 pub mod fusion;
 pub mod landmarks;

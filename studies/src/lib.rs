@@ -8,6 +8,7 @@
 pub mod bandwidth;
 pub mod dr;
 pub mod dynamics;
+pub mod grid;
 pub mod if_sim;
 pub mod report;
 pub mod steady_state;

@@ -49,12 +49,35 @@ pub enum Command {
     /// Process a recording into position fixes and standard files (RINEX, NMEA, GeoJSON, KML, CSV).
     #[command(after_help = RUN_EXIT_STATUS)]
     Run(Box<RunArgs>),
+    /// Process the recordings (and study grids) of a manifest one after another: one summary
+    /// table.
+    #[command(after_help = BATCH_EXIT_STATUS)]
+    Batch(BatchArgs),
     /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
     Config(ConfigArgs),
     /// Loop studies: steady-state errors, bandwidth vs noise, high dynamics (seed 004).
     Study(gpsrx_studies::StudyArgs),
     /// Measure this machine: correlator kernels, acquisition, end-to-end real-time factor.
     Bench(BenchArgs),
+}
+
+/// The exit status of `gpsrx batch`, shown by `gpsrx batch --help`.
+pub const BATCH_EXIT_STATUS: &str = "Exit status:
+  0  at least one recording gave a valid fix, or one study case ran (the others' errors are in
+     the summary: a bad recording does not stop the batch)
+  1  the manifest cannot be used, or every entry failed (an error or no valid fix)";
+
+/// `gpsrx batch`.
+#[derive(Debug, Args)]
+pub struct BatchArgs {
+    /// The manifest: TOML (`[[recording]]` tables with `path`, `format`, `fs_hz`, `nav`,
+    /// `options`; `[[study]]` grids) or CSV (a header with a `path` column; other columns are
+    /// receiver options such as `tropo` or `rate_hz`). Relative paths are relative to it.
+    pub manifest: PathBuf,
+    /// Output directory: `summary.csv`, one directory of `gpsrx run` files per recording, and
+    /// `study-NAME.csv` per study grid.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
 }
 
 /// `gpsrx config`.

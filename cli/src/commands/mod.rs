@@ -1,6 +1,7 @@
 //! One module per `gpsrx` subcommand.
 
 pub mod acquire;
+pub mod batch;
 pub mod bench;
 pub mod config;
 pub mod demo;

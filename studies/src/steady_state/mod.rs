@@ -153,9 +153,12 @@ fn check_args(args: &SteadyStateArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Runs the study: the 48 cells at `--bn-hz` and T = 1 ms (`--quick`: only these), and in the
-/// full run the same cells at Bn = 2 and 18 Hz and at T = 20 ms, where the loop is accepted.
-pub fn run(args: &SteadyStateArgs, progress: bool) -> anyhow::Result<StudyReport> {
+/// The cells the study runs, in order, and the (Bn, T, order) groups it does not run (an
+/// unstable digital loop).
+#[allow(clippy::type_complexity)]
+pub fn cells(
+    args: &SteadyStateArgs,
+) -> anyhow::Result<(Vec<(f64, f64)>, Vec<Cell>, Vec<(f64, f64, u8, String)>)> {
     check_args(args)?;
     let aid = AidParams {
         alpha_rad_s: args.alpha_rad_s,
@@ -172,6 +175,13 @@ pub fn run(args: &SteadyStateArgs, progress: bool) -> anyhow::Result<StudyReport
             }
         }
     }
+    Ok((cfgs, cells, not_run))
+}
+
+/// Runs the study: the 48 cells at `--bn-hz` and T = 1 ms (`--quick`: only these), and in the
+/// full run the same cells at Bn = 2 and 18 Hz and at T = 20 ms, where the loop is accepted.
+pub fn run(args: &SteadyStateArgs, progress: bool) -> anyhow::Result<StudyReport> {
+    let (cfgs, cells, not_run) = cells(args)?;
     let results = run_cases(&cells, "steady-state", progress, simulate)
         .into_iter()
         .collect::<anyhow::Result<Vec<_>>>()?;

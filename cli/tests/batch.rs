@@ -1,0 +1,83 @@
+//! `gpsrx batch`: a simulated recording, a missing one and a corrupt one in one manifest; the
+//! exit status rule; a bad manifest.
+
+use gpsrx_samples::sim::{Scenario, Simulator};
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn batch(manifest: &Path, out: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gpsrx"))
+        .env("NO_COLOR", "1")
+        .env_remove("GPSRX_LOG")
+        .args(["batch", &manifest.display().to_string(), "--out"])
+        .arg(out)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot start gpsrx: {e}"))
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// 4 s of the default scenario's static antenna (fixes from about 1 s with the navigation
+/// data and an approximate position).
+fn simulate(dir: &Path) {
+    let mut scenario = Scenario::default_scenario().expect("default scenario");
+    scenario.duration_s = 4.0;
+    Simulator::new(&scenario, Path::new("."))
+        .and_then(|s| s.run(dir, &|_| {}))
+        .expect("simulation");
+}
+
+#[test]
+fn a_bad_recording_is_a_row_of_the_summary_and_the_batch_goes_on() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    simulate(&dir.path().join("good"));
+    std::fs::write(dir.path().join("corrupt.ci8"), [1u8, 2, 3]).expect("write");
+    let manifest = dir.path().join("m.csv");
+    std::fs::write(
+        &manifest,
+        "name,path,format,fs_hz,nav,approx_llh\n\
+         good,good/signal.ci8,,,builtin:brdc0010.22n,\"[36.4, 127.4, 0.0]\"\n\
+         missing,nowhere.ci8,ci8,2048000,,\n\
+         corrupt,corrupt.ci8,ci8,2048000,,\n",
+    )
+    .expect("write");
+    let out = dir.path().join("out");
+    let o = batch(&manifest, &out);
+    let (stdout, stderr) = (text(&o.stdout), text(&o.stderr));
+    assert_eq!(o.status.code(), Some(0), "{stdout}\n{stderr}");
+    assert!(stdout.contains("3 recordings: 1 with fixes"), "{stdout}");
+    let summary = std::fs::read_to_string(out.join("summary.csv")).expect("summary.csv");
+    let rows: Vec<&str> = summary.lines().collect();
+    assert_eq!(rows.len(), 4, "{summary}");
+    assert!(
+        rows[1].starts_with("good,") && rows[1].contains(",ok,"),
+        "{summary}"
+    );
+    assert!(
+        rows[2].contains(",error,") && rows[2].contains("does not exist"),
+        "{summary}"
+    );
+    // One byte and a half sample: read, with a warning, but far too short for a fix.
+    assert!(rows[3].starts_with("corrupt,"), "{summary}");
+    assert!(!rows[3].contains(",ok,"), "{summary}");
+    assert!(out.join("good").join("pvt.csv").exists());
+}
+
+#[test]
+fn every_entry_failing_or_a_bad_manifest_is_exit_status_1() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let manifest = dir.path().join("m.toml");
+    std::fs::write(&manifest, "[[recording]]\npath = \"nowhere.ci8\"\n").expect("write");
+    let o = batch(&manifest, &dir.path().join("out"));
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o.stderr).contains("every entry of the batch failed"));
+    assert!(dir.path().join("out").join("summary.csv").exists());
+
+    std::fs::write(&manifest, "[[recording]]\nfile = \"a.bin\"\n").expect("write");
+    let o = batch(&manifest, &dir.path().join("out2"));
+    assert_eq!(o.status.code(), Some(1));
+    let err = text(&o.stderr);
+    assert!(err.contains("m.toml") && err.contains("file"), "{err}");
+}

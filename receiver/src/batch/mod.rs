@@ -1,0 +1,66 @@
+//! Batches of recordings processed one after another on this machine: `gpsrx batch` and the
+//! Python package's tasks (`gpsrx.batch`, one per recording on a Dask cluster) share this code.
+//!
+//! A [`Manifest`] (TOML or CSV, [`manifest`]) lists the recordings with their format, rate,
+//! navigation file and receiver options ([`options`]); [`process`] runs one into its own
+//! output directory and turns any failure into a row of the summary ([`summary`]), so a bad
+//! recording does not stop the batch; [`run_batch`] runs them in turn. Memory stays bounded by
+//! one receiver: a recording's outputs are streamed to its files and dropped before the next.
+
+pub mod manifest;
+pub mod options;
+pub mod recording;
+pub mod summary;
+
+pub use manifest::{Manifest, ManifestError, RecordingSpec, StudySpec};
+pub use recording::{run_recording, run_recording_to, RecordingError};
+pub use summary::{BatchRow, Status};
+
+use std::path::Path;
+
+/// Runs one recording with its files in `out_root/NAME/`; every failure becomes a row with
+/// status [`Status::Error`] and the message `gpsrx run` would print.
+pub fn process(spec: &RecordingSpec, out_root: &Path) -> BatchRow {
+    let path = spec.path.display().to_string();
+    let out = out_root.join(&spec.name);
+    match run_recording_to(spec, &out) {
+        Ok((summary, warnings)) => BatchRow::done(&spec.name, &path, &summary, &warnings),
+        Err(e) => {
+            let message = error_chain(&e);
+            tracing::warn!("{}: {message}", spec.name);
+            BatchRow::failed(&spec.name, &path, message)
+        }
+    }
+}
+
+/// Runs every recording of `manifest` in turn (`progress` is told each row as it is done).
+pub fn run_batch(
+    manifest: &Manifest,
+    out_root: &Path,
+    progress: &mut dyn FnMut(&BatchRow),
+) -> Vec<BatchRow> {
+    manifest
+        .recordings
+        .iter()
+        .map(|spec| {
+            let row = process(spec, out_root);
+            progress(&row);
+            row
+        })
+        .collect()
+}
+
+/// The error and its causes on one line, each text once.
+pub fn error_chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let t = c.to_string();
+        if !text.contains(&t) {
+            text.push_str(": ");
+            text.push_str(&t);
+        }
+        cause = c.source();
+    }
+    text
+}
