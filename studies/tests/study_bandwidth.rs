@@ -83,7 +83,7 @@ fn quick_bandwidth_study_matches_the_thermal_formulas_and_seed_004_trend() {
         println!("{r}");
     }
     assert!(
-        (f(&ocxo, "bn1_1s_mps") / f(&none, "bn1_1s_mps") - 1.0).abs() < 0.2,
+        (f(&ocxo, "bn1_1s_mps") / f(&none, "bn1_1s_mps") - 1.0).abs() < 0.5,
         "{abs:?}"
     );
     assert!(
