@@ -41,6 +41,48 @@ pub const START_TOW_S: f64 = 538_194.0;
 /// The static receiver of the study scenarios (Seoul), latitude, longitude (deg), height (m).
 pub const SEOUL_LLH: [f64; 3] = [37.5665, 126.9780, 40.0];
 
+/// A receiver oscillator for the simulator's two-state clock model (`gpsrx_samples::sim::clock`):
+/// white FM of Allan deviation `allan_deviation_1s` at 1 s (q1 = sigma_1^2 = h0 / 2) and
+/// random-walk FM of power-law coefficient `h_m2` (q2 = 2 pi^2 h_-2), so that
+/// `sigma_y^2(tau) = sigma_1^2 / tau + (2 pi^2 / 3) h_-2 tau`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Oscillator {
+    /// Name in the reports.
+    pub name: &'static str,
+    /// White-FM Allan deviation at 1 s.
+    pub allan_deviation_1s: f64,
+    /// Random-walk FM coefficient h_-2, 1/s.
+    pub h_m2: f64,
+}
+
+impl Oscillator {
+    /// A perfect clock (bias only).
+    pub const NONE: Oscillator = Oscillator {
+        name: "none",
+        allan_deviation_1s: 0.0,
+        h_m2: 0.0,
+    };
+    /// A TCXO: sigma_y(1 s) = 1.09e-10, sigma_y(10 s) = 1.44e-10.
+    pub const TCXO: Oscillator = Oscillator {
+        name: "TCXO",
+        allan_deviation_1s: 1e-10,
+        h_m2: 3e-22,
+    };
+    /// An OCXO: sigma_y(1 s) = 1.09e-12, sigma_y(10 s) = 1.44e-12.
+    pub const OCXO: Oscillator = Oscillator {
+        name: "OCXO",
+        allan_deviation_1s: 1e-12,
+        h_m2: 3e-26,
+    };
+
+    /// Allan deviation at `tau_s` (the two-state model's).
+    pub fn allan_deviation(&self, tau_s: f64) -> f64 {
+        (self.allan_deviation_1s.powi(2) / tau_s
+            + 2.0 * std::f64::consts::PI.powi(2) / 3.0 * self.h_m2 * tau_s)
+            .sqrt()
+    }
+}
+
 /// A scenario in the simulator's TOML: `duration_s`, noise `seed`, complex float samples at
 /// `fs_hz` (zero IF), the `[receiver]` table body `receiver` (e.g. `kind = "static"` and its
 /// position) and the `[satellites]` table body `satellites` (PRNs and C/N0). The receiver
@@ -55,14 +97,37 @@ pub fn scenario_toml(
     satellites: &str,
     extra: &str,
 ) -> String {
+    scenario_toml_with_oscillator(
+        duration_s,
+        seed,
+        fs_hz,
+        receiver,
+        satellites,
+        extra,
+        &Oscillator::NONE,
+    )
+}
+
+/// [`scenario_toml`] with the receiver clock driven by `osc`.
+pub fn scenario_toml_with_oscillator(
+    duration_s: f64,
+    seed: u64,
+    fs_hz: f64,
+    receiver: &str,
+    satellites: &str,
+    extra: &str,
+    osc: &Oscillator,
+) -> String {
     format!(
         "duration_s = {duration_s}\nseed = {seed}\nnav = \"builtin:brdc0010.22n\"\n\
          [start]\nweek = {START_WEEK}\ntow_s = {START_TOW_S:.1}\n\
          [output]\nformat = \"cf32_le\"\nfs_hz = {fs_hz}\n\
          [receiver]\n{receiver}\n\
-         [clock]\nbias_s = 1.0e-4\ndrift_s_s = 0.0\nallan_deviation_1s = 0.0\n\
+         [clock]\nbias_s = 1.0e-4\ndrift_s_s = 0.0\nallan_deviation_1s = {:e}\n\
+         random_walk_fm_h_m2 = {:e}\n\
          [satellites]\n{satellites}\n\
-         [truth]\nrate_hz = 1.0\n{extra}\n"
+         [truth]\nrate_hz = 1.0\n{extra}\n",
+        osc.allan_deviation_1s, osc.h_m2
     )
 }
 

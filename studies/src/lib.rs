@@ -1,5 +1,5 @@
 //! `gpsrx study ...`: loop-bandwidth, steady-state and high-dynamics studies (seed 004), and
-//! GPS/DR fusion (seeds 000 and 002).
+//! GPS/DR fusion (seeds 000 and 002), landmark ranges with few satellites (seed 001).
 //!
 //! Each study runs its cases in parallel (rayon) behind a progress bar and writes `study.md`,
 //! `study.csv`, `study.json` and PNG plots to `--out DIR` (see [`report`]). `--quick` runs a
@@ -10,6 +10,7 @@ pub mod dr;
 pub mod dynamics;
 pub mod grid;
 pub mod if_sim;
+pub mod landmarks;
 pub mod report;
 pub mod steady_state;
 
@@ -44,6 +45,9 @@ pub enum StudyKind {
     /// 4-state filter, outages, a tilted gyro) and the accelerometer speed filter (seed 002) on a
     /// simulated urban drive.
     Dr(dr::DrArgs),
+    /// Street-level landmark ranges with 3-9 satellites (seed 001): fix availability and
+    /// PDOP/HDOP with 0-2 landmarks, Monte Carlo over geometries.
+    Landmarks(landmarks::LandmarksArgs),
 }
 
 /// Options every study has.
@@ -67,6 +71,7 @@ pub fn run(args: &StudyArgs) -> anyhow::Result<()> {
         StudyKind::Bandwidth(a) => (bandwidth::run(a, true)?, &a.common.out),
         StudyKind::Dynamics(a) => (dynamics::run(a, true)?, &a.common.out),
         StudyKind::Dr(a) => (dr::run(a, true)?, &a.common.out),
+        StudyKind::Landmarks(a) => (landmarks::run(a, true)?, &a.common.out),
     };
     let written = report.write(out)?;
     let plots = std::fs::read_dir(out)

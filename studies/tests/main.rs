@@ -26,4 +26,5 @@ fn run_study(args: &[&str], out: &std::path::Path) {
 mod study_bandwidth;
 mod study_dr;
 mod study_dynamics;
+mod study_landmarks;
 mod study_steady_state;

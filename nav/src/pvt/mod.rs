@@ -111,6 +111,23 @@ pub enum PvtError {
         /// GDOP of the failing geometry (infinite if the inverse does not exist).
         gdop: f64,
     },
+    /// The least-squares point's geometry does not fix the position: PDOP above the limit (with
+    /// 3 satellites and a landmark, the landmark direction is nearly perpendicular to the
+    /// satellites' solution curve, or the noisy curve misses the landmark's range sphere).
+    #[error(
+        "the geometry does not allow a fix: PDOP {pdop:.1} > {max_pdop} ({satellites} satellites, \
+         {landmarks} landmarks); wait for more satellites or a landmark in another direction"
+    )]
+    WeakGeometry {
+        /// PDOP at the least-squares point.
+        pdop: f64,
+        /// The limit ([`PvtOptions::max_pdop`]).
+        max_pdop: f64,
+        /// Satellites used.
+        satellites: usize,
+        /// Landmarks used.
+        landmarks: usize,
+    },
     /// The iteration did not converge or left the neighbourhood of the Earth.
     #[error("least squares did not converge after {iterations} iterations (last step {last_step_m:.3e} m)")]
     Diverged {
@@ -216,9 +233,7 @@ pub fn solve(
     let (fix, raim) = raim::check_and_exclude(&ctx, fix)?;
 
     let llh = Llh::from_ecef(&fix.pos_m);
-    let dop = dop::dop_enu(&fix.geometry_rows, &llh).ok_or(PvtError::SingularGeometry {
-        gdop: f64::INFINITY,
-    })?;
+    let dop = fix.dop;
     let dop_without_landmarks = if landmarks.is_empty() {
         None
     } else {

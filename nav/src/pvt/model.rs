@@ -112,14 +112,18 @@ pub struct PvtOptions {
     pub raim_pfa: f64,
     /// Run RAIM detection and exclusion.
     pub raim: bool,
-    /// Maximum Gauss-Newton iterations (a cold start needs about 6-8).
+    /// Maximum Gauss-Newton iterations (a cold start needs about 6-8; a damped iteration near
+    /// a weak landmark geometry up to about 30).
     pub max_iterations: usize,
+    /// PDOP above which the least-squares point is refused as
+    /// [`super::PvtError::WeakGeometry`].
+    pub max_pdop: f64,
 }
 
 impl Default for PvtOptions {
     /// No ionosphere (no coefficients known yet), troposphere on, 5 deg mask, elevation/C/N0
     /// weights with a = b = 1.5 m at 45 dB-Hz, Doppler sigma 0.1 m/s, RAIM at pfa 1e-3,
-    /// 20 iterations.
+    /// 50 iterations, PDOP limit 50.
     fn default() -> PvtOptions {
         PvtOptions {
             iono: None,
@@ -133,7 +137,8 @@ impl Default for PvtOptions {
             doppler_sigma_mps: 0.1,
             raim_pfa: 1e-3,
             raim: true,
-            max_iterations: 20,
+            max_iterations: 50,
+            max_pdop: 50.0,
         }
     }
 }
@@ -150,6 +155,9 @@ impl PvtOptions {
         }
         if !(self.doppler_sigma_mps > 0.0 && self.doppler_sigma_mps.is_finite()) {
             return bad("doppler_sigma_mps", self.doppler_sigma_mps);
+        }
+        if !(self.max_pdop.is_finite() && self.max_pdop > 0.0) {
+            return bad("max_pdop", self.max_pdop);
         }
         if self.max_iterations == 0 {
             return bad("max_iterations", 0.0);

@@ -8,6 +8,7 @@ mod coarse_time_tests;
 mod common;
 mod ephemeris_tests;
 mod frames_tests;
+mod landmark_tests;
 mod lnav_rtklib_tests;
 mod lnav_tests;
 mod pvt_tests;

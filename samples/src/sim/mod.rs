@@ -147,10 +147,11 @@ impl Simulator {
         let span = scenario.duration_s + 2.0;
         let trajectory =
             Trajectory::from_config(&scenario.receiver, base_dir, scenario.duration_s)?;
-        let clock = ReceiverClock::new(
+        let clock = ReceiverClock::with_random_walk_fm(
             scenario.clock.bias_s,
             scenario.clock.drift_s_s,
             scenario.clock.allan_deviation_1s,
+            scenario.clock.random_walk_fm_h_m2,
             span,
             scenario.seed,
         );

@@ -365,6 +365,10 @@ pub struct ClockConfig {
     /// Allan deviation at tau = 1 s of the white frequency noise (0 = none).
     #[serde(default)]
     pub allan_deviation_1s: f64,
+    /// Random-walk frequency noise, power-law coefficient h_-2 of S_y(f) = h_-2 / f^2 (1/s;
+    /// 0 = none): adds (2 pi^2 / 3) h_-2 tau to the Allan variance (see `sim::clock`).
+    #[serde(default)]
+    pub random_walk_fm_h_m2: f64,
 }
 
 /// Satellite selection and signal strength.
@@ -635,6 +639,9 @@ impl Scenario {
                     o.start_s, o.end_s
                 ));
             }
+        }
+        if self.clock.random_walk_fm_h_m2 < 0.0 || !self.clock.random_walk_fm_h_m2.is_finite() {
+            return bad("[clock] random_walk_fm_h_m2 must be >= 0".into());
         }
         if self.clock.allan_deviation_1s < 0.0 || !self.clock.allan_deviation_1s.is_finite() {
             return bad("[clock] allan_deviation_1s must be >= 0".into());

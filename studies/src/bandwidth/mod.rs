@@ -65,6 +65,7 @@ mod plots;
 mod ratios;
 mod result;
 mod table;
+mod table_two_abs;
 mod table_two_md;
 mod theory;
 mod track;
@@ -141,7 +142,9 @@ pub fn run(args: &BandwidthArgs, progress: bool) -> anyhow::Result<StudyReport> 
         })
         .collect();
     let cases = cases(&runnable, args.common.seed, window_s);
-    let outcomes = run_cases(&cases, "bandwidth", progress, |c| run_case(c, aided));
+    let outcomes = run_cases(&cases, "bandwidth", progress, |c| {
+        run_case(c, aided, &crate::if_sim::Oscillator::NONE)
+    });
     let mut measured: Vec<(Cell, CellMeasured, f64)> = Vec::new();
     for (case, out) in cases.iter().zip(outcomes) {
         let out = out?;
@@ -168,7 +171,8 @@ pub fn run(args: &BandwidthArgs, progress: bool) -> anyhow::Result<StudyReport> 
         .collect();
     let recorded_s: f64 = cases.iter().map(|c| c.duration_s).sum();
     let wall_s = t_start.elapsed().as_secs_f64();
-    Ok(build_report(
+    let absolute = table_two_abs::run_absolute(args.common.seed, window_s, quick, progress)?;
+    let mut report = build_report(
         &results,
         &RunInfo {
             window_s,
@@ -179,7 +183,15 @@ pub fn run(args: &BandwidthArgs, progress: bool) -> anyhow::Result<StudyReport> 
             recorded_s,
             wall_s,
         },
-    ))
+    );
+    report.conclusions_md += &table_two_abs::absolute_md(&absolute);
+    if let Some(obj) = report.summary.as_object_mut() {
+        obj.insert(
+            "table_two_absolute".into(),
+            serde_json::to_value(&absolute).unwrap_or_default(),
+        );
+    }
+    Ok(report)
 }
 
 /// How the study ran.

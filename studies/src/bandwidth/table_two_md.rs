@@ -64,8 +64,8 @@ fn table_two_discussion(ratios: &[TableTwoRatio]) -> String {
          (8x) applies to the low-frequency part of the loop's frequency error alone, not to \
          either output. Seed 004's 1.65-1.81 is therefore consistent with a Doppler averaged \
          over about a second plus a noise share that does not grow with Bn: in a real receiver the oscillator's Allan \
-         term grows as 1/Bn and pulls the ratio below 2, and this simulation has no \
-         oscillator noise."
+         term grows as 1/Bn and pulls the ratio below 2; the grid above has no oscillator \
+         noise (the oscillators are in the next subsection)."
     );
     s
 }

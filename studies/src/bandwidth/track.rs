@@ -3,19 +3,26 @@
 use super::plan::Case;
 use super::{cell_channel_config, measure_cell, CellMeasured, FS_HZ, PRNS};
 use crate::if_sim::{
-    self, satellites_with_cn0, scenario_toml, static_receiver, ChannelSpec, ChannelTrace,
-    SimSource, Truth, SEOUL_LLH,
+    self, satellites_with_cn0, scenario_toml_with_oscillator, static_receiver, ChannelSpec,
+    ChannelTrace, Oscillator, SimSource, Truth, SEOUL_LLH,
 };
 
-pub(super) fn run_case(case: &Case, aided: bool) -> anyhow::Result<Vec<CellMeasured>> {
+/// Simulates `case` with the receiver oscillator `osc` and measures its cells (aided by the
+/// true carrier phase, which includes the receiver clock, or unaided).
+pub(super) fn run_case(
+    case: &Case,
+    aided: bool,
+    osc: &Oscillator,
+) -> anyhow::Result<Vec<CellMeasured>> {
     let sats: Vec<(u8, f64)> = PRNS.iter().map(|&p| (p, case.cn0_dbhz)).collect();
-    let text = scenario_toml(
+    let text = scenario_toml_with_oscillator(
         case.duration_s,
         case.seed,
         FS_HZ,
         &static_receiver(SEOUL_LLH),
         &satellites_with_cn0(&sats),
         "",
+        osc,
     );
     let sim = if_sim::simulator(&text)?;
     let truth = Truth::new(&sim);
