@@ -11,7 +11,7 @@ use gpsrx_nav::{
     azimuth_elevation, read_rinex_nav, rotate_for_earth_rotation, Ephemeris, GpsTime, Llh, NavData,
     Vector3,
 };
-use gpsrx_receiver::output::nmea::{gga, gsv, rmc};
+use gpsrx_receiver::output::nmea::{gga, gst, gsv, rmc, zda};
 use gpsrx_receiver::output::{
     rinex_nav::write_rinex_nav_file, write_geojson, write_kml, write_rinex_nav, ChannelCsvWriter,
     ChannelRow, Fix, FixQuality, NavHeader, NavRecord, NmeaOptions, NmeaWriter, ObsEpoch,
@@ -181,6 +181,7 @@ fn test_fix() -> Fix {
         vdop: 1.5,
         raim: "ok, passed".to_string(),
         quality: FixQuality::Gnss,
+        sigma_enu_m: Some([0.8, 1.1, 2.3]),
         sats_in_view: (1..=9)
             .map(|k| SatView {
                 prn: k * 3,
@@ -200,11 +201,25 @@ fn test_fix() -> Fix {
 fn gga_known_answer_and_checksums() {
     let fix = test_fix();
     let opts = NmeaOptions::default();
-    // 05:30:00 GPST - 18 s = 05:29:42 UTC; the checksum 57 was computed outside this code.
+    // 05:30:00 GPST - 18 s = 05:29:42 UTC; 6 decimals of minutes (11.5166667 deg is
+    // 11 deg 31.000002'); the checksum 55 was computed outside this code.
     assert_eq!(
         gga(&fix, &opts),
-        "$GPGGA,052942.00,4807.0380,N,01131.0000,E,1,08,0.9,545.400,M,0.000,M,,*57\r\n"
+        "$GPGGA,052942.00,4807.038000,N,01131.000002,E,1,08,0.9,545.400,M,0.000,M,,*55\r\n"
     );
+    // GST: the error ellipse from the east/north sigmas (0.8, 1.1 m: major axis north), the
+    // latitude, longitude and altitude sigmas; ZDA: the UTC date. Checksums 40 and 6C computed
+    // outside this code.
+    assert_eq!(
+        gst(&fix, &opts),
+        "$GPGST,052942.00,,1.10,0.80,0.0,1.10,0.80,2.30*40\r\n"
+    );
+    assert_eq!(zda(&fix, &opts), "$GPZDA,052942.00,01,01,2022,00,00*6C\r\n");
+    let undated = Fix {
+        week_known: false,
+        ..fix.clone()
+    };
+    assert!(zda(&undated, &opts).starts_with("$GPZDA,052942.00,,,,00,00*"));
     let with_geoid = gga(
         &fix,
         &NmeaOptions {
@@ -225,7 +240,7 @@ fn gga_known_answer_and_checksums() {
     let mut south_west = fix.clone();
     south_west.llh = Llh::from_degrees(-33.5, -70.25, 500.0);
     let f = parse_nmea(&gga(&south_west, &opts));
-    assert_eq!(&f[2..6], ["3330.0000", "S", "07015.0000", "W"]);
+    assert_eq!(&f[2..6], ["3330.000000", "S", "07015.000000", "W"]);
 
     let f = parse_nmea(&rmc(&fix, &opts));
     assert_eq!(f[0], "GPRMC");
@@ -268,7 +283,7 @@ fn gga_known_answer_and_checksums() {
     w.write_fix(&fix).expect("in memory");
     let text = String::from_utf8(w.finish().expect("flush")).expect("ASCII");
     let sentences: Vec<String> = text.split_inclusive("\r\n").map(str::to_string).collect();
-    assert_eq!(sentences.len(), 6, "GGA, RMC, GSA and 3 GSV");
+    assert_eq!(sentences.len(), 8, "GGA, RMC, GSA, 3 GSV, GST and ZDA");
     for s in &sentences {
         parse_nmea(s);
     }
@@ -368,6 +383,15 @@ fn pvt_and_channel_csv_columns() {
     assert_eq!(&rows[2][15], "", "NaN HDOP is an empty cell");
     let lat: f64 = rows[0][5].parse().expect("lat");
     assert!((lat - 48.1173).abs() < 1e-9);
+    // The uncertainty and the UTC time at the end: week 2190, TOW 538200 s is 2022-01-01
+    // 05:30:00 GPS time, 05:29:42 UTC (18 leap seconds); no UTC while the week is unknown.
+    assert_eq!(header[20..].join(","), "sigma_e_m,sigma_n_m,sigma_u_m,utc");
+    assert_eq!(
+        (&rows[0][20], &rows[0][21], &rows[0][22]),
+        ("0.800", "1.100", "2.300")
+    );
+    assert_eq!(&rows[0][23], "2022-01-01T05:29:42.000000Z");
+    assert_eq!(&rows[5][23], "");
 
     let mut w = ChannelCsvWriter::new(Vec::new(), "channels.csv").expect("header");
     let row = ChannelRow {

@@ -66,7 +66,7 @@ impl Columns {
 }
 
 /// Columns of a fix table.
-pub const FIX_COLUMNS: [&str; 22] = [
+pub const FIX_COLUMNS: [&str; 25] = [
     "t_stream_s",
     "week",
     "tow_s",
@@ -89,6 +89,9 @@ pub const FIX_COLUMNS: [&str; 22] = [
     "raim",
     "used_prns",
     "week_known",
+    "sigma_e_m",
+    "sigma_n_m",
+    "sigma_u_m",
 ];
 
 /// The fixes as columns.
@@ -119,6 +122,10 @@ pub fn fixes<'py>(py: Python<'py>, fixes: &[FixReport]) -> PyResult<Bound<'py, P
         c.text("raim", f.raim.clone());
         c.text("used_prns", prn_list(&f.used_prns));
         c.int("week_known", i64::from(f.week_known));
+        let s = f.sigma_enu_m;
+        c.opt("sigma_e_m", s.map(|s| s[0]));
+        c.opt("sigma_n_m", s.map(|s| s[1]));
+        c.opt("sigma_u_m", s.map(|s| s[2]));
     }
     c.into_dict(py, &FIX_COLUMNS)
 }

@@ -96,6 +96,7 @@ pub fn fused_as_fixes(fixes: &[FusedFix]) -> Vec<Fix> {
                     FixSource::Fused => FixQuality::Fused,
                     FixSource::DrOnly => FixQuality::DeadReckoning,
                 },
+                sigma_enu_m: None,
                 sats_in_view: Vec::new(),
             }
         })

@@ -1,4 +1,5 @@
-//! NMEA 0183 (version 2.3 fields) GGA, RMC, GSA and GSV sentences (`pvt.nmea`), talker `GP`.
+//! NMEA 0183 (version 2.3 fields) GGA, RMC, GSA, GSV, GST and ZDA sentences (`pvt.nmea`),
+//! talker `GP`. Latitude and longitude carry 6 decimals of minutes (2 mm).
 //!
 //! Each sentence is `$<body>*hh\r\n` where `hh` is the XOR of every byte between `$` and `*`
 //! as two upper-case hexadecimal digits. Times are UTC = GPS time - leap seconds
@@ -65,20 +66,23 @@ fn utc_fields(t: GpsTime, leap_seconds: i32) -> (String, String) {
     }
 }
 
-/// `ddmm.mmmm,N` / `dddmm.mmmm,E` for an angle in degrees (rounded on 1e-4 minute, so the
+/// Ticks of minutes of arc per minute: 6 decimals (1e-6 minute is 1.9 mm of latitude).
+const MINUTE_TICKS: u64 = 1_000_000;
+
+/// `ddmm.mmmmmm,N` / `dddmm.mmmmmm,E` for an angle in degrees (rounded on 1e-6 minute, so the
 /// minutes never print as 60). Empty fields for a non-finite angle.
 fn angle_fields(deg: f64, deg_digits: usize, pos: char, neg: char) -> String {
     if !deg.is_finite() || deg.abs() > 180.0 {
         return ",".to_string();
     }
     let hemi = if deg < 0.0 { neg } else { pos };
-    let ticks = (deg.abs() * 60.0 * 10_000.0).round() as u64;
-    let whole_deg = ticks / 600_000;
-    let min_ticks = ticks % 600_000;
+    let ticks = (deg.abs() * 60.0 * MINUTE_TICKS as f64).round() as u64;
+    let whole_deg = ticks / (60 * MINUTE_TICKS);
+    let min_ticks = ticks % (60 * MINUTE_TICKS);
     format!(
-        "{whole_deg:0deg_digits$}{:02}.{:04},{hemi}",
-        min_ticks / 10_000,
-        min_ticks % 10_000
+        "{whole_deg:0deg_digits$}{:02}.{:06},{hemi}",
+        min_ticks / MINUTE_TICKS,
+        min_ticks % MINUTE_TICKS
     )
 }
 
@@ -243,7 +247,42 @@ pub fn gsv(fix: &Fix) -> Vec<String> {
         .collect()
 }
 
-/// Streams GGA, RMC, GSA and GSV sentences for each fix.
+/// GST: time, RMS of the pseudorange residuals (empty: not carried), the horizontal error
+/// ellipse (semi-major, semi-minor, orientation of the major axis from true north; from the
+/// east and north one-sigma uncertainties, the axes along them), and the one-sigma latitude,
+/// longitude and altitude errors, m. Empty error fields when the fix has no uncertainty.
+pub fn gst(fix: &Fix, opts: &NmeaOptions) -> String {
+    let (time, _) = utc_fields(fix.time, opts.leap_seconds);
+    let errors = match fix.sigma_enu_m.filter(|_| position_valid(fix)) {
+        Some([e, n, u]) => {
+            let (major, minor, orient) = if n >= e { (n, e, 0.0) } else { (e, n, 90.0) };
+            format!(
+                "{},{},{},{},{},{}",
+                opt_num(major, 2),
+                opt_num(minor, 2),
+                opt_num(orient, 1),
+                opt_num(n, 2),
+                opt_num(e, 2),
+                opt_num(u, 2)
+            )
+        }
+        None => ",,,,,".to_string(),
+    };
+    sentence(&format!("GPGST,{time},,{errors}"))
+}
+
+/// ZDA: UTC time, day, month, year, local zone 00:00; the date fields are empty while the GPS
+/// week is unknown.
+pub fn zda(fix: &Fix, opts: &NmeaOptions) -> String {
+    let (time, _) = utc_fields(fix.time, opts.leap_seconds);
+    let date = match calendar_rounded(fix.time.add_seconds(-f64::from(opts.leap_seconds)), 2) {
+        Some(c) if fix.week_known => format!("{:02},{:02},{:04}", c.day, c.month, c.year),
+        _ => ",,".to_string(),
+    };
+    sentence(&format!("GPZDA,{time},{date},00,00"))
+}
+
+/// Streams GGA, RMC, GSA, GSV, GST and ZDA sentences for each fix.
 #[derive(Debug)]
 pub struct NmeaWriter<W: Write> {
     out: W,
@@ -272,7 +311,7 @@ impl<W: Write> NmeaWriter<W> {
         }
     }
 
-    /// Writes GGA, RMC, GSA and the GSV group of one fix.
+    /// Writes GGA, RMC, GSA, the GSV group, GST and ZDA of one fix.
     pub fn write_fix(&mut self, fix: &Fix) -> Result<(), OutputError> {
         let mut text = gga(fix, &self.opts);
         text.push_str(&rmc(fix, &self.opts));
@@ -280,6 +319,8 @@ impl<W: Write> NmeaWriter<W> {
         for s in gsv(fix) {
             text.push_str(&s);
         }
+        text.push_str(&gst(fix, &self.opts));
+        text.push_str(&zda(fix, &self.opts));
         self.out
             .write_all(text.as_bytes())
             .map_err(OutputError::io(&self.file))
@@ -303,9 +344,9 @@ mod tests {
 
     #[test]
     fn angles_round_without_sixty_minutes() {
-        assert_eq!(angle_fields(48.117_3, 2, 'N', 'S'), "4807.0380,N");
-        assert_eq!(angle_fields(-11.516_666_7, 3, 'E', 'W'), "01131.0000,W");
-        assert_eq!(angle_fields(9.999_999_999, 2, 'N', 'S'), "1000.0000,N");
+        assert_eq!(angle_fields(48.117_3, 2, 'N', 'S'), "4807.038000,N");
+        assert_eq!(angle_fields(-11.516_666_7, 3, 'E', 'W'), "01131.000002,W");
+        assert_eq!(angle_fields(9.999_999_999_99, 2, 'N', 'S'), "1000.000000,N");
         assert_eq!(angle_fields(f64::NAN, 2, 'N', 'S'), ",");
     }
 

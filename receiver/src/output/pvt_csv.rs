@@ -11,8 +11,10 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 /// Columns of `pvt.csv`: the fixed leading block, then `quality` and `used_prns`
-/// (space-separated).
-pub const PVT_COLUMNS: [&str; 20] = [
+/// (space-separated), the one-sigma uncertainty east, north and up (m, from the solution's
+/// covariance) and the UTC time (ISO 8601, from the GPS time and the leap seconds; empty while
+/// the week is unknown).
+pub const PVT_COLUMNS: [&str; 24] = [
     "gps_week",
     "tow_s",
     "x_m",
@@ -33,6 +35,10 @@ pub const PVT_COLUMNS: [&str; 20] = [
     "raim",
     "quality",
     "used_prns",
+    "sigma_e_m",
+    "sigma_n_m",
+    "sigma_u_m",
+    "utc",
 ];
 
 /// Columns of `channels.csv`. `gps_week` and `tow_s` are the receiver time of the row, empty
@@ -132,6 +138,14 @@ impl<W: Write> PvtCsvWriter<W> {
             fix.raim.clone(),
             fix.quality.name().to_string(),
             prns.join(" "),
+            opt_cell(fix.sigma_enu_m.map(|s| s[0]), 3),
+            opt_cell(fix.sigma_enu_m.map(|s| s[1]), 3),
+            opt_cell(fix.sigma_enu_m.map(|s| s[2]), 3),
+            if fix.week_known {
+                gpsrx_samples::sigmf::format_datetime_utc(fix.time)
+            } else {
+                String::new()
+            },
         ];
         self.out.write_record(&row).map_err(csv_err(&self.file))
     }

@@ -115,6 +115,7 @@ pub(crate) fn fix_of(
         vdop: sol.dop.vdop,
         raim: raim_text(&sol.raim),
         quality: FixQuality::Gnss,
+        sigma_enu_m: sigma_enu_m(sol),
         sats_in_view,
     }
 }
@@ -126,4 +127,16 @@ fn raim_text(r: &RaimStatus) -> String {
         RaimStatus::FaultExcluded { prn } => format!("excluded G{prn:02}"),
         other => format!("{other:?}").to_lowercase(),
     }
+}
+
+/// The one-sigma east, north and up uncertainty of a solution, m: the square roots of the
+/// diagonal of its position covariance `sigma0^2 N^-1` in the local frame (`None` if not
+/// finite). Measured against simulator truth it is optimistic by 2-3x in the horizontal for
+/// carrier-smoothed fixes: their post-fit residuals agree with each other better than their
+/// errors, which are correlated over the smoothing time (the a-priori model alone is 5-10x
+/// pessimistic); a calibrated error model is still to come.
+fn sigma_enu_m(sol: &PvtSolution) -> Option<[f64; 3]> {
+    let c = sol.position_covariance_enu();
+    let s = [c[(0, 0)], c[(1, 1)], c[(2, 2)]].map(|v| v.max(0.0).sqrt());
+    s.iter().all(|v| v.is_finite()).then_some(s)
 }
