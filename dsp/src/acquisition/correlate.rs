@@ -144,8 +144,86 @@ impl AcquisitionEngine {
 }
 
 /// `dst[t] = src[(start + t) mod src.len()] * rep[t]` (`start < src.len()`,
-/// `dst.len() <= src.len()`), in at most two contiguous runs.
+/// `dst.len() <= src.len()`), in at most two contiguous runs. The loops are compiled a second
+/// time for AVX2 + FMA and that version is taken when the CPU has them (the build targets
+/// baseline x86-64, whose SSE2 complex products ran at half the speed: 14 % of a weak-signal
+/// run's time was here).
 fn mul_rotated(dst: &mut [Complex32], src: &[Complex32], start: usize, rep: &[Complex32]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU supports AVX2 and FMA (checked above).
+        unsafe { mul_rotated_avx2(dst, src, start, rep) };
+        return;
+    }
+    mul_rotated_portable(dst, src, start, rep);
+}
+
+/// [`mul_rotated`] with AVX2 and FMA: four complex products per instruction group,
+/// `a b = (a_re b_re - a_im b_im, a_im b_re + a_re b_im)` as `fmaddsub(a, dup(b_re),
+/// swap(a) dup(b_im))`.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn mul_rotated_avx2(
+    dst: &mut [Complex32],
+    src: &[Complex32],
+    start: usize,
+    rep: &[Complex32],
+) {
+    let first = dst.len().min(src.len() - start);
+    let (d0, d1) = dst.split_at_mut(first);
+    let (r0, r1) = rep.split_at(first);
+    let rest = d1.len();
+    // SAFETY: the caller guarantees AVX2 and FMA.
+    unsafe {
+        mul_avx2(d0, &src[start..start + first], r0);
+        mul_avx2(d1, &src[..rest], &r1[..rest]);
+    }
+}
+
+/// `dst[t] = a[t] b[t]` for equal lengths, AVX2 + FMA.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA; `a` and `b` at least as long as `dst`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn mul_avx2(dst: &mut [Complex32], a: &[Complex32], b: &[Complex32]) {
+    use std::arch::x86_64::{
+        _mm256_fmaddsub_ps, _mm256_loadu_ps, _mm256_movehdup_ps, _mm256_moveldup_ps, _mm256_mul_ps,
+        _mm256_permute_ps, _mm256_storeu_ps,
+    };
+    let n = dst.len().min(a.len()).min(b.len());
+    let lanes = n / 4 * 4;
+    let (pd, pa, pb) = (
+        dst.as_mut_ptr().cast::<f32>(),
+        a.as_ptr().cast::<f32>(),
+        b.as_ptr().cast::<f32>(),
+    );
+    let mut k = 0;
+    while k < lanes {
+        // SAFETY: k + 4 <= n complex values (8 floats) in each slice; Complex32 is two f32
+        // (repr(C)), unaligned loads and stores.
+        unsafe {
+            let va = _mm256_loadu_ps(pa.add(2 * k));
+            let vb = _mm256_loadu_ps(pb.add(2 * k));
+            let b_re = _mm256_moveldup_ps(vb);
+            let b_im = _mm256_movehdup_ps(vb);
+            let a_swapped = _mm256_permute_ps(va, 0b1011_0001);
+            let t = _mm256_mul_ps(a_swapped, b_im);
+            _mm256_storeu_ps(pd.add(2 * k), _mm256_fmaddsub_ps(va, b_re, t));
+        }
+        k += 4;
+    }
+    for t in lanes..n {
+        dst[t] = a[t] * b[t];
+    }
+}
+
+/// The body of [`mul_rotated`], inlined into each compiled version.
+#[inline(always)]
+fn mul_rotated_portable(dst: &mut [Complex32], src: &[Complex32], start: usize, rep: &[Complex32]) {
     let first = dst.len().min(src.len() - start);
     let (d0, d1) = dst.split_at_mut(first);
     let (r0, r1) = rep.split_at(first);

@@ -40,10 +40,6 @@ pub(crate) fn analyse(
     exclusion: usize,
     floors: &mut Vec<f64>,
 ) -> Peak {
-    let excluded = |l: usize, centre: usize| -> bool {
-        let d = l.abs_diff(centre);
-        d.min(lags - d) <= exclusion
-    };
     // The window starts around the raw maximum; if a cell elsewhere is larger relative to its
     // row's floor (the raw maximum sat on a raised row), the window moves there once.
     let raw_max = grid
@@ -57,44 +53,75 @@ pub(crate) fn analyse(
             }
         })
         .1;
-    let mut centre = raw_max % lags.max(1);
+    let lags = lags.max(1);
+    let mut centre = raw_max % lags;
+    let window = (2 * exclusion + 1).min(lags);
+    let kept = (lags - window).max(1) as f64;
     let (mut peak, mut row, mut lag) = (0.0f64, 0usize, centre);
     for _ in 0..2 {
-        let kept = (0..lags).filter(|&l| !excluded(l, centre)).count().max(1);
         floors.clear();
-        for r in 0..rows {
-            let cells = &grid[r * lags..(r + 1) * lags];
-            let sum: f64 = cells
-                .iter()
-                .enumerate()
-                .filter(|(l, _)| !excluded(*l, centre))
-                .map(|(_, &v)| f64::from(v))
-                .sum();
-            floors.push((sum / kept as f64).max(f64::MIN_POSITIVE));
+        for cells in grid.chunks_exact(lags).take(rows) {
+            let total: f64 = cells.iter().map(|&v| f64::from(v)).sum();
+            let inside: f64 = if window == lags {
+                total
+            } else {
+                circular(cells, centre + lags - exclusion, window)
+                    .map(|&v| f64::from(v))
+                    .sum()
+            };
+            floors.push(((total - inside) / kept).max(f64::MIN_POSITIVE));
         }
         (peak, row, lag) = (0.0, 0, centre);
-        for (r, &floor) in floors.iter().enumerate() {
-            for (l, &v) in grid[r * lags..(r + 1) * lags].iter().enumerate() {
-                let x = f64::from(v) / floor;
-                if x > peak {
-                    (peak, row, lag) = (x, r, l);
-                }
+        for (r, (cells, &floor)) in grid.chunks_exact(lags).zip(floors.iter()).enumerate() {
+            // The row's largest cell (the first of equals), then its ratio to the floor.
+            let (l, v) = row_max(cells.iter().copied().enumerate());
+            let x = f64::from(v) / floor;
+            if x > peak {
+                (peak, row, lag) = (x, r, l);
             }
         }
-        if excluded(lag, centre) {
+        if circular_distance(lag, centre, lags) <= exclusion {
             break;
         }
         centre = lag;
     }
+    // The largest cell more than `exclusion` lags from the peak, relative to its row's floor.
     let mut second = 0.0f64;
-    for (r, &floor) in floors.iter().enumerate() {
-        for (l, &v) in grid[r * lags..(r + 1) * lags].iter().enumerate() {
-            if !excluded(l, lag) {
-                second = second.max(f64::from(v) / floor);
-            }
+    if window < lags {
+        for (cells, &floor) in grid.chunks_exact(lags).zip(floors.iter()) {
+            let (_, v) = row_max(
+                circular(cells, lag + exclusion + 1, lags - window)
+                    .copied()
+                    .enumerate(),
+            );
+            second = second.max(f64::from(v) / floor);
         }
     }
     finish(grid, lags, rows, floors, row, lag, peak, second)
+}
+
+/// `n` cells of `cells` from index `from` on, wrapping around (`from` taken modulo the length).
+fn circular(cells: &[f32], from: usize, n: usize) -> impl Iterator<Item = &f32> {
+    let len = cells.len();
+    let from = from % len.max(1);
+    let first = n.min(len - from);
+    cells[from..from + first]
+        .iter()
+        .chain(cells[..n - first].iter())
+}
+
+/// The circular distance between lags `a` and `b` of a `lags`-long code period.
+fn circular_distance(a: usize, b: usize, lags: usize) -> usize {
+    let d = a.abs_diff(b);
+    d.min(lags - d)
+}
+
+/// The largest value and its index (the first of equals; `(0, -inf)` when empty).
+fn row_max(cells: impl Iterator<Item = (usize, f32)>) -> (usize, f32) {
+    cells.fold(
+        (0, f32::NEG_INFINITY),
+        |b, (i, v)| if v > b.1 { (i, v) } else { b },
+    )
 }
 
 #[allow(clippy::too_many_arguments)]
