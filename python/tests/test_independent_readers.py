@@ -44,3 +44,21 @@ def test_pynmea2_parses_every_sentence_and_the_fixes_land_on_the_truth(sim, trut
             east_m = (msg.longitude - lon0) * 111_320.0 * math.cos(math.radians(lat0))
             assert math.hypot(north_m, east_m) < 20.0, line
     assert {"GGA", "RMC", "GSA", "GSV", "GST", "ZDA"} <= kinds, kinds
+
+
+def test_gpxpy_reads_the_track_of_a_run(sim, tmp_path):
+    import gpxpy
+
+    result = gpsrx.run(sim["data_path"], out=str(tmp_path), **RUN_OPTIONS)
+    with open(tmp_path / "track.gpx") as f:
+        gpx = gpxpy.parse(f)
+    points = gpx.tracks[0].segments[0].points
+    valid = [q for q in result["fixes"]["quality"] if q != "none"]
+    assert len(points) == len(valid) > 50
+    lat0, lon0 = 36.3721, 127.3604
+    for p in points:
+        north_m = (p.latitude - lat0) * 111_320.0
+        east_m = (p.longitude - lon0) * 111_320.0 * math.cos(math.radians(lat0))
+        assert math.hypot(north_m, east_m) < 20.0
+        assert p.type_of_gpx_fix == "3d" and p.satellites >= 4
+        assert p.time is not None and p.time.year == 2022

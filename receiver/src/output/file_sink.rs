@@ -5,7 +5,7 @@
 //! header's approximate position, or 300 s of observables with the week known, or the end;
 //! never written while the GPS week is unknown, see [`crate::pipeline::dating`]),
 //! `ephemeris.rnx` (the decoded ephemerides, at the end), `almanac.yuma` (the decoded almanac,
-//! when one was), `track.geojson` and `track.kml` (the
+//! when one was), `track.geojson`, `track.kml` and `track.gpx` (the
 //! fixes, at the end).
 
 use crate::output::{
@@ -211,6 +211,8 @@ impl Sink for FileSink {
         write_geojson(&mut f, "track.geojson", &self.fixes)?;
         let mut f = create_file(&self.dir.join("track.kml"))?;
         write_kml(&mut f, "track.kml", "gpsrx track", &self.fixes)?;
+        let mut f = create_file(&self.dir.join("track.gpx"))?;
+        super::write_gpx(&mut f, "track.gpx", "gpsrx track", &self.fixes)?;
         Ok(())
     }
 }

@@ -9,7 +9,7 @@ use super::{Fix, FixQuality, OutputError};
 use std::io::Write;
 
 /// Escapes the five XML special characters.
-fn xml_escape(text: &str) -> String {
+pub(crate) fn xml_escape(text: &str) -> String {
     let mut s = String::with_capacity(text.len());
     for c in text.chars() {
         match c {

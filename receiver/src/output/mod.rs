@@ -3,8 +3,9 @@
 //! - [`rinex_obs`]: RINEX 3.04 GPS observation file (`observables.rnx`), streamed epoch by epoch;
 //! - [`rinex_nav`]: RINEX 3.04 GPS navigation file (`ephemeris.rnx`);
 //! - [`yuma`]: the decoded almanac as a YUMA file (`almanac.yuma`);
-//! - [`nmea`]: NMEA 0183 GGA, RMC, GSA and GSV sentences (`pvt.nmea`);
-//! - [`geojson`] and [`kml`]: the track for maps (`track.geojson`, `track.kml`);
+//! - [`nmea`]: NMEA 0183 GGA, RMC, GSA, GSV, GST and ZDA sentences (`pvt.nmea`);
+//! - [`geojson`], [`kml`] and [`gpx`]: the track for maps (`track.geojson`, `track.kml`,
+//!   `track.gpx`);
 //! - [`pvt_csv`]: one row per fix (`pvt.csv`) and one row per channel and epoch
 //!   (`channels.csv`).
 //!
@@ -16,6 +17,7 @@
 
 pub mod file_sink;
 pub mod geojson;
+pub mod gpx;
 pub mod kml;
 pub mod nmea;
 pub mod pvt_csv;
@@ -30,6 +32,7 @@ use std::path::Path;
 
 pub use file_sink::FileSink;
 pub use geojson::write_geojson;
+pub use gpx::write_gpx;
 pub use kml::write_kml;
 pub use nmea::{NmeaOptions, NmeaWriter};
 pub use pvt_csv::{ChannelCsvWriter, PvtCsvWriter};
