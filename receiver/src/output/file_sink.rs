@@ -85,9 +85,12 @@ impl FileSink {
         approx_position_m: Option<[f64; 3]>,
         week: u32,
     ) -> Result<(), OutputError> {
+        // GPS - UTC at the start of the week (the IERS table; 18 s since 2017).
+        let (year, month, ..) = gpsrx_nav::GpsTime::new(week, 0.0).to_calendar();
         let header = ObsHeader {
             approx_position_m: approx_position_m.unwrap_or_default(),
             interval_s: Some(1.0 / self.rate_hz),
+            leap_seconds: Some(gpsrx_nav::utc::leap_seconds_on(year, month)),
             ..ObsHeader::default()
         };
         if self.obs_dropped > 0 {
@@ -171,7 +174,12 @@ impl Sink for FileSink {
         self.channels_csv.flush()?;
         match self.obs_writer.take() {
             Some(w) => {
+                let last = w.last_epoch_time();
                 w.finish()?;
+                if let Some(t) = last {
+                    let path = self.dir.join("observables.rnx");
+                    super::rinex_obs::insert_time_of_last_obs(&path, t)?;
+                }
             }
             None if !self.obs_backlog.is_empty() && !self.obs_week_known => {
                 tracing::warn!(
@@ -186,7 +194,12 @@ impl Sink for FileSink {
                 let week = self.obs_backlog.last().map_or(0, |o| o.time.week);
                 self.open_observables(None, week)?;
                 if let Some(w) = self.obs_writer.take() {
+                    let last = w.last_epoch_time();
                     w.finish()?;
+                    if let Some(t) = last {
+                        let path = self.dir.join("observables.rnx");
+                        super::rinex_obs::insert_time_of_last_obs(&path, t)?;
+                    }
                 }
             }
             None => {}

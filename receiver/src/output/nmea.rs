@@ -3,7 +3,8 @@
 //!
 //! Each sentence is `$<body>*hh\r\n` where `hh` is the XOR of every byte between `$` and `*`
 //! as two upper-case hexadecimal digits. Times are UTC = GPS time - leap seconds
-//! ([`NmeaOptions::leap_seconds`], 18 s since 2017-01-01). While the GPS week is unknown
+//! ([`NmeaOptions::leap_seconds`]; by default the count in effect at the fix's date, 18 s
+//! since 2017-01-01, from the leap-second table). While the GPS week is unknown
 //! ([`Fix::week_known`]) the RMC date is left empty.
 //!
 //! **Altitude.** GGA field 9 is meant to be the altitude above mean sea level (the geoid) and
@@ -30,8 +31,8 @@ const GSA_MAX_PRNS: usize = 12;
 /// How sentences are formed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NmeaOptions {
-    /// GPS - UTC, s (18 since 2017-01-01).
-    pub leap_seconds: i32,
+    /// GPS - UTC, s; `None`: the count in effect at each fix's date (18 since 2017-01-01).
+    pub leap_seconds: Option<i32>,
     /// Geoid separation N at the fix, m; `None` writes ellipsoidal height with N = 0.
     pub geoid_separation_m: Option<f64>,
 }
@@ -39,7 +40,7 @@ pub struct NmeaOptions {
 impl Default for NmeaOptions {
     fn default() -> NmeaOptions {
         NmeaOptions {
-            leap_seconds: 18,
+            leap_seconds: None,
             geoid_separation_m: None,
         }
     }
@@ -55,9 +56,19 @@ pub fn checksum(body: &str) -> u8 {
     body.bytes().fold(0, |acc, b| acc ^ b)
 }
 
+/// `t` moved back by the leap seconds, `leap_seconds` or else the count in effect at `t`'s
+/// date (a GPS time whose calendar fields read as UTC).
+fn utc_of(t: GpsTime, leap_seconds: Option<i32>) -> GpsTime {
+    let leap = leap_seconds.unwrap_or_else(|| {
+        let (y, m, ..) = t.add_seconds(-18.0).to_calendar();
+        gpsrx_nav::utc::leap_seconds_on(y, m)
+    });
+    t.add_seconds(-f64::from(leap))
+}
+
 /// UTC time `hhmmss.ss` and date `ddmmyy` of `t`, rounded to 0.01 s.
-fn utc_fields(t: GpsTime, leap_seconds: i32) -> (String, String) {
-    match calendar_rounded(t.add_seconds(-f64::from(leap_seconds)), 2) {
+fn utc_fields(t: GpsTime, leap_seconds: Option<i32>) -> (String, String) {
+    match calendar_rounded(utc_of(t, leap_seconds), 2) {
         Some(c) => (
             format!("{:02}{:02}{:02}.{:02}", c.hour, c.minute, c.second, c.frac),
             format!("{:02}{:02}{:02}", c.day, c.month, c.year.rem_euclid(100)),
@@ -275,7 +286,7 @@ pub fn gst(fix: &Fix, opts: &NmeaOptions) -> String {
 /// week is unknown.
 pub fn zda(fix: &Fix, opts: &NmeaOptions) -> String {
     let (time, _) = utc_fields(fix.time, opts.leap_seconds);
-    let date = match calendar_rounded(fix.time.add_seconds(-f64::from(opts.leap_seconds)), 2) {
+    let date = match calendar_rounded(utc_of(fix.time, opts.leap_seconds), 2) {
         Some(c) if fix.week_known => format!("{:02},{:02},{:04}", c.day, c.month, c.year),
         _ => ",,".to_string(),
     };
@@ -348,6 +359,20 @@ mod tests {
         assert_eq!(angle_fields(-11.516_666_7, 3, 'E', 'W'), "01131.000002,W");
         assert_eq!(angle_fields(9.999_999_999_99, 2, 'N', 'S'), "1000.000000,N");
         assert_eq!(angle_fields(f64::NAN, 2, 'N', 'S'), ",");
+    }
+
+    #[test]
+    fn utc_takes_the_leap_seconds_of_the_date() {
+        // 16 s until 2015-07-01, 17 until 2017-01-01, 18 since (IERS Bulletin C).
+        for (year, want_second) in [(2015, 44.0), (2016, 43.0), (2022, 42.0)] {
+            let t = GpsTime::from_calendar(year, 3, 1, 12, 0, 0.0);
+            let (_, _, _, h, mi, sec) = utc_of(t, None).to_calendar();
+            assert_eq!((h, mi), (11, 59), "{year}");
+            assert!((sec - want_second).abs() < 1e-6, "{year}: {sec}");
+        }
+        let t = GpsTime::from_calendar(2022, 3, 1, 12, 0, 0.0);
+        let (.., sec) = utc_of(t, Some(20)).to_calendar();
+        assert!((sec - 40.0).abs() < 1e-6);
     }
 
     #[test]

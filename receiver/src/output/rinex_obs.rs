@@ -202,6 +202,11 @@ impl<W: Write> RinexObsWriter<W> {
         Ok(())
     }
 
+    /// The time of the last epoch written, if any.
+    pub fn last_epoch_time(&self) -> Option<GpsTime> {
+        self.last_time
+    }
+
     /// Flushes and returns the destination. Fails with [`OutputError::Empty`] if no epoch was
     /// written, since a header without `TIME OF FIRST OBS` is not valid RINEX.
     pub fn finish(mut self) -> Result<W, OutputError> {
@@ -314,23 +319,10 @@ impl<W: Write> RinexObsWriter<W> {
             }
             line(text, "INTERVAL");
         }
-        let cal = calendar_rounded(first, 7).ok_or_else(|| {
+        let first_text = obs_time_text(first).ok_or_else(|| {
             OutputError::invalid(&self.file, format!("first epoch {first:?} is not valid"))
         })?;
-        // 5I6,F13.7,5X,A3
-        line(
-            format!(
-                "{:6}{:6}{:6}{:6}{:6}{:13.7}{:5}GPS",
-                cal.year,
-                cal.month,
-                cal.day,
-                cal.hour,
-                cal.minute,
-                f64::from(cal.second) + cal.frac as f64 * 1e-7,
-                ""
-            ),
-            "TIME OF FIRST OBS",
-        );
+        line(first_text, "TIME OF FIRST OBS");
         line("     0".to_string(), "RCV CLOCK OFFS APPL");
         if let Some(leap) = h.leap_seconds {
             line(format!("{leap:6}"), "LEAP SECONDS");
@@ -368,6 +360,56 @@ pub fn ssi_from_cn0(cn0_dbhz: f64) -> Option<u8> {
 /// ambiguity/slip possible.
 pub fn lli_flags(sat: &SatObs) -> u8 {
     u8::from(sat.loss_of_lock) | (u8::from(sat.half_cycle_ambiguous) << 1)
+}
+
+/// A header time field (5I6,F13.7,5X,A3: `TIME OF FIRST OBS` and `TIME OF LAST OBS`), `None`
+/// for a time that has no calendar date.
+fn obs_time_text(t: GpsTime) -> Option<String> {
+    let cal = calendar_rounded(t, 7)?;
+    Some(format!(
+        "{:6}{:6}{:6}{:6}{:6}{:13.7}{:5}GPS",
+        cal.year,
+        cal.month,
+        cal.day,
+        cal.hour,
+        cal.minute,
+        f64::from(cal.second) + cal.frac as f64 * 1e-7,
+        ""
+    ))
+}
+
+/// Adds `TIME OF LAST OBS` (`last`) to the header of the finished file at `path`, after its
+/// `TIME OF FIRST OBS` line: the header is written before the last epoch is known, so the file
+/// is copied line by line into a new one beside it (bounded memory), which replaces it.
+pub fn insert_time_of_last_obs(path: &Path, last: GpsTime) -> Result<(), OutputError> {
+    use std::io::{BufRead, BufReader};
+    let file = path.display().to_string();
+    let Some(text) = obs_time_text(last) else {
+        return Err(OutputError::invalid(
+            &file,
+            format!("last epoch {last:?} is not valid"),
+        ));
+    };
+    let tmp = path.with_extension("rnx.tmp");
+    let input = File::open(path).map_err(OutputError::io(&file))?;
+    let mut out = create_file(&tmp)?;
+    let mut in_header = true;
+    for l in BufReader::new(input).lines() {
+        let l = l.map_err(OutputError::io(&file))?;
+        writeln!(out, "{l}").map_err(OutputError::io(&file))?;
+        if in_header
+            && l.get(60..)
+                .is_some_and(|label| label.starts_with("TIME OF FIRST OBS"))
+        {
+            writeln!(out, "{text:<60}TIME OF LAST OBS").map_err(OutputError::io(&file))?;
+        }
+        in_header &= !l
+            .get(60..)
+            .is_some_and(|label| label.starts_with("END OF HEADER"));
+    }
+    out.flush().map_err(OutputError::io(&file))?;
+    drop(out);
+    std::fs::rename(&tmp, path).map_err(OutputError::io(&file))
 }
 
 #[cfg(test)]
@@ -415,6 +457,29 @@ mod tests {
         }
         let bytes = w.finish()?;
         Ok(String::from_utf8_lossy(&bytes).into_owned())
+    }
+
+    #[test]
+    fn time_of_last_obs_goes_into_the_finished_header_only() -> Result<(), OutputError> {
+        let text = write(&[epoch(538_200.0), epoch(538_200.5)])?;
+        let dir = tempfile::tempdir().map_err(OutputError::io("tempdir"))?;
+        let path = dir.path().join("o.rnx");
+        std::fs::write(&path, &text).map_err(OutputError::io("o.rnx"))?;
+        insert_time_of_last_obs(&path, GpsTime::new(2190, 538_200.5))?;
+        let out = std::fs::read_to_string(&path).map_err(OutputError::io("o.rnx"))?;
+        let lines: Vec<&str> = out.lines().collect();
+        let first = lines.iter().position(|l| l.ends_with("TIME OF FIRST OBS"));
+        let last = lines.iter().position(|l| l.ends_with("TIME OF LAST OBS"));
+        assert_eq!(last, first.map(|i| i + 1), "{out}");
+        // 2022-01-01 05:30:00.5 GPS time, in the columns of TIME OF FIRST OBS.
+        let l = lines[last.unwrap_or(0)];
+        assert_eq!(&l[..43], "  2022     1     1     5    30    0.5000000");
+        assert_eq!(&l[48..51], "GPS");
+        assert_eq!(l.len(), 76);
+        // The body is unchanged, and the label appears once.
+        assert_eq!(out.matches("TIME OF LAST OBS").count(), 1);
+        assert_eq!(lines.len(), text.lines().count() + 1);
+        Ok(())
     }
 
     #[test]
