@@ -29,21 +29,13 @@ const GSV_MAX_SENTENCES: usize = 9;
 const GSA_MAX_PRNS: usize = 12;
 
 /// How sentences are formed.
-#[derive(Debug, Clone, PartialEq)]
+/// The default: leap seconds from the table at each fix's date, no geoid separation.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct NmeaOptions {
     /// GPS - UTC, s; `None`: the count in effect at each fix's date (18 since 2017-01-01).
     pub leap_seconds: Option<i32>,
     /// Geoid separation N at the fix, m; `None` writes ellipsoidal height with N = 0.
     pub geoid_separation_m: Option<f64>,
-}
-
-impl Default for NmeaOptions {
-    fn default() -> NmeaOptions {
-        NmeaOptions {
-            leap_seconds: None,
-            geoid_separation_m: None,
-        }
-    }
 }
 
 /// `$body*hh\r\n` with the NMEA checksum.
