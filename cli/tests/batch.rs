@@ -81,3 +81,38 @@ fn every_entry_failing_or_a_bad_manifest_is_exit_status_1() {
     let err = text(&o.stderr);
     assert!(err.contains("m.toml") && err.contains("file"), "{err}");
 }
+
+/// `gpsrx run --json`: the summary as one JSON object on standard output, equal to the fixes
+/// written to `pvt.csv`.
+#[test]
+fn run_json_prints_the_summary_for_scripts() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    simulate(&dir.path().join("rec"));
+    let out_dir = dir.path().join("out");
+    let nav = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data/brdc0010.22n");
+    let out = Command::new(env!("CARGO_BIN_EXE_gpsrx"))
+        .env("NO_COLOR", "1")
+        .env_remove("GPSRX_LOG")
+        .arg("run")
+        .arg(dir.path().join("rec/signal.ci8"))
+        .arg("--nav")
+        .arg(&nav)
+        .args(["--approx-llh", "36.4,127.4,0", "--json", "--out"])
+        .arg(&out_dir)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot start gpsrx: {e}"));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("not JSON ({e}): {}", text(&out.stdout)));
+    let fixes = v["fixes"].as_u64().unwrap_or(0);
+    let rows = std::fs::read_to_string(out_dir.join("pvt.csv"))
+        .expect("pvt.csv")
+        .lines()
+        .skip(1)
+        .filter(|l| !l.contains(",none,"))
+        .count() as u64;
+    assert!(fixes > 10 && fixes == rows, "{v}");
+    assert!(v["first_fix_s"].as_f64().is_some_and(|t| t < 2.0), "{v}");
+    assert_eq!(v["outputs"].as_str(), Some(out_dir.display().to_string().as_str()));
+    assert!(v["tracked_prns"].as_array().is_some_and(|a| a.len() >= 6), "{v}");
+}

@@ -34,6 +34,9 @@ pub struct RunArgs {
     /// Output directory (created if needed).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    /// Print the summary as JSON on standard output (for scripts) instead of text.
+    #[arg(long)]
+    pub json: bool,
     /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
     #[arg(long, value_name = "FILE")]
     pub nav: Option<PathBuf>,

@@ -49,6 +49,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         },
         loops: LoopArgs::default(),
         out: dir.join("run"),
+        json: false,
         nav: None,
         iono: Some(IonoModel::Klobuchar),
         tropo: Some(TropoModel::Saastamoinen),

@@ -150,7 +150,15 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunRepor
 pub fn run(args: &RunArgs) -> anyhow::Result<Completion> {
     let (report, _) = run_file(args, true)?;
     let mut out = crate::exit::stdout();
-    print_report(&mut out, &report, args)?;
+    if args.json {
+        let mut value = serde_json::to_value(&report)?;
+        if let Some(map) = value.as_object_mut() {
+            map.insert("outputs".into(), args.out.display().to_string().into());
+        }
+        writeln!(out, "{}", serde_json::to_string_pretty(&value)?)?;
+    } else {
+        print_report(&mut out, &report, args)?;
+    }
     out.flush()?;
     Ok(if report.receiver.fixes == 0 {
         Completion::NoValidFix
