@@ -113,6 +113,12 @@ fn run_json_prints_the_summary_for_scripts() {
         .count() as u64;
     assert!(fixes > 10 && fixes == rows, "{v}");
     assert!(v["first_fix_s"].as_f64().is_some_and(|t| t < 2.0), "{v}");
-    assert_eq!(v["outputs"].as_str(), Some(out_dir.display().to_string().as_str()));
-    assert!(v["tracked_prns"].as_array().is_some_and(|a| a.len() >= 6), "{v}");
+    assert_eq!(
+        v["outputs"].as_str(),
+        Some(out_dir.display().to_string().as_str())
+    );
+    assert!(
+        v["tracked_prns"].as_array().is_some_and(|a| a.len() >= 6),
+        "{v}"
+    );
 }
