@@ -8,7 +8,7 @@ use clap::Parser;
 use gpsrx_cli::cli::{Cli, Command};
 use gpsrx_cli::commands;
 use gpsrx_cli::exit::{error_message, is_broken_pipe, Completion};
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -16,10 +16,13 @@ fn main() -> ExitCode {
     let filter = tracing_subscriber::EnvFilter::try_from_env("GPSRX_LOG").unwrap_or_else(|_| {
         tracing_subscriber::EnvFilter::new(if cli.verbose { "debug" } else { "info" })
     });
+    // No colour codes in a log file or a pipe (nor with NO_COLOR set).
+    let ansi = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();
     tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
         .with_target(false)
+        .with_ansi(ansi)
         .init();
     let done = |r: anyhow::Result<()>| r.map(|()| Completion::Done);
     let result = match cli.command {

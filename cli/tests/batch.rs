@@ -83,7 +83,7 @@ fn every_entry_failing_or_a_bad_manifest_is_exit_status_1() {
 }
 
 /// `gpsrx run --json`: the summary as one JSON object on standard output, equal to the fixes
-/// written to `pvt.csv`.
+/// written to `pvt.csv`; the log on standard error has no colour codes (not a terminal).
 #[test]
 fn run_json_prints_the_summary_for_scripts() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -91,7 +91,7 @@ fn run_json_prints_the_summary_for_scripts() {
     let out_dir = dir.path().join("out");
     let nav = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data/brdc0010.22n");
     let out = Command::new(env!("CARGO_BIN_EXE_gpsrx"))
-        .env("NO_COLOR", "1")
+        .env_remove("NO_COLOR")
         .env_remove("GPSRX_LOG")
         .arg("run")
         .arg(dir.path().join("rec/signal.ci8"))
@@ -102,6 +102,9 @@ fn run_json_prints_the_summary_for_scripts() {
         .output()
         .unwrap_or_else(|e| panic!("cannot start gpsrx: {e}"));
     assert!(out.status.success(), "{}", text(&out.stderr));
+    // The log goes to a pipe here: no colour codes in it.
+    assert!(text(&out.stderr).contains("INFO"), "{}", text(&out.stderr));
+    assert!(!out.stderr.contains(&0x1b), "escape codes in a piped log");
     let v: serde_json::Value = serde_json::from_slice(&out.stdout)
         .unwrap_or_else(|e| panic!("not JSON ({e}): {}", text(&out.stdout)));
     let fixes = v["fixes"].as_u64().unwrap_or(0);

@@ -16,9 +16,10 @@ use gpsrx_receiver::{Assistance, Receiver, RunSummary};
 use gpsrx_samples::sigmf::RecordingStart;
 use gpsrx_samples::{SampleSource, SourceConfig};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 
 mod dr_inputs;
+pub mod progress_line;
 
 pub use crate::cli::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
 use dr_inputs::{write_fused_outputs, DrInputs};
@@ -38,6 +39,8 @@ pub struct RunReport {
 /// The command's own sink beside the files: the progress bar and the fixes for DR fusion.
 struct CommandSink {
     bar: ProgressBar,
+    /// The progress as log lines, when standard error is not a terminal.
+    line: Option<progress_line::ProgressLine>,
     gnss_fixes: Option<Vec<GnssFix>>,
 }
 
@@ -51,6 +54,9 @@ impl Sink for CommandSink {
     }
 
     fn progress(&mut self, p: &Progress) -> Result<(), SinkError> {
+        if let Some(line) = &mut self.line {
+            line.update(p);
+        }
         self.bar.set_position(p.sample_index);
         self.bar.set_message(format!(
             "{} satellites, {} frame-synced, {} with ephemeris",
@@ -117,8 +123,11 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunRepor
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let files = FileSink::create(&args.out, config.run.rate_hz)?;
+    let line = (show_progress && !std::io::stderr().is_terminal())
+        .then(|| progress_line::ProgressLine::new(src.fs_hz(), src.total_samples()));
     let extra = CommandSink {
         bar: bar.clone(),
+        line,
         gnss_fixes: dr_inputs.as_ref().map(|_| Vec::new()),
     };
     let mut sink = Tee(files, extra);
