@@ -2,13 +2,14 @@
 //! integration interval of every channel to CSV for loop studies.
 
 use crate::commands::acquire::search_plan;
+use crate::commands::run::progress_line::ProgressLine;
 use crate::commands::source::open_interruptible;
 use anyhow::Context;
-use gpsrx_receiver::pipeline::{FixReport, SearchSettings, Sink, SinkError};
+use gpsrx_receiver::pipeline::{FixReport, Progress, SearchSettings, Sink, SinkError};
 use gpsrx_receiver::{Assistance, Receiver};
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use std::collections::BTreeMap;
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 
 pub use crate::cli::TrackArgs;
 
@@ -72,10 +73,19 @@ fn csv_row(e: &ChannelEpoch) -> String {
 struct TrackSink {
     summaries: BTreeMap<u8, ChannelSummary>,
     writer: Option<std::io::BufWriter<std::fs::File>>,
+    /// The progress as log lines, when standard error is not a terminal.
+    line: Option<ProgressLine>,
 }
 
 impl Sink for TrackSink {
     fn fix(&mut self, _report: &FixReport) -> Result<(), SinkError> {
+        Ok(())
+    }
+
+    fn progress(&mut self, p: &Progress) -> Result<(), SinkError> {
+        if let Some(line) = &mut self.line {
+            line.update(p);
+        }
         Ok(())
     }
 
@@ -143,9 +153,12 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
         }
         None => None,
     };
+    let line = (!std::io::stderr().is_terminal())
+        .then(|| ProgressLine::new(src.fs_hz(), src.total_samples()));
     let mut sink = TrackSink {
         summaries: BTreeMap::new(),
         writer,
+        line,
     };
     let run = receiver.run(src.as_mut(), &mut sink);
     crate::commands::run::warn_source(src.as_ref());
