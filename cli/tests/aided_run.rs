@@ -180,6 +180,20 @@ fn error_3d_m(f: &Fix, truth: &[(f64, [f64; 3], [f64; 3])]) -> f64 {
         .sqrt()
 }
 
+/// Simulates `sc` with the INS table `ins_toml` into `dir`: the recording's path and the
+/// `ins.csv` written through the INS error model.
+fn simulate_with_ins(sc: &mut Scenario, ins_toml: &str, dir: &Path) -> (PathBuf, PathBuf) {
+    sc.ins = Some(toml::from_str(ins_toml).unwrap_or_else(|e| panic!("{e}")));
+    let sim = Simulator::new(sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let report = sim.run(dir, &|_| {}).unwrap_or_else(|e| panic!("{e}"));
+    let ins_path = dir.join("ins.csv");
+    let cfg: InsErrorConfig = toml::Value::Table(sc.ins.clone().unwrap_or_default())
+        .try_into()
+        .unwrap_or_else(|e| panic!("{e}"));
+    write_ins_for(&sim, &cfg, &ins_path).unwrap_or_else(|e| panic!("{e}"));
+    (report.data_path, ins_path)
+}
+
 /// Seed 004 end to end: a 3 Hz 2nd-order PLL cannot follow a 5 g turn (dynamic stress
 /// 0.2809 a / Bn^2 = 2900 deg for the full 5 g on the line of sight); fed forward with the INS
 /// velocity (biased accelerometers, 0.01 m/s^2) it keeps phase lock on every satellite and the
@@ -189,19 +203,11 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
     let dir = tmp();
     let (turn_at, turn_s) = (16.0, 8.0);
     let mut sc = turn_scenario(30.0, turn_at, turn_s);
-    sc.ins = Some(
-        toml::from_str("accel_bias_enu_mps2 = [0.01, 0.01, 0.0]\nrate_hz = 100.0")
-            .unwrap_or_else(|e| panic!("{e}")),
+    let (data_path, ins_path) = simulate_with_ins(
+        &mut sc,
+        "accel_bias_enu_mps2 = [0.01, 0.01, 0.0]\nrate_hz = 100.0",
+        dir.path(),
     );
-    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
-    let report = sim
-        .run(dir.path(), &|_| {})
-        .unwrap_or_else(|e| panic!("{e}"));
-    let ins_path: PathBuf = dir.path().join("ins.csv");
-    let cfg: InsErrorConfig = toml::Value::Table(sc.ins.clone().unwrap_or_default())
-        .try_into()
-        .unwrap_or_else(|e| panic!("{e}"));
-    write_ins_for(&sim, &cfg, &ins_path).unwrap_or_else(|e| panic!("{e}"));
     let nav = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data/brdc0010.22n");
     let nav = nav.to_str().unwrap_or_default();
     let ins = ins_path.to_str().unwrap_or_default();
@@ -218,10 +224,10 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
     let unaided_out = dir.path().join("unaided");
     let mut aided_args = common.to_vec();
     aided_args.extend_from_slice(&["--ins", ins]);
-    let (aided_report, aided) = run_report(&report.data_path, &aided_out, &aided_args);
+    let (aided_report, aided) = run_report(&data_path, &aided_out, &aided_args);
     let mut unaided_args = common.to_vec();
     unaided_args.extend_from_slice(&["--ins", ins, "--no-aiding"]);
-    let unaided = run(&report.data_path, &unaided_out, &unaided_args);
+    let unaided = run(&data_path, &unaided_out, &unaided_args);
 
     // The turn in GPS time (plus the 1 s ramps).
     let t0 = 538194.0 + turn_at;
@@ -283,21 +289,8 @@ fn aided_0p4_hz_loops_keep_every_satellite_through_a_10g_turn_with_a_1_or_2_mg_i
         let dir = tmp();
         let mut sc = turn_scenario_with(18.0, turn_at, turn_s, 250.0, 10.0);
         let b = bias_mg * 9.80665e-3;
-        sc.ins = Some(
-            toml::from_str(&format!(
-                "accel_bias_enu_mps2 = [{b}, {b}, {b}]\nrate_hz = 100.0"
-            ))
-            .unwrap_or_else(|e| panic!("{e}")),
-        );
-        let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
-        let report = sim
-            .run(dir.path(), &|_| {})
-            .unwrap_or_else(|e| panic!("{e}"));
-        let ins_path: PathBuf = dir.path().join("ins.csv");
-        let cfg: InsErrorConfig = toml::Value::Table(sc.ins.clone().unwrap_or_default())
-            .try_into()
-            .unwrap_or_else(|e| panic!("{e}"));
-        write_ins_for(&sim, &cfg, &ins_path).unwrap_or_else(|e| panic!("{e}"));
+        let ins_toml = format!("accel_bias_enu_mps2 = [{b}, {b}, {b}]\nrate_hz = 100.0");
+        let (data_path, ins_path) = simulate_with_ins(&mut sc, &ins_toml, dir.path());
         let nav = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data/brdc0010.22n");
         let (nav, ins) = (
             nav.to_str().unwrap_or_default(),
@@ -307,11 +300,11 @@ fn aided_0p4_hz_loops_keep_every_satellite_through_a_10g_turn_with_a_1_or_2_mg_i
         let aided_out = dir.path().join("aided");
         let mut aided_args = loops.to_vec();
         aided_args.extend_from_slice(&["--aided-pll-order", "3", "--aided-pll-bw", "0.4"]);
-        let aided = run(&report.data_path, &aided_out, &aided_args);
+        let aided = run(&data_path, &aided_out, &aided_args);
         let unaided_out = dir.path().join("unaided");
         let mut unaided_args = loops.to_vec();
         unaided_args.extend_from_slice(&["--pll-order", "3", "--pll-bw", "0.4", "--no-aiding"]);
-        let unaided = run(&report.data_path, &unaided_out, &unaided_args);
+        let unaided = run(&data_path, &unaided_out, &unaided_args);
 
         let t0 = 538194.0 + turn_at;
         let t1 = t0 + turn_s + 1.0;

@@ -123,6 +123,14 @@ fn the_run_false_alarm_probability_is_honoured_end_to_end_on_noise() {
 /// Eight satellites over Seoul at 2.048 MHz from `seed`, for `duration_s`, with the C/N0 list
 /// `cn0` (TOML array of `{ prn, dbhz }`); returns the simulator and the receiver's sink.
 fn simulate_and_run(seed: u64, duration_s: f64, cn0: &str) -> (Simulator, MemorySink) {
+    let sim = seoul(seed, duration_s, 538_198.0, cn0);
+    let sink = run_simulation(&sim);
+    (sim, sink)
+}
+
+/// The simulator of a static antenna in Seoul at 2.048 MHz (cf32), starting at `tow_s` of
+/// week 2190, with the C/N0 list `cn0`.
+fn seoul(seed: u64, duration_s: f64, tow_s: f64, cn0: &str) -> Simulator {
     let text = format!(
         r#"
 duration_s = {duration_s}
@@ -130,7 +138,7 @@ seed = {seed}
 nav = "builtin:brdc0010.22n"
 [start]
 week = 2190
-tow_s = 538198.0
+tow_s = {tow_s:.1}
 [output]
 format = "cf32_le"
 fs_hz = 2.048e6
@@ -142,9 +150,7 @@ cn0 = {cn0}
 "#
     );
     let sc = Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
-    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
-    let sink = run_simulation(&sim);
-    (sim, sink)
+    Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Asserts that every PRN acquired or tracked is one the simulator put in the sky.
@@ -211,21 +217,7 @@ fn a_28_dbhz_satellite_is_acquired_held_and_used_in_the_fixes() {
     // the background search finds the weak ones, the weak-signal pull-in (FLL on 10 ms sums,
     // differential bit sync, bit-aligned 20 ms PLL) holds them from their first acquisition,
     // their subframes give their time, and they are used in the fixes.
-    let text = r#"
-duration_s = 24.0
-seed = 2828
-nav = "builtin:brdc0010.22n"
-[start]
-week = 2190
-tow_s = 538194.0
-[output]
-format = "cf32_le"
-fs_hz = 2.048e6
-[receiver]
-kind = "static"
-llh_deg = [37.5665, 126.9780, 40.0]
-[satellites]
-cn0 = [
+    let cn0 = "[
   { prn = 31, dbhz = 45.0 },
   { prn = 26, dbhz = 42.0 },
   { prn = 32, dbhz = 40.0 },
@@ -234,10 +226,8 @@ cn0 = [
   { prn = 22, dbhz = 35.0 },
   { prn = 3, dbhz = 29.0 },
   { prn = 16, dbhz = 28.5 },
-]
-"#;
-    let sc = Scenario::from_toml(text).unwrap_or_else(|e| panic!("{e}"));
-    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+]";
+    let sim = seoul(2828, 24.0, 538_194.0, cn0);
     let sink = run_simulation(&sim);
     let (_, truth) = sim.receiver_truth(0.0);
     for weak in [3u8, 16] {
