@@ -6,7 +6,7 @@ use gpsrx_receiver::pipeline::{MemorySink, ReceiverEvent, Sink};
 use gpsrx_receiver::{Assistance, Receiver, ReceiverConfig};
 use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
 use gpsrx_samples::sim::{Scenario, Simulator};
-use gpsrx_samples::{SampleError, SampleFormat, SampleSource};
+use gpsrx_samples::{IntegerFormat, IntegerSamplesMut, SampleError, SampleFormat, SampleSource};
 use num_complex::Complex32;
 use std::path::Path;
 
@@ -627,4 +627,110 @@ fn an_ins_50_mps_off_is_rejected_before_it_aids_and_the_fixes_are_the_unaided_on
         "3D RMS fix error: unaided {rp:.2} m, INS 50 m/s off {rb:.2} m, perfect INS {rg:.2} m"
     );
     assert!(rb < rp + 0.5, "{rb} m vs {rp} m unaided");
+}
+
+/// The simulator's samples quantised to ci8 (about 20 LSB rms), offered either as stored
+/// (`read_integer`: the window holds ci8 and the correlators read it in place) or only
+/// through `read` as complex f32.
+struct Ci8Source<'a> {
+    inner: SimSource<'a>,
+    offer_integers: bool,
+    scale: f32,
+    buf: Vec<Complex32>,
+}
+
+impl<'a> Ci8Source<'a> {
+    fn new(sim: &'a Simulator, offer_integers: bool) -> Self {
+        let mut first = Vec::new();
+        sim.generate_chunk(0, &mut first);
+        let power = first.iter().map(|c| c.norm_sqr()).sum::<f32>() / first.len() as f32;
+        Self {
+            inner: SimSource::new(sim),
+            offer_integers,
+            scale: 20.0 / power.sqrt(),
+            buf: Vec::new(),
+        }
+    }
+
+    fn quantise(&self, x: f32) -> i8 {
+        (x * self.scale).round().clamp(-127.0, 127.0) as i8
+    }
+}
+
+impl SampleSource for Ci8Source<'_> {
+    fn fs_hz(&self) -> f64 {
+        self.inner.fs_hz()
+    }
+    fn format(&self) -> &SampleFormat {
+        &SampleFormat::Ci8
+    }
+    fn total_samples(&self) -> Option<u64> {
+        self.inner.total_samples()
+    }
+    fn read(&mut self, out: &mut [Complex32]) -> Result<(u64, usize), SampleError> {
+        let (first, n) = self.inner.read(out)?;
+        for o in &mut out[..n] {
+            *o = Complex32::new(
+                f32::from(self.quantise(o.re)),
+                f32::from(self.quantise(o.im)),
+            );
+        }
+        Ok((first, n))
+    }
+    fn integer_format(&self) -> Option<IntegerFormat> {
+        self.offer_integers.then_some(IntegerFormat::Ci8)
+    }
+    fn read_integer(&mut self, out: IntegerSamplesMut<'_>) -> Result<(u64, usize), SampleError> {
+        let IntegerSamplesMut::Ci8(out) = out else {
+            return Err(SampleError::NoIntegerRead {
+                asked: out.format(),
+            });
+        };
+        let mut buf = std::mem::take(&mut self.buf);
+        buf.resize(out.len(), Complex32::new(0.0, 0.0));
+        let (first, n) = self.inner.read(&mut buf)?;
+        for (o, c) in out.iter_mut().zip(&buf[..n]) {
+            *o = [self.quantise(c.re), self.quantise(c.im)];
+        }
+        self.buf = buf;
+        Ok((first, n))
+    }
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+#[test]
+fn ci8_samples_held_as_stored_give_the_fixes_of_the_same_samples_in_f32() {
+    let sim = simulator(8.0);
+    let fs = 2.048e6;
+    let mut as_f32 = MemorySink::new();
+    let a = receiver(fs)
+        .run(&mut Ci8Source::new(&sim, false), &mut as_f32)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut as_stored = MemorySink::new();
+    let b = receiver(fs)
+        .run(&mut Ci8Source::new(&sim, true), &mut as_stored)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(a.fixes > 5, "{} fixes", a.fixes);
+    assert_eq!(a.fixes, b.fixes);
+    assert_eq!(a.tracked_prns, b.tracked_prns);
+    assert_eq!(as_f32.events, as_stored.events);
+    // The same sums in another order (the kernels' lanes): equal to far below a millimetre.
+    for (x, y) in as_f32.fixes.iter().zip(&as_stored.fixes) {
+        assert_eq!(x.fix.time, y.fix.time);
+        let d: f64 = (0..3)
+            .map(|i| (x.fix.ecef_m[i] - y.fix.ecef_m[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(d < 1e-3, "fixes {d} m apart at {:.1} s", x.t_stream_s);
+    }
+    for (f, (h, v)) in as_stored.fixes.iter().zip(fix_errors(&sim, &as_stored)) {
+        let (h_max, v_max) = fix_bounds();
+        assert!(
+            h < h_max && v < v_max,
+            "fix at {:.1} s off by {h:.2} / {v:.2} m",
+            f.t_stream_s
+        );
+    }
 }

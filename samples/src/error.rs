@@ -9,6 +9,14 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SampleError {
+    /// A source was asked for samples as stored in a format it does not hand over (a
+    /// programming error: ask `integer_format()` first).
+    #[error("this source cannot hand over {asked} samples as stored; read them with read()")]
+    NoIntegerRead {
+        /// The format asked for.
+        asked: crate::source::IntegerFormat,
+    },
+
     /// The recording does not exist.
     #[error("recording {path} does not exist: check the path")]
     NotFound {

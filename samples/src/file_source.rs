@@ -11,7 +11,8 @@ use crate::format::SampleFormat;
 use crate::mixer::Mixer;
 use crate::resolve::{resolve, Resolved};
 use crate::source::{
-    non_finite_warning, to_baseband, trailing_bytes_warning, SampleSource, SourceConfig,
+    non_finite_warning, to_baseband, trailing_bytes_warning, IntegerFormat, IntegerSamplesMut,
+    SampleSource, SourceConfig,
 };
 use crate::span::{bytes_for_samples, sample_position, Span};
 
@@ -72,11 +73,27 @@ impl FileSource {
     /// Like [`SampleSource::read`] but without Q inversion or IF mixing: the values as stored
     /// (real formats give Q = 0). Non-finite values still read as 0.
     pub fn read_raw(&mut self, out: &mut [Complex32]) -> Result<(u64, usize), SampleError> {
+        let mut non_finite = 0;
+        let read = self.for_each_chunk(out.len(), |format, bytes, phase, range| {
+            non_finite += decode(format, bytes, phase, &mut out[range]);
+        });
+        self.non_finite += non_finite;
+        read
+    }
+
+    /// Hands the bytes of the next `wanted` samples (fewer at the end of the span) to `take`
+    /// chunk by chunk, with the sample offset into the chunk's first byte and the samples'
+    /// range in the request; returns (index of the first sample, samples handed over).
+    fn for_each_chunk(
+        &mut self,
+        wanted: usize,
+        mut take: impl FnMut(&SampleFormat, &[u8], usize, std::ops::Range<usize>),
+    ) -> Result<(u64, usize), SampleError> {
         let first = self.pos;
         let mut done = 0;
-        while done < out.len() && self.pos < self.span.end_sample() {
+        while done < wanted && self.pos < self.span.end_sample() {
             let left = self.span.end_sample() - self.pos;
-            let n = (out.len() - done)
+            let n = (wanted - done)
                 .min(self.max_block)
                 .min(usize::try_from(left).unwrap_or(usize::MAX));
             let format: &SampleFormat = &self.resolved.format;
@@ -84,7 +101,7 @@ impl FileSource {
             let end_byte = bytes_for_samples(format, self.pos + n as u64);
             let len = (end_byte - byte) as usize;
             let bytes = self.chunks.get(self.resolved.data_offset + byte, len)?;
-            self.non_finite += decode(format, bytes, phase, &mut out[done..done + n]);
+            take(format, bytes, phase, done..done + n);
             self.pos += n as u64;
             done += n;
         }
@@ -119,6 +136,39 @@ impl SampleSource for FileSource {
             self.mixer.as_ref(),
         );
         Ok((first, n))
+    }
+
+    fn integer_format(&self) -> Option<IntegerFormat> {
+        let r = &self.resolved;
+        if r.if_hz != 0.0 || r.invert_q {
+            return None;
+        }
+        match r.format {
+            SampleFormat::Ci8 => Some(IntegerFormat::Ci8),
+            SampleFormat::Ci16Le => Some(IntegerFormat::Ci16),
+            _ => None,
+        }
+    }
+
+    fn read_integer(&mut self, out: IntegerSamplesMut<'_>) -> Result<(u64, usize), SampleError> {
+        let asked = out.format();
+        if self.integer_format() != Some(asked) {
+            return Err(SampleError::NoIntegerRead { asked });
+        }
+        match out {
+            IntegerSamplesMut::Ci8(out) => self.for_each_chunk(out.len(), |_, bytes, _, range| {
+                let dst: &mut [u8] = bytemuck::cast_slice_mut(&mut out[range]);
+                dst.copy_from_slice(&bytes[..dst.len()]);
+            }),
+            IntegerSamplesMut::Ci16(out) => self.for_each_chunk(out.len(), |_, bytes, _, range| {
+                for (o, b) in out[range].iter_mut().zip(bytes.chunks_exact(4)) {
+                    *o = [
+                        i16::from_le_bytes([b[0], b[1]]),
+                        i16::from_le_bytes([b[2], b[3]]),
+                    ];
+                }
+            }),
+        }
     }
 
     fn warnings(&self) -> Vec<String> {

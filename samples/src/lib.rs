@@ -29,6 +29,6 @@ pub mod writer;
 
 pub use error::SampleError;
 pub use format::SampleFormat;
-pub use source::{open_source, SampleSource, SourceConfig};
+pub use source::{open_source, IntegerFormat, IntegerSamplesMut, SampleSource, SourceConfig};
 pub use stream_source::ReaderSource;
 pub use writer::{create_wav_writer, create_writer, SampleWriter, WriteStats};

@@ -84,6 +84,74 @@ pub trait SampleSource: Send {
     /// Things the user should know: a trailing partial sample dropped, non-finite values zeroed,
     /// a duration cut at the end of the file, `--format` or `--fs` overriding metadata.
     fn warnings(&self) -> Vec<String>;
+
+    /// The complex integer format this source can hand over exactly as stored, without turning
+    /// samples into f32 ([`SampleSource::read_integer`]): complex 8- or 16-bit samples at IF 0
+    /// with Q not inverted, where [`SampleSource::read`] would only widen them. `None` (the
+    /// default) when every sample must go through [`SampleSource::read`].
+    fn integer_format(&self) -> Option<IntegerFormat> {
+        None
+    }
+
+    /// Like [`SampleSource::read`], the samples as stored (the same values `read` gives, in
+    /// integers); only for the [`SampleSource::integer_format`] the source reports. Reading
+    /// either way continues where the other stopped.
+    fn read_integer(&mut self, out: IntegerSamplesMut<'_>) -> Result<(u64, usize), SampleError> {
+        Err(SampleError::NoIntegerRead {
+            asked: out.format(),
+        })
+    }
+}
+
+/// A complex integer sample format handed over as stored ([`SampleSource::integer_format`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IntegerFormat {
+    /// Interleaved signed 8-bit I/Q (SigMF `ci8`).
+    Ci8,
+    /// Interleaved signed 16-bit I/Q (SigMF `ci16_le`), in host order once read.
+    Ci16,
+}
+
+impl std::fmt::Display for IntegerFormat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            IntegerFormat::Ci8 => "ci8",
+            IntegerFormat::Ci16 => "ci16",
+        })
+    }
+}
+
+/// Room for samples read as stored ([`SampleSource::read_integer`]), one variant per
+/// [`IntegerFormat`].
+#[derive(Debug)]
+pub enum IntegerSamplesMut<'a> {
+    /// Room for ci8 samples.
+    Ci8(&'a mut [[i8; 2]]),
+    /// Room for ci16 samples.
+    Ci16(&'a mut [[i16; 2]]),
+}
+
+impl IntegerSamplesMut<'_> {
+    /// The format this room takes.
+    pub fn format(&self) -> IntegerFormat {
+        match self {
+            IntegerSamplesMut::Ci8(_) => IntegerFormat::Ci8,
+            IntegerSamplesMut::Ci16(_) => IntegerFormat::Ci16,
+        }
+    }
+
+    /// Samples of room.
+    pub fn len(&self) -> usize {
+        match self {
+            IntegerSamplesMut::Ci8(s) => s.len(),
+            IntegerSamplesMut::Ci16(s) => s.len(),
+        }
+    }
+
+    /// Whether there is no room at all.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 /// Turns decoded samples into complex baseband the way every source does: negates Q when

@@ -1413,3 +1413,102 @@ fn sigmf_datetime_is_read_as_utc_and_round_trips() {
     );
     assert!(recording_start(Path::new("-")).expect("stdin").is_none());
 }
+
+/// Samples handed over as stored (`read_integer`) are the values `read` gives, across the
+/// 1 MiB read chunks and in uneven requests, for ci8 and ci16; formats that need converting,
+/// a non-zero IF and an inverted Q offer no integer read.
+#[test]
+fn integer_reads_give_the_values_read_gives() {
+    use gpsrx_samples::{IntegerFormat, IntegerSamplesMut};
+    let dir = tempfile::tempdir().expect("tempdir");
+    let n = 700_001; // ci8: 1.4 MB, ci16: 2.8 MB -- both span several chunks.
+    for (format, expect) in [
+        (SampleFormat::Ci8, IntegerFormat::Ci8),
+        (SampleFormat::Ci16Le, IntegerFormat::Ci16),
+    ] {
+        let path = dir.path().join(format!("x.{}", format.name()));
+        let full = format.full_scale();
+        let samples: Vec<Complex32> = (0..n)
+            .map(|k| {
+                let a = (k as f32 * 0.37).sin() * full;
+                let b = (k as f32 * 0.11).cos() * full;
+                c(a.round(), b.round())
+            })
+            .collect();
+        let mut w = create_writer(&path, &format).expect("create writer");
+        w.write(&samples).expect("write");
+        w.finish().expect("finish");
+        let cfg = SourceConfig::new(&path)
+            .with_format(format.clone())
+            .with_fs_hz(FS);
+        let mut by_read = open_source(&cfg).expect("open");
+        let mut by_int = open_source(&cfg).expect("open");
+        assert_eq!(by_int.integer_format(), Some(expect));
+        let mut got = Vec::new();
+        let mut sizes = [1usize, 333_333, 4096, 999_999].into_iter().cycle();
+        loop {
+            let size = sizes.next().unwrap_or(4096);
+            let (first, m) = match expect {
+                IntegerFormat::Ci8 => {
+                    let mut room = vec![[0i8; 2]; size];
+                    let r = by_int.read_integer(IntegerSamplesMut::Ci8(&mut room));
+                    let (first, m) = r.expect("integer read");
+                    got.extend(
+                        room[..m]
+                            .iter()
+                            .map(|&[i, q]| c(f32::from(i), f32::from(q))),
+                    );
+                    (first, m)
+                }
+                IntegerFormat::Ci16 => {
+                    let mut room = vec![[0i16; 2]; size];
+                    let r = by_int.read_integer(IntegerSamplesMut::Ci16(&mut room));
+                    let (first, m) = r.expect("integer read");
+                    got.extend(
+                        room[..m]
+                            .iter()
+                            .map(|&[i, q]| c(f32::from(i), f32::from(q))),
+                    );
+                    (first, m)
+                }
+            };
+            assert_eq!(first as usize + m, got.len(), "{format}: indices run on");
+            if m == 0 {
+                break;
+            }
+        }
+        let mut want = vec![c(0.0, 0.0); n + 10];
+        let (_, m) = by_read.read(&mut want).expect("read");
+        want.truncate(m);
+        assert_eq!(got.len(), n, "{format}");
+        assert!(got == want, "{format}: integer read differs from read()");
+        assert_eq!(got, samples, "{format}: not the samples written");
+        // What needs converting is not offered.
+        for cfg in [
+            SourceConfig {
+                if_hz: 1.0e6,
+                ..cfg.clone()
+            },
+            SourceConfig {
+                invert_q: true,
+                ..cfg.clone()
+            },
+        ] {
+            let mut s = open_source(&cfg).expect("open");
+            assert_eq!(s.integer_format(), None);
+            let mut room = [[0i8; 2]; 4];
+            assert!(matches!(
+                s.read_integer(IntegerSamplesMut::Ci8(&mut room)),
+                Err(SampleError::NoIntegerRead { .. })
+            ));
+        }
+    }
+    let cf = dir.path().join("x.cf32");
+    let mut w = create_writer(&cf, &SampleFormat::Cf32Le).expect("create writer");
+    w.write(&[c(1.0, 2.0); 8]).expect("write");
+    w.finish().expect("finish");
+    let cfg = SourceConfig::new(&cf)
+        .with_format(SampleFormat::Cf32Le)
+        .with_fs_hz(FS);
+    assert_eq!(open_source(&cfg).expect("open").integer_format(), None);
+}

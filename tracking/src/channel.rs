@@ -560,6 +560,12 @@ impl Channel {
     /// NCO frequencies), `Channel::build_epoch` (the report) and the state transitions
     /// `Channel::maybe_hand_over` / `Channel::maybe_switch_loops` at a bit edge.
     pub fn process_code_period(&mut self, samples: &[Complex32]) -> Option<ChannelEpoch> {
+        self.process_period(SampleSlice::Cf32(samples))
+    }
+
+    /// [`Channel::process_code_period`] on samples in any format the correlators read in place
+    /// (complex f32, or ci8/ci16 as stored: no conversion, a quarter of the memory traffic).
+    pub fn process_period(&mut self, samples: SampleSlice<'_>) -> Option<ChannelEpoch> {
         if self.state == ChannelState::Lost {
             return None;
         }
@@ -595,7 +601,7 @@ impl Channel {
     /// Returns the 1 ms prompt, the receive time of the period's first sample (`index / fs`, s)
     /// and the period's `ms_count`.
     #[inline]
-    fn correlate_period(&mut self, samples: &[Complex32]) -> (Complex64, f64, u64) {
+    fn correlate_period(&mut self, samples: SampleSlice<'_>) -> (Complex64, f64, u64) {
         let state_now = ReplicaState {
             code_phase_chips: self.code_phase_chips,
             code_rate_chips_s: self.code_rate_chips_s,
@@ -614,7 +620,7 @@ impl Channel {
         }
         let mut out = [Complex32::new(0.0, 0.0); 3];
         self.correlator.correlate_packed(
-            SampleSlice::Cf32(samples),
+            samples,
             self.fs_hz,
             &self.packed_code,
             &state_now,

@@ -13,7 +13,10 @@
 
 use anyhow::Context;
 use gpsrx_samples::stream_source::is_stdin_path;
-use gpsrx_samples::{open_source, SampleError, SampleFormat, SampleSource, SourceConfig};
+use gpsrx_samples::{
+    open_source, IntegerFormat, IntegerSamplesMut, SampleError, SampleFormat, SampleSource,
+    SourceConfig,
+};
 use num_complex::Complex32;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError};
@@ -73,6 +76,19 @@ impl SampleSource for Interruptible {
             return Ok((self.next_index, 0));
         }
         let (first, n) = self.inner.read(out)?;
+        self.next_index = first + n as u64;
+        Ok((first, n))
+    }
+
+    fn integer_format(&self) -> Option<IntegerFormat> {
+        self.inner.integer_format()
+    }
+
+    fn read_integer(&mut self, out: IntegerSamplesMut<'_>) -> Result<(u64, usize), SampleError> {
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            return Ok((self.next_index, 0));
+        }
+        let (first, n) = self.inner.read_integer(out)?;
         self.next_index = first + n as u64;
         Ok((first, n))
     }

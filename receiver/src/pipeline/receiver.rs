@@ -398,6 +398,11 @@ impl Receiver {
                 receiver_hz: self.fs_hz,
             });
         }
+        // Samples held as stored where the source can (ci8, ci16): the correlators read them
+        // in place.
+        if let Some(f) = self.window.hold_as_stored(source) {
+            tracing::debug!("samples held as {f}, read by the correlators in place");
+        }
         // Until the cold start: gather its samples.
         while self.manager.cold_start_pending() {
             let got = self.window.fill(source, self.block)?;
@@ -524,8 +529,8 @@ impl Receiver {
     fn cold_start(&mut self, sink: &mut dyn Sink) -> Result<(), ReceiverError> {
         let first = self.window.start();
         let n = (self.window.end() - first).min(self.cold_samples()) as usize;
-        let samples = self.window.get(first, n).unwrap_or(&[]);
-        let found = self.manager.cold_start(samples, first)?;
+        let samples = self.window.get_cf32(first, n).unwrap_or_default();
+        let found = self.manager.cold_start(&samples, first)?;
         self.processed_to = Some(first);
         self.announce(&found, first, sink)
     }

@@ -7,9 +7,16 @@
 //! Nothing is allocated or zeroed per block in the steady state: the buffer keeps its size and
 //! the live samples are moved to its front only when the dropped prefix is as long as they
 //! are.
+//!
+//! Samples are held as the source stores them when it can hand them over that way (complex
+//! ci8/ci16 at IF 0: [`SampleSource::integer_format`]) -- the correlators read those in place,
+//! with no conversion and a half or a quarter of the memory traffic of complex f32 -- else as
+//! complex f32. The searches, which need f32, convert the span they read.
 
-use gpsrx_samples::{SampleError, SampleSource};
+use gpsrx_dsp::correlator::SampleSlice;
+use gpsrx_samples::{IntegerFormat, IntegerSamplesMut, SampleError, SampleSource};
 use num_complex::Complex32;
+use std::borrow::Cow;
 
 /// Samples processed per block, as a fraction of a second (10 ms). 40 ms blocks measured no
 /// faster on 2 cores, with more memory.
@@ -21,15 +28,110 @@ pub fn block_samples(fs_hz: f64) -> usize {
     ((fs_hz * BLOCK_S).ceil() as usize).max(1)
 }
 
+/// One complex sample as the window may hold it.
+trait Held: Copy + Default + Send + Sync {
+    /// The samples as the correlators read them.
+    fn slice(s: &[Self]) -> SampleSlice<'_>;
+}
+
+impl Held for Complex32 {
+    fn slice(s: &[Self]) -> SampleSlice<'_> {
+        SampleSlice::Cf32(s)
+    }
+}
+
+impl Held for [i8; 2] {
+    fn slice(s: &[Self]) -> SampleSlice<'_> {
+        SampleSlice::Ci8(s)
+    }
+}
+
+impl Held for [i16; 2] {
+    fn slice(s: &[Self]) -> SampleSlice<'_> {
+        SampleSlice::Ci16(s)
+    }
+}
+
+/// `buf[head..tail]` are the live samples; `buf[tail..]` is room for the next reads
+/// (initialised once, when the buffer grows).
+#[derive(Debug, Default)]
+struct Buffer<T> {
+    buf: Vec<T>,
+    head: usize,
+    tail: usize,
+}
+
+impl<T: Held> Buffer<T> {
+    fn live(&self) -> &[T] {
+        &self.buf[self.head..self.tail]
+    }
+
+    fn len(&self) -> usize {
+        self.tail - self.head
+    }
+
+    /// Makes room for `n` samples behind the live ones.
+    fn reserve(&mut self, n: usize) {
+        if self.buf.len() < self.tail + n {
+            self.buf.resize(self.tail + n, T::default());
+        }
+    }
+
+    /// The live samples and the room for `n` more.
+    fn split(&mut self, n: usize) -> (&[T], &mut [T]) {
+        self.reserve(n);
+        let (held, room) = self.buf.split_at_mut(self.tail);
+        (&held[self.head..], &mut room[..n])
+    }
+
+    /// Drops the first `n` live samples. Compacts when the dropped prefix is as long as the
+    /// live samples: at most one copy per sample dropped, and the buffer stays within twice
+    /// the live span plus one block (the background search holds up to half a second).
+    fn drop_front(&mut self, n: usize) {
+        self.head += n.min(self.len());
+        if self.head >= self.tail - self.head {
+            self.buf.copy_within(self.head..self.tail, 0);
+            self.tail -= self.head;
+            self.head = 0;
+        }
+    }
+
+    /// Drops every live sample (a gap: the next ones do not follow them).
+    fn clear(&mut self) {
+        self.head = self.tail;
+    }
+}
+
+/// The samples, in the format they are held in.
+#[derive(Debug)]
+enum Store {
+    Cf32(Buffer<Complex32>),
+    Ci8(Buffer<[i8; 2]>),
+    Ci16(Buffer<[i16; 2]>),
+}
+
+impl Default for Store {
+    fn default() -> Self {
+        Store::Cf32(Buffer::default())
+    }
+}
+
+/// Runs `$body` with `$b` bound to the store's buffer, whatever its sample type.
+macro_rules! each {
+    ($store:expr, $b:ident => $body:expr) => {
+        match $store {
+            Store::Cf32($b) => $body,
+            Store::Ci8($b) => $body,
+            Store::Ci16($b) => $body,
+        }
+    };
+}
+
 /// Recent samples `[start, start + len)` of a stream.
 #[derive(Debug, Default)]
 pub struct SampleWindow {
     start: u64,
-    /// `data[head..tail]` are the live samples; `data[tail..]` is room for the next reads
-    /// (initialised once, when the buffer grows).
-    data: Vec<Complex32>,
-    head: usize,
-    tail: usize,
+    store: Store,
     end_of_stream: bool,
 }
 
@@ -37,7 +139,16 @@ pub struct SampleWindow {
 #[derive(Debug, Clone, Copy)]
 pub struct SampleView<'a> {
     start: u64,
-    data: &'a [Complex32],
+    data: SampleSlice<'a>,
+}
+
+/// `s[a..b]` of a sample slice of any format.
+fn sub(s: SampleSlice<'_>, a: usize, b: usize) -> SampleSlice<'_> {
+    match s {
+        SampleSlice::Cf32(x) => SampleSlice::Cf32(&x[a..b]),
+        SampleSlice::Ci8(x) => SampleSlice::Ci8(&x[a..b]),
+        SampleSlice::Ci16(x) => SampleSlice::Ci16(&x[a..b]),
+    }
 }
 
 impl<'a> SampleView<'a> {
@@ -56,31 +167,67 @@ impl<'a> SampleView<'a> {
         let n = limit.saturating_sub(self.start).min(self.data.len() as u64) as usize;
         SampleView {
             start: self.start,
-            data: &self.data[..n],
+            data: sub(self.data, 0, n),
         }
     }
 
-    /// Samples `[from, from + len)` if all are held.
-    pub fn get(&self, from: u64, len: usize) -> Option<&'a [Complex32]> {
+    /// Samples `[from, from + len)` if all are held, as held.
+    pub fn get(&self, from: u64, len: usize) -> Option<SampleSlice<'a>> {
         if from < self.start || from + len as u64 > self.end() {
             return None;
         }
         let a = (from - self.start) as usize;
-        Some(&self.data[a..a + len])
+        Some(sub(self.data, a, a + len))
+    }
+
+    /// Samples `[from, from + len)` if all are held, as complex f32 (borrowed when held so,
+    /// else converted: integer values are exact in f32).
+    pub fn get_cf32(&self, from: u64, len: usize) -> Option<Cow<'a, [Complex32]>> {
+        let to_c = |re: f32, im: f32| Complex32::new(re, im);
+        Some(match self.get(from, len)? {
+            SampleSlice::Cf32(x) => Cow::Borrowed(x),
+            SampleSlice::Ci8(x) => Cow::Owned(
+                x.iter()
+                    .map(|&[i, q]| to_c(f32::from(i), f32::from(q)))
+                    .collect(),
+            ),
+            SampleSlice::Ci16(x) => Cow::Owned(
+                x.iter()
+                    .map(|&[i, q]| to_c(f32::from(i), f32::from(q)))
+                    .collect(),
+            ),
+        })
     }
 }
 
 impl SampleWindow {
-    /// An empty window at sample 0.
+    /// An empty window at sample 0, holding complex f32.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Holds the samples of `src` as it stores them, if it can hand them over that way and
+    /// nothing is held yet (else nothing changes). Returns the format now held, if integer.
+    pub fn hold_as_stored(&mut self, src: &dyn SampleSource) -> Option<IntegerFormat> {
+        if each!(&self.store, b => b.len()) == 0 {
+            self.store = match src.integer_format() {
+                Some(IntegerFormat::Ci8) => Store::Ci8(Buffer::default()),
+                Some(IntegerFormat::Ci16) => Store::Ci16(Buffer::default()),
+                None => Store::Cf32(Buffer::default()),
+            };
+        }
+        match self.store {
+            Store::Cf32(_) => None,
+            Store::Ci8(_) => Some(IntegerFormat::Ci8),
+            Store::Ci16(_) => Some(IntegerFormat::Ci16),
+        }
     }
 
     /// The samples held.
     pub fn view(&self) -> SampleView<'_> {
         SampleView {
             start: self.start,
-            data: &self.data[self.head..self.tail],
+            data: each!(&self.store, b => Held::slice(b.live())),
         }
     }
 
@@ -91,7 +238,7 @@ impl SampleWindow {
 
     /// Absolute index one past the last sample held.
     pub fn end(&self) -> u64 {
-        self.start + (self.tail - self.head) as u64
+        self.start + each!(&self.store, b => b.len()) as u64
     }
 
     /// Whether the source is exhausted.
@@ -99,9 +246,9 @@ impl SampleWindow {
         self.end_of_stream
     }
 
-    /// Samples `[from, from + len)` if all are held.
-    pub fn get(&self, from: u64, len: usize) -> Option<&[Complex32]> {
-        self.view().get(from, len)
+    /// Samples `[from, from + len)` if all are held, as complex f32.
+    pub fn get_cf32(&self, from: u64, len: usize) -> Option<Cow<'_, [Complex32]>> {
+        self.view().get_cf32(from, len)
     }
 
     /// Drops samples before `index`.
@@ -110,26 +257,26 @@ impl SampleWindow {
         if index <= self.start {
             return;
         }
-        self.head += (index - self.start) as usize;
+        let n = (index - self.start) as usize;
+        each!(&mut self.store, b => b.drop_front(n));
         self.start = index;
-        // Compact when the dropped prefix is as long as the live samples: at most one copy per
-        // sample dropped, and the buffer stays within twice the live span plus one block (the
-        // background search holds up to half a second: 32 MB at 4 MHz, not 80).
-        if self.head >= self.tail - self.head {
-            self.data.copy_within(self.head..self.tail, 0);
-            self.tail -= self.head;
-            self.head = 0;
-        }
     }
 
-    /// Appends samples that follow the ones held (a stream pushed block by block).
+    /// Appends samples that follow the ones held (a stream pushed block by block). A window
+    /// holding integers (after a run from a source) goes over to f32 first.
     pub fn push(&mut self, samples: &[Complex32]) {
-        if self.data.len() < self.tail + samples.len() {
-            self.data
-                .resize(self.tail + samples.len(), Complex32::new(0.0, 0.0));
+        if !matches!(self.store, Store::Cf32(_)) {
+            let held = self.get_cf32(self.start, (self.end() - self.start) as usize);
+            let held = held.map(Cow::into_owned).unwrap_or_default();
+            let mut b = Buffer::default();
+            b.split(held.len()).1.copy_from_slice(&held);
+            b.tail = held.len();
+            self.store = Store::Cf32(b);
         }
-        self.data[self.tail..self.tail + samples.len()].copy_from_slice(samples);
-        self.tail += samples.len();
+        if let Store::Cf32(b) = &mut self.store {
+            b.split(samples.len()).1.copy_from_slice(samples);
+            b.tail += samples.len();
+        }
     }
 
     /// Reads up to `n` more samples from `src`; returns how many arrived (0 at the end).
@@ -151,30 +298,54 @@ impl SampleWindow {
         if self.end_of_stream {
             return Ok((0, work(self.view())));
         }
-        if self.data.len() < self.tail + n {
-            self.data.resize(self.tail + n, Complex32::new(0.0, 0.0));
-        }
-        let (held, room) = self.data.split_at_mut(self.tail);
-        let view = SampleView {
-            start: self.start,
-            data: &held[self.head..],
+        let start = self.start;
+        let (read, r) = match &mut self.store {
+            Store::Cf32(b) => {
+                let (held, room) = b.split(n);
+                let view = SampleView {
+                    start,
+                    data: Held::slice(held),
+                };
+                rayon::join(|| src.read(room), || work(view))
+            }
+            Store::Ci8(b) => {
+                let (held, room) = b.split(n);
+                let view = SampleView {
+                    start,
+                    data: Held::slice(held),
+                };
+                rayon::join(
+                    || src.read_integer(IntegerSamplesMut::Ci8(room)),
+                    || work(view),
+                )
+            }
+            Store::Ci16(b) => {
+                let (held, room) = b.split(n);
+                let view = SampleView {
+                    start,
+                    data: Held::slice(held),
+                };
+                rayon::join(
+                    || src.read_integer(IntegerSamplesMut::Ci16(room)),
+                    || work(view),
+                )
+            }
         };
-        let room = &mut room[..n];
-        let (read, r) = rayon::join(|| src.read(room), || work(view));
         let (first, got) = read?;
         if got == 0 {
             self.end_of_stream = true;
             return Ok((0, r));
         }
-        if self.tail == self.head {
+        let empty = each!(&self.store, b => b.len()) == 0;
+        if empty {
             // First read, or the window was empty: adopt the source's index.
             self.start = first;
         } else if first != self.end() {
             // A gap in the stream: keep only the new samples.
-            self.head = self.tail;
+            each!(&mut self.store, b => b.clear());
             self.start = first;
         }
-        self.tail += got;
+        each!(&mut self.store, b => b.tail += got);
         Ok((got, r))
     }
 }
@@ -183,20 +354,28 @@ impl SampleWindow {
 mod tests {
     use super::*;
 
+    /// Sample `i` of `v` (real part), if held.
+    fn re(v: &SampleView<'_>, i: u64) -> Option<f32> {
+        v.get_cf32(i, 1).map(|s| s[0].re)
+    }
+
     #[test]
     fn get_and_discard_by_absolute_index() {
         let mut w = SampleWindow::new();
         w.start = 100;
-        w.data = (0..10).map(|i| Complex32::new(i as f32, 0.0)).collect();
-        w.tail = 10;
+        w.push(
+            &(0..10)
+                .map(|i| Complex32::new(i as f32, 0.0))
+                .collect::<Vec<_>>(),
+        );
         assert_eq!(w.end(), 110);
-        assert_eq!(w.get(103, 2).map(|s| s[0].re), Some(3.0));
-        assert!(w.get(99, 2).is_none());
-        assert!(w.get(109, 2).is_none());
+        assert_eq!(re(&w.view(), 103), Some(3.0));
+        assert!(w.get_cf32(99, 2).is_none());
+        assert!(w.get_cf32(109, 2).is_none());
         w.discard_before(106);
         assert_eq!(w.start(), 106);
-        assert_eq!(w.get(106, 4).map(|s| s[3].re), Some(9.0));
-        assert!(w.get(105, 1).is_none());
+        assert_eq!(w.get_cf32(106, 4).map(|s| s[3].re), Some(9.0));
+        assert!(w.get_cf32(105, 1).is_none());
     }
 
     /// A source counting up from `first`: sample k is k + 0j.
@@ -241,8 +420,7 @@ mod tests {
             let (got, seen) = w
                 .fill_during(&mut src, 30, |v| {
                     // The work sees exactly what was held before this read, values = indices.
-                    let ok = (v.start()..v.end())
-                        .all(|i| v.get(i, 1).map(|s| s[0].re) == Some(i as f32));
+                    let ok = (v.start()..v.end()).all(|i| re(&v, i) == Some(i as f32));
                     (v.end(), ok)
                 })
                 .unwrap_or_else(|e| panic!("{e}"));
@@ -252,11 +430,8 @@ mod tests {
             assert_eq!(w.end(), 50 + 30 * (round + 1));
             // Keep the last 45 samples, as a slow channel would.
             w.discard_before(w.end().saturating_sub(45));
-            assert!(
-                w.data.len() <= 2 * 45 + 30 + 30,
-                "buffer {} grew",
-                w.data.len()
-            );
+            let size = each!(&w.store, b => b.buf.len());
+            assert!(size <= 2 * 45 + 30 + 30, "buffer {size} grew");
         }
         // Each round's work saw the window as it was before the round's read.
         assert_eq!(seen_ends[0], 0);
@@ -266,6 +441,6 @@ mod tests {
             .all(|(k, &e)| e == 50 + 30 * (k as u64 + 1)));
         // Every held sample is still its own index after the compactions.
         let v = w.view();
-        assert!((v.start()..v.end()).all(|i| v.get(i, 1).map(|s| s[0].re) == Some(i as f32)));
+        assert!((v.start()..v.end()).all(|i| re(&v, i) == Some(i as f32)));
     }
 }

@@ -359,8 +359,11 @@ impl ChannelManager {
         };
         let outcome = match (engine, search) {
             (Some(engine), Some(s)) => {
-                let samples = window.get(s.first, s.len).unwrap_or(&[]);
-                let (results, ()) = rayon::join(|| engine.search(samples, &s.targets), run_all);
+                let search = || {
+                    let samples = window.get_cf32(s.first, s.len).unwrap_or_default();
+                    engine.search(&samples, &s.targets)
+                };
+                let (results, ()) = rayon::join(search, run_all);
                 let results = results
                     .map_err(|e| tracing::warn!("a search failed: {e}"))
                     .ok();
@@ -603,7 +606,7 @@ fn run_channel(
                     let t = start as f64 / ch.fs_hz();
                     ch.set_aid(aid.doppler_aid(ch.prn(), t), t);
                 }
-                if let Some(e) = ch.process_code_period(x) {
+                if let Some(e) = ch.process_period(x) {
                     out.push(e);
                 }
             }
