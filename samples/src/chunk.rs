@@ -43,6 +43,49 @@ impl ChunkReader {
     }
 
     /// The bytes `start..start + len` (`len <= CHUNK_BYTES`, `start + len <= limit`).
+    /// Fills `dst` with the bytes from `start` on: what the chunk holds of them is copied,
+    /// the rest read from the file straight into `dst` (no second copy for large reads). An
+    /// error if the file ends first.
+    pub fn read_into(&mut self, start: u64, dst: &mut [u8]) -> Result<(), SampleError> {
+        let buf_end = self.buf_start + self.buf_len as u64;
+        let mut done = 0;
+        if start >= self.buf_start && start < buf_end {
+            let off = (start - self.buf_start) as usize;
+            done = (self.buf_len - off).min(dst.len());
+            dst[..done].copy_from_slice(&self.buf[off..off + done]);
+        }
+        if done == dst.len() {
+            return Ok(());
+        }
+        // The chunk is left behind: empty it, and read the rest in place.
+        self.buf_len = 0;
+        let read_at = start + done as u64;
+        self.buf_start = read_at;
+        if self.file_pos != read_at {
+            self.file
+                .seek(SeekFrom::Start(read_at))
+                .map_err(|e| SampleError::io("seek in", &self.path, e))?;
+            self.file_pos = read_at;
+        }
+        let want = dst.len() as u64;
+        if read_at + (want - done as u64) > self.limit {
+            return Err(truncated(&self.path, read_at, start + want));
+        }
+        while done < dst.len() {
+            match self.file.read(&mut dst[done..]) {
+                Ok(0) => return Err(truncated(&self.path, start + done as u64, start + want)),
+                Ok(n) => {
+                    done += n;
+                    self.file_pos += n as u64;
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(SampleError::io("read", &self.path, e)),
+            }
+        }
+        self.buf_start = self.file_pos;
+        Ok(())
+    }
+
     pub fn get(&mut self, start: u64, len: usize) -> Result<&[u8], SampleError> {
         let buf_end = self.buf_start + self.buf_len as u64;
         if start >= self.buf_start && start + len as u64 <= buf_end {
@@ -77,19 +120,26 @@ impl ChunkReader {
             }
         }
         if self.buf_len < len {
-            return Err(SampleError::io(
-                "read",
+            return Err(truncated(
                 &self.path,
-                std::io::Error::new(
-                    std::io::ErrorKind::UnexpectedEof,
-                    format!(
-                        "file ended at byte {} but {} bytes were expected: was it truncated while reading?",
-                        start + self.buf_len as u64,
-                        start + len as u64
-                    ),
-                ),
+                start + self.buf_len as u64,
+                start + len as u64,
             ));
         }
         Ok(&self.buf[..len])
     }
+}
+
+/// The file ended at byte `at` where `expected` bytes were due.
+fn truncated(path: &std::path::Path, at: u64, expected: u64) -> SampleError {
+    SampleError::io(
+        "read",
+        path,
+        std::io::Error::new(
+            std::io::ErrorKind::UnexpectedEof,
+            format!(
+                "file ended at byte {at} but {expected} bytes were expected: was it truncated while reading?"
+            ),
+        ),
+    )
 }

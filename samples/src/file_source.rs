@@ -156,10 +156,18 @@ impl SampleSource for FileSource {
             return Err(SampleError::NoIntegerRead { asked });
         }
         match out {
-            IntegerSamplesMut::Ci8(out) => self.for_each_chunk(out.len(), |_, bytes, _, range| {
-                let dst: &mut [u8] = bytemuck::cast_slice_mut(&mut out[range]);
-                dst.copy_from_slice(&bytes[..dst.len()]);
-            }),
+            IntegerSamplesMut::Ci8(out) => {
+                // Stored as wanted: read straight into `out`.
+                let first = self.pos;
+                let left = self.span.end_sample() - self.pos;
+                let n = out.len().min(usize::try_from(left).unwrap_or(usize::MAX));
+                let dst: &mut [u8] = bytemuck::cast_slice_mut(&mut out[..n]);
+                let (byte, _) = sample_position(&self.resolved.format, self.pos);
+                self.chunks
+                    .read_into(self.resolved.data_offset + byte, dst)?;
+                self.pos += n as u64;
+                Ok((first, n))
+            }
             IntegerSamplesMut::Ci16(out) => self.for_each_chunk(out.len(), |_, bytes, _, range| {
                 for (o, b) in out[range].iter_mut().zip(bytes.chunks_exact(4)) {
                     *o = [

@@ -85,11 +85,13 @@ impl<T: Held> Buffer<T> {
     }
 
     /// Drops the first `n` live samples. Compacts when the dropped prefix is as long as the
-    /// live samples: at most one copy per sample dropped, and the buffer stays within twice
-    /// the live span plus one block (the background search holds up to half a second).
-    fn drop_front(&mut self, n: usize) {
+    /// live samples and at least `compact_bytes` ([`COMPACT_BYTES`]): at most one copy per sample dropped (a
+    /// quarter of one at 4 MHz ci8, where the live half second is 4 MB), and the buffer stays
+    /// within twice the live span plus one block plus [`COMPACT_BYTES`].
+    fn drop_front(&mut self, n: usize, compact_bytes: usize) {
         self.head += n.min(self.len());
-        if self.head >= self.tail - self.head {
+        let least = compact_bytes / std::mem::size_of::<T>();
+        if self.head >= (self.tail - self.head).max(least) {
             self.buf.copy_within(self.head..self.tail, 0);
             self.tail -= self.head;
             self.head = 0;
@@ -101,6 +103,9 @@ impl<T: Held> Buffer<T> {
         self.head = self.tail;
     }
 }
+
+/// Samples dropped, in bytes, before the live ones are moved to the front of the buffer.
+const COMPACT_BYTES: usize = 16 << 20;
 
 /// The samples, in the format they are held in.
 #[derive(Debug)]
@@ -128,11 +133,24 @@ macro_rules! each {
 }
 
 /// Recent samples `[start, start + len)` of a stream.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct SampleWindow {
     start: u64,
     store: Store,
     end_of_stream: bool,
+    /// Bytes dropped before a compaction ([`COMPACT_BYTES`]; smaller in tests).
+    compact_bytes: usize,
+}
+
+impl Default for SampleWindow {
+    fn default() -> Self {
+        Self {
+            start: 0,
+            store: Store::default(),
+            end_of_stream: false,
+            compact_bytes: COMPACT_BYTES,
+        }
+    }
 }
 
 /// A read-only view of the samples a [`SampleWindow`] holds.
@@ -258,7 +276,8 @@ impl SampleWindow {
             return;
         }
         let n = (index - self.start) as usize;
-        each!(&mut self.store, b => b.drop_front(n));
+        let compact_bytes = self.compact_bytes;
+        each!(&mut self.store, b => b.drop_front(n, compact_bytes));
         self.start = index;
     }
 
@@ -415,6 +434,7 @@ mod tests {
             end: 2000,
         };
         let mut w = SampleWindow::new();
+        w.compact_bytes = 0;
         let mut seen_ends = Vec::new();
         for round in 0..40u64 {
             let (got, seen) = w
