@@ -4,3 +4,4 @@
 mod acquisition;
 mod faults;
 mod pipeline;
+mod plots;

@@ -50,6 +50,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         loops: LoopArgs::default(),
         out: dir.join("run"),
         json: false,
+        no_plots: false,
         nav: None,
         iono: Some(IonoModel::Klobuchar),
         tropo: Some(TropoModel::Saastamoinen),
