@@ -2,6 +2,7 @@
 //! simulator's truth (one test binary for the crate).
 
 mod acquisition;
+mod ephemeris_file;
 mod faults;
 mod pipeline;
 mod plots;

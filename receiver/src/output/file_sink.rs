@@ -10,12 +10,12 @@
 //! [`crate::output::plots`] (`track.png`, `skyplot.png`, `cn0.png`, `dop.png`, at the end; a
 //! plot that cannot be drawn is a warning).
 
+use crate::output::plots::{write_run_plots, RunPlotData};
 use crate::output::{
     create_file, rinex_nav::write_rinex_nav_file, write_geojson, write_kml, ChannelCsvWriter,
     ChannelRow, Fix, NavHeader, NavRecord, NmeaOptions, NmeaWriter, ObsEpoch, ObsHeader,
     OutputError, PvtCsvWriter, RinexObsWriter,
 };
-use crate::output::plots::{write_run_plots, RunPlotData};
 use crate::pipeline::sink::{FixReport, NavigationEnd, ObservablesReport, Sink, SinkError};
 use std::fs::File;
 use std::io::BufWriter;
@@ -226,8 +226,10 @@ impl Sink for FileSink {
         let records: Vec<NavRecord> = end
             .ephemerides
             .iter()
-            .cloned()
-            .map(NavRecord::from)
+            .map(|e| NavRecord {
+                transmission_tow_s: end.transmission_tow_s.get(&e.prn).copied(),
+                ephemeris: e.clone(),
+            })
             .collect();
         let header = NavHeader {
             iono: end.iono,

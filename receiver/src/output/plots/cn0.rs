@@ -12,13 +12,19 @@ use std::path::Path;
 
 /// Size of `cn0.png`, px.
 pub const CN0_SIZE: (u32, u32) = (1000, 600);
+/// Lowest C/N0 on the axis, dB-Hz.
+const CN0_FLOOR_DBHZ: f64 = 15.0;
 
 /// The stretches of `points` (time order) without a gap longer than three times the median
 /// step: a satellite lost and found again is drawn as separate lines.
 pub fn split_at_gaps(points: &[(f64, f64)]) -> Vec<&[(f64, f64)]> {
     let mut steps: Vec<f64> = points.windows(2).map(|w| w[1].0 - w[0].0).collect();
     if steps.is_empty() {
-        return if points.is_empty() { Vec::new() } else { vec![points] };
+        return if points.is_empty() {
+            Vec::new()
+        } else {
+            vec![points]
+        };
     }
     steps.sort_by(f64::total_cmp);
     let limit = 3.0 * steps[steps.len() / 2];
@@ -49,7 +55,10 @@ pub fn draw_cn0(cn0: &BTreeMap<u8, Decimated<(f64, f64)>>, path: &Path) -> Resul
     let (chart_area, side) = with_legend_strip(&area, &entries);
     let all = || cn0.values().flat_map(|d| d.values().iter().copied());
     let (t0, t1) = padded_range(all().map(|p| p.0), false);
+    // A lost signal's estimate collapses towards 0 dB-Hz: the axis stops at 15 dB-Hz so the
+    // tracked levels stay readable (the plunge leaves through the bottom).
     let (y0, y1) = padded_range(all().map(|p| p.1), false);
+    let y0 = y0.max(CN0_FLOOR_DBHZ.min(y1 - 1.0));
     let mut chart = ChartBuilder::on(&chart_area)
         .margin(MARGIN_PX)
         .x_label_area_size(X_AREA_PX)
@@ -58,7 +67,7 @@ pub fn draw_cn0(cn0: &BTreeMap<u8, Decimated<(f64, f64)>>, path: &Path) -> Resul
         .map_err(plot_err(path))?;
     chart
         .configure_mesh()
-.light_line_style(TRANSPARENT)
+        .light_line_style(TRANSPARENT)
         .x_desc("time from the start of the recording (s)")
         .y_desc("C/N0 (dB-Hz)")
         .x_label_formatter(&|v| tick_label(*v))
@@ -70,7 +79,10 @@ pub fn draw_cn0(cn0: &BTreeMap<u8, Decimated<(f64, f64)>>, path: &Path) -> Resul
     for (i, series) in cn0.values().enumerate() {
         for run in split_at_gaps(series.values()) {
             chart
-                .draw_series(LineSeries::new(run.iter().copied(), color(i).stroke_width(2)))
+                .draw_series(LineSeries::new(
+                    run.iter().copied(),
+                    color(i).stroke_width(2),
+                ))
                 .map_err(plot_err(path))?;
         }
     }

@@ -47,7 +47,7 @@ pub fn draw_dop(fixes: &[FixPoint], path: &Path) -> Result<(), PlotError> {
         .build_cartesian_2d(t0..t1, 0..n_max + 1)
         .map_err(plot_err(path))?;
     top.configure_mesh()
-.light_line_style(TRANSPARENT)
+        .light_line_style(TRANSPARENT)
         .y_desc("satellites used")
         .x_label_formatter(&|v| tick_label(*v))
         .y_labels((n_max + 2) as usize)
@@ -71,7 +71,7 @@ pub fn draw_dop(fixes: &[FixPoint], path: &Path) -> Result<(), PlotError> {
         .map_err(plot_err(path))?;
     bottom
         .configure_mesh()
-.light_line_style(TRANSPARENT)
+        .light_line_style(TRANSPARENT)
         .x_desc("time from the start of the recording (s)")
         .y_desc("dilution of precision")
         .x_label_formatter(&|v| tick_label(*v))
@@ -81,7 +81,10 @@ pub fn draw_dop(fixes: &[FixPoint], path: &Path) -> Result<(), PlotError> {
         .draw()
         .map_err(plot_err(path))?;
     type Pick = fn(&FixPoint) -> f64;
-    for (i, pick) in [(|f: &FixPoint| f.pdop) as Pick, |f: &FixPoint| f.hdop].into_iter().enumerate() {
+    for (i, pick) in [(|f: &FixPoint| f.pdop) as Pick, |f: &FixPoint| f.hdop]
+        .into_iter()
+        .enumerate()
+    {
         let pts = fixes
             .iter()
             .map(|f| (f.t_s, pick(f)))

@@ -72,7 +72,8 @@ pub fn draw_dr_track(fused: &[FusedFix], path: &Path) -> Result<(), PlotError> {
         LegendEntry {
             name: match outages.len() {
                 0 => "DR only (GNSS outage): none".to_string(),
-                n => format!("DR only (GNSS outage): {n}, {outage_s:.0} s"),
+                1 => format!("DR only (GNSS outage): 1, {outage_s:.0} s"),
+                n => format!("DR only (GNSS outages): {n}, {outage_s:.0} s"),
             },
             color: OUTAGE,
             swatch: Swatch::Line,
@@ -95,7 +96,7 @@ pub fn draw_dr_track(fused: &[FusedFix], path: &Path) -> Result<(), PlotError> {
         .map_err(plot_err(path))?;
     chart
         .configure_mesh()
-.light_line_style(TRANSPARENT)
+        .light_line_style(TRANSPARENT)
         .x_desc("east of the median position (m)")
         .y_desc("north (m)")
         .x_label_formatter(&|v| tick_label(*v))

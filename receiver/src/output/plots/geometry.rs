@@ -80,7 +80,10 @@ pub fn equal_scale_ranges(
         (e0, e1, n0, n1) = (0.0, 0.0, 0.0, 0.0);
     }
     let (w, h) = (f64::from(plot_px.0.max(1)), f64::from(plot_px.1.max(1)));
-    let m_per_px = ((e1 - e0) / w).max((n1 - n0) / h).max(min_span_m / w.min(h)) * 1.1;
+    let m_per_px = ((e1 - e0) / w)
+        .max((n1 - n0) / h)
+        .max(min_span_m / w.min(h))
+        * 1.1;
     let (ce, cn) = (0.5 * (e0 + e1), 0.5 * (n0 + n1));
     let (half_e, half_n) = (0.5 * m_per_px * w, 0.5 * m_per_px * h);
     (ce - half_e..ce + half_e, cn - half_n..cn + half_n)
@@ -127,7 +130,11 @@ mod tests {
     fn equal_scale_keeps_metres_per_pixel_equal() {
         // 100 m east by 10 m north on 800x400 px: east sets the scale, 0.1375 m/px.
         let (e, n) = equal_scale_ranges(&[(0.0, 0.0), (100.0, 10.0)], (800, 400), 1.0);
-        assert_abs_diff_eq!((e.end - e.start) / 800.0, (n.end - n.start) / 400.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(
+            (e.end - e.start) / 800.0,
+            (n.end - n.start) / 400.0,
+            epsilon = 1e-12
+        );
         assert_abs_diff_eq!(e.end - e.start, 110.0, epsilon = 1e-9);
         assert_abs_diff_eq!(0.5 * (n.start + n.end), 5.0, epsilon = 1e-12);
         // A single point still gets the minimum span on the short side.
@@ -139,7 +146,12 @@ mod tests {
 
     #[test]
     fn median_ignores_an_outlier() {
-        let pts = [[1.0, 10.0, 5.0], [2.0, 20.0, 6.0], [1e6, -1e6, 7.0], [3.0, 30.0, f64::NAN]];
+        let pts = [
+            [1.0, 10.0, 5.0],
+            [2.0, 20.0, 6.0],
+            [1e6, -1e6, 7.0],
+            [3.0, 30.0, f64::NAN],
+        ];
         assert_eq!(median_position(pts.into_iter()), Some([2.0, 10.0, 6.0]));
         assert_eq!(median_position(std::iter::empty()), None);
     }

@@ -3,8 +3,8 @@
 
 use super::style::LEGEND_PX;
 use plotters::coord::Shift;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// How a legend entry shows its series.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -74,9 +74,8 @@ pub fn free_corner(series: &[Vec<(f64, f64)>], box_frac: (f64, f64)) -> Option<C
         (Corner::LowerLeft, 0.0, 0.0),
         (Corner::LowerRight, 1.0 - w, 0.0),
     ];
-    let inside = |(x, y): (f64, f64), x0: f64, y0: f64| {
-        x >= x0 && x <= x0 + w && y >= y0 && y <= y0 + h
-    };
+    let inside =
+        |(x, y): (f64, f64), x0: f64, y0: f64| x >= x0 && x <= x0 + w && y >= y0 && y <= y0 + h;
     corners.into_iter().find_map(|(corner, x0, y0)| {
         let hit = series.iter().any(|line| {
             line.iter().any(|&p| inside(p, x0, y0))

@@ -123,7 +123,10 @@ pub fn draw_line_plot(plot: &LinePlot, path: &Path) -> Result<(), PlotError> {
                 .collect()
         })
         .collect();
-    let corner = free_corner(&normalised, (f64::from(lw) / area_w, f64::from(lh) / area_h));
+    let corner = free_corner(
+        &normalised,
+        (f64::from(lw) / area_w, f64::from(lh) / area_h),
+    );
     let (chart_area, side) = match (corner, entries.is_empty()) {
         (None, false) => {
             let (a, b) = root.split_horizontally(w.saturating_sub(lw + 2 * MARGIN_PX));
@@ -142,7 +145,7 @@ pub fn draw_line_plot(plot: &LinePlot, path: &Path) -> Result<(), PlotError> {
             let mut chart = $chart.map_err(plot_err(path))?;
             chart
                 .configure_mesh()
-.light_line_style(TRANSPARENT)
+                .light_line_style(TRANSPARENT)
                 .x_desc(plot.x_label.as_str())
                 .y_desc(plot.y_label.as_str())
                 .x_label_formatter(&|v| tick_label(*v))
@@ -177,14 +180,12 @@ pub fn draw_line_plot(plot: &LinePlot, path: &Path) -> Result<(), PlotError> {
     let (xr, yr) = (x0..x1, y0..y1);
     match (plot.log_x, plot.log_y) {
         (false, false) => draw!(builder.build_cartesian_2d(xr, yr)),
-        (true, false) => draw!(builder.build_cartesian_2d(
-            xr.log_scale().with_key_points(log_ticks(x0, x1)),
-            yr
-        )),
-        (false, true) => draw!(builder.build_cartesian_2d(
-            xr,
-            yr.log_scale().with_key_points(log_ticks(y0, y1))
-        )),
+        (true, false) => {
+            draw!(builder.build_cartesian_2d(xr.log_scale().with_key_points(log_ticks(x0, x1)), yr))
+        }
+        (false, true) => {
+            draw!(builder.build_cartesian_2d(xr, yr.log_scale().with_key_points(log_ticks(y0, y1))))
+        }
         (true, true) => draw!(builder.build_cartesian_2d(
             xr.log_scale().with_key_points(log_ticks(x0, x1)),
             yr.log_scale().with_key_points(log_ticks(y0, y1))

@@ -65,11 +65,15 @@ pub fn write_run_plots(dir: &Path, data: &RunPlotData) -> Vec<PathBuf> {
         }
     };
     let has_valid = fixes.iter().any(|f| f.valid);
-    draw("track.png", has_valid, &|p| track::draw_track(fixes, None, p));
+    draw("track.png", has_valid, &|p| {
+        track::draw_track(fixes, None, p)
+    });
     draw("skyplot.png", !data.sky.is_empty(), &|p| {
         skyplot::draw_skyplot(&data.sky, p)
     });
-    draw("cn0.png", !data.cn0.is_empty(), &|p| cn0::draw_cn0(&data.cn0, p));
+    draw("cn0.png", !data.cn0.is_empty(), &|p| {
+        cn0::draw_cn0(&data.cn0, p)
+    });
     draw("dop.png", !fixes.is_empty(), &|p| dop::draw_dop(fixes, p));
     written
 }

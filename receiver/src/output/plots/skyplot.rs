@@ -24,14 +24,20 @@ pub fn draw_skyplot(sky: &BTreeMap<u8, Decimated<SkyPoint>>, path: &Path) -> Res
     )?;
     let (w, h) = area.dim_in_pixel();
     let side = w.min(h).saturating_sub(20);
-    let square = area.clone().shrink(((w - side) / 2, (h - side) / 2), (side, side));
+    let square = area
+        .clone()
+        .shrink(((w - side) / 2, (h - side) / 2), (side, side));
     let mut chart = ChartBuilder::on(&square)
         .build_cartesian_2d(-EDGE..EDGE, -EDGE..EDGE)
         .map_err(plot_err(path))?;
     let grid = RGBColor(190, 190, 190);
     for el in [0.0, 30.0, 60.0] {
         let ring: Vec<(f64, f64)> = (0..=360).map(|az| sky_xy(f64::from(az), el)).collect();
-        let style = if el == 0.0 { BLACK.stroke_width(2) } else { grid.stroke_width(1) };
+        let style = if el == 0.0 {
+            BLACK.stroke_width(2)
+        } else {
+            grid.stroke_width(1)
+        };
         chart
             .draw_series(LineSeries::new(ring, style))
             .map_err(plot_err(path))?;
@@ -46,7 +52,9 @@ pub fn draw_skyplot(sky: &BTreeMap<u8, Decimated<SkyPoint>>, path: &Path) -> Res
             .map_err(plot_err(path))?;
     }
     let font = ("sans-serif", LABEL_PX + 3).into_font();
-    let small = ("sans-serif", LABEL_PX - 2).into_font().color(&RGBColor(110, 110, 110));
+    let small = ("sans-serif", LABEL_PX - 2)
+        .into_font()
+        .color(&RGBColor(110, 110, 110));
     let centred = |p: (f64, f64), s: &str| {
         EmptyElement::at(p) + Text::new(s.to_string(), (-5 * s.len() as i32, -9), font.clone())
     };
@@ -60,12 +68,17 @@ pub fn draw_skyplot(sky: &BTreeMap<u8, Decimated<SkyPoint>>, path: &Path) -> Res
     // Elevation labels along the 15 deg azimuth, clear of the north line.
     chart
         .draw_series([30.0, 60.0].iter().map(|&el| {
-            EmptyElement::at(sky_xy(15.0, el)) + Text::new(format!("{el:.0}°"), (3, -2), small.clone())
+            EmptyElement::at(sky_xy(15.0, el))
+                + Text::new(format!("{el:.0}°"), (3, -2), small.clone())
         }))
         .map_err(plot_err(path))?;
     for (i, (prn, track)) in sky.iter().enumerate() {
         let c = color(i);
-        let pts: Vec<(f64, f64)> = track.values().iter().map(|p| sky_xy(p.az_deg, p.el_deg)).collect();
+        let pts: Vec<(f64, f64)> = track
+            .values()
+            .iter()
+            .map(|p| sky_xy(p.az_deg, p.el_deg))
+            .collect();
         chart
             .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(3)))
             .map_err(plot_err(path))?;
@@ -73,7 +86,9 @@ pub fn draw_skyplot(sky: &BTreeMap<u8, Decimated<SkyPoint>>, path: &Path) -> Res
             let label = EmptyElement::at(last)
                 + Circle::new((0, 0), 6, c.filled())
                 + Text::new(format!("G{prn:02}"), (8, -20), font.clone().color(&c));
-            chart.draw_series(std::iter::once(label)).map_err(plot_err(path))?;
+            chart
+                .draw_series(std::iter::once(label))
+                .map_err(plot_err(path))?;
         }
     }
     area.present().map_err(plot_err(path))?;

@@ -47,7 +47,10 @@ pub fn draw_track(
     let valid: Vec<&FixPoint> = fixes.iter().filter(|f| f.valid).collect();
     let (origin, origin_name) = match origin_ecef_m {
         Some(o) => (Some(o), "reference position"),
-        None => (median_position(valid.iter().map(|f| f.ecef_m)), "median fix"),
+        None => (
+            median_position(valid.iter().map(|f| f.ecef_m)),
+            "median fix",
+        ),
     };
     let frame = origin.map(LocalFrame::at);
     let en: Vec<(f64, f64, usize)> = match &frame {
@@ -89,7 +92,7 @@ pub fn draw_track(
         .map_err(plot_err(path))?;
     chart
         .configure_mesh()
-.light_line_style(TRANSPARENT)
+        .light_line_style(TRANSPARENT)
         .x_desc("east (m)")
         .y_desc("north (m)")
         .x_label_formatter(&|v| tick_label(*v))
@@ -112,7 +115,11 @@ pub fn draw_track(
         .map_err(plot_err(path))?;
     if frame.is_some() {
         chart
-            .draw_series(std::iter::once(Cross::new((0.0, 0.0), 8, BLACK.stroke_width(2))))
+            .draw_series(std::iter::once(Cross::new(
+                (0.0, 0.0),
+                8,
+                BLACK.stroke_width(2),
+            )))
             .map_err(plot_err(path))?;
     }
     draw_legend(&side, &entries, (0, (MARGIN_PX + 5) as i32)).map_err(plot_err(path))?;
