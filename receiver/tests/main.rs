@@ -6,3 +6,4 @@ mod ephemeris_file;
 mod faults;
 mod pipeline;
 mod plots;
+mod sigmf_lo;
