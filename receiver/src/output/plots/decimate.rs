@@ -24,7 +24,7 @@ impl<T> Decimated<T> {
 
     /// Offers the next value.
     pub fn push(&mut self, v: T) {
-        if self.pushed % self.stride == 0 {
+        if self.pushed.is_multiple_of(self.stride) {
             self.values.push(v);
             if self.values.len() >= 2 * self.cap {
                 let mut k = 0;

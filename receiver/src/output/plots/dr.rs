@@ -31,7 +31,7 @@ fn stretches(fused: &[FusedFix], frame: &LocalFrame) -> Vec<Stretch> {
     for (i, f) in fused.iter().enumerate() {
         let outage = f.source == FixSource::DrOnly;
         let changes = out.last().is_none_or(|s| s.0 != outage);
-        if i % stride != 0 && !changes && i + 1 != fused.len() {
+        if !i.is_multiple_of(stride) && !changes && i + 1 != fused.len() {
             continue;
         }
         let [e, n, _] = frame.enu_m([f.ecef_m.x, f.ecef_m.y, f.ecef_m.z]);

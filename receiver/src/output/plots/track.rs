@@ -2,6 +2,7 @@
 //! of satellites it used.
 
 use super::canvas::{plot_px, titled, with_legend_strip, MARGIN_PX, X_AREA_PX, Y_AREA_PX};
+use super::cn0::split_at_gaps;
 use super::data::FixPoint;
 use super::geometry::{equal_scale_ranges, median_position, LocalFrame};
 use super::legend::{draw_legend, LegendEntry, Swatch};
@@ -58,7 +59,7 @@ pub fn draw_track(
             .iter()
             .map(|f| {
                 let [e, n, _] = frame.enu_m(f.ecef_m);
-                (e, n, f.n_sv.min(10).max(3))
+                (e, n, f.n_sv.clamp(3, 10))
             })
             .collect(),
         None => Vec::new(),
@@ -101,12 +102,21 @@ pub fn draw_track(
         .axis_desc_style(("sans-serif", AXIS_DESC_PX))
         .draw()
         .map_err(plot_err(path))?;
-    chart
-        .draw_series(LineSeries::new(
-            pts.iter().copied(),
-            RGBColor(170, 170, 170).stroke_width(1),
-        ))
-        .map_err(plot_err(path))?;
+    // Fixes joined in time order, broken where fixes are missing (a GNSS outage).
+    let times: Vec<(f64, f64)> = valid
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (f.t_s, i as f64))
+        .collect();
+    for run in split_at_gaps(&times) {
+        let (a, b) = (run[0].1 as usize, run[run.len() - 1].1 as usize);
+        chart
+            .draw_series(LineSeries::new(
+                pts[a..=b].iter().copied(),
+                RGBColor(170, 170, 170).stroke_width(1),
+            ))
+            .map_err(plot_err(path))?;
+    }
     chart
         .draw_series(
             en.iter()
