@@ -50,7 +50,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         loops: LoopArgs::default(),
         out: dir.join("run"),
         json: false,
-        no_plots: false,
+        // The plots only when the files are kept.
+        no_plots: args.keep.is_none(),
         nav: None,
         iono: Some(IonoModel::Klobuchar),
         tropo: Some(TropoModel::Saastamoinen),
