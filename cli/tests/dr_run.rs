@@ -138,6 +138,12 @@ fn fused_fixes_continue_through_a_30_s_outage_within_metres_of_the_truth() {
     // many gaps; here it must stay a bounded drift.
     assert!(speed_rms < 1.0, "speed filter RMS {speed_rms} m/s");
 
+    // The plots, dr.png with them: PNG signatures (PNG spec 5.2).
+    for name in ["track.png", "skyplot.png", "cn0.png", "dop.png", "dr.png"] {
+        let bytes = std::fs::read(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{name}");
+    }
+
     // NMEA marks DR-only fixes with GGA quality 6; the calibration is saved.
     let nmea = std::fs::read_to_string(out.join("fused.nmea")).unwrap_or_else(|e| panic!("{e}"));
     assert!(nmea

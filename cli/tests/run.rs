@@ -256,6 +256,29 @@ fn a_recording_too_short_for_a_fix_ends_with_a_message_not_an_error() {
 }
 
 #[test]
+fn no_plots_leaves_the_png_plots_out() {
+    // 3 s: no fix, but the channels' C/N0 is plotted by default.
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let data = simulate(STATIC_BUSAN, 3.0, dir.path());
+    let pngs = |out: &std::path::Path| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(out)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .filter_map(Result::ok)
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".png"))
+            .collect();
+        v.sort();
+        v
+    };
+    let on = dir.path().join("on");
+    run(&data, &on, &[]);
+    assert_eq!(pngs(&on), ["cn0.png"]);
+    let off = dir.path().join("off");
+    run(&data, &off, &["--no-plots"]);
+    assert!(pngs(&off).is_empty(), "{:?}", pngs(&off));
+}
+
+#[test]
 fn observables_before_the_first_fix_carry_the_decoded_week() {
     // 16 s: subframe 1 (TOW 538200-538206) is decoded, subframe 3 is not, so no fix. Without
     // its metadata the recording has no date and there is no --week: the epochs before

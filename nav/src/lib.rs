@@ -1,5 +1,5 @@
 //! GPS domain basics for gpsrx: time, frames, broadcast ephemeris, RINEX navigation files,
-//! atmospheric models and the LNAV (L1 C/A) navigation message.
+//! atmospheric models, the EGM96 geoid and the LNAV (L1 C/A) navigation message.
 //!
 //! Every formula cites the IS-GPS-200 section or table it implements. Units are SI and are
 //! carried in the names (`tow_s`, `clock_bias_s`, `delta_n_rad_s`).
@@ -9,6 +9,7 @@ pub mod atmosphere;
 pub mod constants;
 pub mod ephemeris;
 pub mod frames;
+pub mod geoid;
 pub mod lnav;
 pub mod pvt;
 pub mod rinex_nav;

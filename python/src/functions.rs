@@ -69,8 +69,8 @@ pub fn run<'py>(
         let mut memory = MemorySink::new();
         let outcome = match &out {
             Some(dir) => {
-                let rate = spec.receiver_config()?.run.rate_hz;
-                let files = FileSink::create(dir, rate)?;
+                let run = spec.receiver_config()?.run;
+                let files = FileSink::create(dir, run.rate_hz)?.with_plots(run.plots);
                 let mut tee = Tee(files, memory);
                 let r = batch::run_recording(&spec, &mut tee);
                 memory = tee.1;

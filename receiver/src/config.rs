@@ -79,6 +79,9 @@ pub struct RunSettings {
     /// Approximate position, `[latitude deg, longitude deg, height m]` (WGS-84), within
     /// 100 km (`--approx-llh LAT,LON,H`).
     pub approx_llh: Option<[f64; 3]>,
+    /// Draw the PNG plots of the run (`track.png`, `skyplot.png`, `cn0.png`, `dop.png`,
+    /// `dr.png` with `--dr`) into the output directory (`gpsrx run --no-plots`: false).
+    pub plots: bool,
 }
 
 impl Default for RunSettings {
@@ -101,6 +104,7 @@ impl Default for RunSettings {
             prns: Vec::new(),
             approx_time: None,
             approx_llh: None,
+            plots: true,
         }
     }
 }

@@ -2,5 +2,8 @@
 //! simulator's truth (one test binary for the crate).
 
 mod acquisition;
+mod ephemeris_file;
 mod faults;
 mod pipeline;
+mod plots;
+mod sigmf_lo;

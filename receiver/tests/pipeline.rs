@@ -11,7 +11,7 @@ use num_complex::Complex32;
 use std::path::Path;
 
 /// A static receiver near Daejeon, 2.048 MHz, the built-in broadcast ephemerides.
-fn simulator(duration_s: f64) -> Simulator {
+pub(crate) fn simulator(duration_s: f64) -> Simulator {
     let text = format!(
         r#"
 duration_s = {duration_s}
@@ -36,7 +36,7 @@ drift_s_s = 4.0e-8
 }
 
 /// The simulator's samples as a source, read in reads of any size.
-struct SimSource<'a> {
+pub(crate) struct SimSource<'a> {
     sim: &'a Simulator,
     chunk: u64,
     buf: Vec<Complex32>,
@@ -46,7 +46,7 @@ struct SimSource<'a> {
 }
 
 impl<'a> SimSource<'a> {
-    fn new(sim: &'a Simulator) -> Self {
+    pub(crate) fn new(sim: &'a Simulator) -> Self {
         Self {
             sim,
             chunk: 0,

@@ -134,6 +134,21 @@ pub enum SampleError {
         allowed: String,
     },
 
+    /// `--if` disagrees with the IF the SigMF metadata describes.
+    #[error(
+        "--if {given_hz} Hz for {path} disagrees with the SigMF metadata's IF of {described_hz} Hz (from {field}): drop --if to use the metadata, or correct the .sigmf-meta"
+    )]
+    IfConflict {
+        /// The recording.
+        path: PathBuf,
+        /// The IF given on the command line, Hz.
+        given_hz: f64,
+        /// The IF the metadata describes, Hz.
+        described_hz: f64,
+        /// The metadata field it comes from (`gpsrx:if_hz` or `core:frequency`).
+        field: &'static str,
+    },
+
     /// A skip or duration that is negative or not finite.
     #[error("{what} = {value} s for {path} is not a finite, non-negative number of seconds")]
     BadTimeSpan {

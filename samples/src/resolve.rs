@@ -8,9 +8,11 @@
 //!   [`crate::sigmf::write_sigmf_meta`] writes), or else `P` + `.sigmf-meta`, if either exists;
 //! - without metadata, a file starting with a RIFF/WAVE header is read as WAV.
 //!
-//! Precedence: `--format` and `--fs` win over metadata (a disagreement is a warning); a non-zero
-//! `if_hz` in the configuration wins over `gpsrx:if_hz`; Q is inverted when the configuration or
-//! the metadata asks for it.
+//! Precedence: `--format` and `--fs` win over metadata (a disagreement is a warning); the IF is
+//! the configuration's when non-zero, else the metadata's (`gpsrx:if_hz`, else `L1 -
+//! core:frequency`: [`crate::sigmf::SigmfMeta::described_if_hz`]), and a non-zero IF in both
+//! that disagrees is an error; Q is inverted when the configuration or the metadata asks for
+//! it.
 
 use std::path::{Path, PathBuf};
 
@@ -52,6 +54,31 @@ fn has_extension(path: &Path, ext: &str) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+}
+
+/// Largest difference between `--if` and the metadata's IF taken as agreement, Hz.
+const IF_AGREEMENT_HZ: f64 = 1.0;
+
+/// The IF to mix down: `config_if_hz` when non-zero, else the metadata's; an error when both
+/// are non-zero and disagree by more than [`IF_AGREEMENT_HZ`].
+fn resolve_if(
+    path: &Path,
+    meta: Option<&crate::sigmf::SigmfMeta>,
+    config_if_hz: f64,
+) -> Result<f64, SampleError> {
+    let (described, field) = meta.map_or((0.0, "none"), |m| m.described_if_hz());
+    if config_if_hz == 0.0 {
+        return Ok(described);
+    }
+    if described != 0.0 && (described - config_if_hz).abs() > IF_AGREEMENT_HZ {
+        return Err(SampleError::IfConflict {
+            path: path.to_path_buf(),
+            given_hz: config_if_hz,
+            described_hz: described,
+            field,
+        });
+    }
+    Ok(config_if_hz)
 }
 
 /// Finds the data file and its metadata file for `path`.
@@ -189,10 +216,7 @@ pub fn resolve(cfg: &SourceConfig) -> Result<Resolved, SampleError> {
         (None, Some(d)) => d,
         (None, None) => return Err(SampleError::SampleRateUnknown { path: path.clone() }),
     };
-    let if_hz = match (&meta, cfg.if_hz) {
-        (Some(m), 0.0) => m.if_hz,
-        (_, if_hz) => if_hz,
-    };
+    let if_hz = resolve_if(path, meta.as_ref(), cfg.if_hz)?;
     let invert_q = cfg.invert_q || meta.as_ref().is_some_and(|m| m.invert_q);
     validate_format_and_rates(path, &format, fs_hz, if_hz)?;
 

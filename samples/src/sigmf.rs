@@ -21,7 +21,10 @@
 //! }
 //! ```
 //!
-//! `gpsrx:if_hz` is the intermediate frequency of the samples (0 for complex baseband),
+//! `gpsrx:if_hz` is the intermediate frequency of the samples (0 for complex baseband); when it
+//! is absent (or 0), a `captures[0].core:frequency` other than L1 gives it: the front end was
+//! tuned to `core:frequency`, so L1 lies at `IF = 1575.42e6 - core:frequency` in the samples
+//! ([`SigmfMeta::described_if_hz`]; gpsrx's simulator writes both, consistently),
 //! `gpsrx:invert_q` says the Q channel must be negated (x = I - jQ), `gpsrx:packed_map` gives the
 //! value of 2-bit codes 0b00..0b11. The packed datatypes `ci2`, `ri2`, `ci1` are gpsrx names, not
 //! SigMF 1.x ones (see [`crate::format`]).
@@ -94,6 +97,19 @@ pub struct RecordingStart {
 }
 
 impl SigmfMeta {
+    /// The intermediate frequency of the samples, Hz, and where it comes from: `gpsrx:if_hz`
+    /// when non-zero; else `L1 - captures[0].core:frequency` when that is not L1 (a front end
+    /// tuned off L1 puts the carrier at the difference; IS-GPS-200 3.3.1.1 for L1); else 0.
+    pub fn described_if_hz(&self) -> (f64, &'static str) {
+        if self.if_hz != 0.0 {
+            return (self.if_hz, "gpsrx:if_hz");
+        }
+        match self.frequency_hz.filter(|f| f.is_finite()) {
+            Some(f) if f != GPS_L1_HZ => (GPS_L1_HZ - f, "core:frequency"),
+            _ => (0.0, "none"),
+        }
+    }
+
     /// Metadata for `datatype` at `sample_rate_hz`, complex baseband at GPS L1, nothing else set.
     pub fn new(datatype: impl Into<String>, sample_rate_hz: f64) -> Self {
         SigmfMeta {

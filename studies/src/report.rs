@@ -1,14 +1,15 @@
 //! What every study writes to its `--out DIR`: `study.md` (the tables and the plots, for people),
 //! `study.csv` (one row per case, for tools), `study.json` (a summary) and PNG plots.
 //!
-//! Plots are drawn with plotters' bitmap backend and an embedded DejaVu Sans font
-//! (`studies/assets/fonts`, Bitstream Vera licence), so they need no system fonts.
+//! Plots are drawn by the receiver crate's [`gpsrx_receiver::output::plots`] (plotters'
+//! bitmap backend and an embedded DejaVu Sans font, so they need no system fonts), re-exported
+//! here: [`LinePlot`], [`Series`], [`draw_line_plot`], [`register_font`].
 
 use anyhow::Context;
-use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::Once;
+
+pub use gpsrx_receiver::output::plots::{draw_line_plot, register_font, LinePlot, Series};
 
 /// A table: a header row and string cells, written as Markdown and as CSV.
 #[derive(Debug, Clone, Default)]
@@ -61,36 +62,6 @@ impl Table {
             .with_context(|| format!("cannot write {}", path.display()))?;
         Ok(())
     }
-}
-
-/// One named curve of a line plot.
-#[derive(Debug, Clone, Default)]
-pub struct Series {
-    /// Legend text.
-    pub name: String,
-    /// (x, y) points, drawn in order; non-finite points are skipped.
-    pub points: Vec<(f64, f64)>,
-    /// Draw as a dashed reference line (e.g. a closed form) rather than a measured curve.
-    pub reference: bool,
-}
-
-/// A line plot.
-#[derive(Debug, Clone, Default)]
-pub struct LinePlot {
-    /// File name inside the output directory (`.png`).
-    pub file_name: String,
-    /// Title.
-    pub title: String,
-    /// X axis label.
-    pub x_label: String,
-    /// Y axis label.
-    pub y_label: String,
-    /// Logarithmic x axis.
-    pub log_x: bool,
-    /// Logarithmic y axis.
-    pub log_y: bool,
-    /// The curves.
-    pub series: Vec<Series>,
 }
 
 /// A complete study result.
@@ -159,139 +130,6 @@ impl StudyReport {
             plots,
         })
     }
-}
-
-static FONT: Once = Once::new();
-
-/// Registers the embedded font as `sans-serif` (once per process).
-pub(crate) fn register_font() {
-    FONT.call_once(|| {
-        let bytes: &'static [u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
-        if plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_err() {
-            tracing::warn!("the embedded plot font could not be loaded; plots have no text");
-        }
-    });
-}
-
-const COLORS: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(23, 190, 207),
-];
-
-/// Axis range of the finite values (positive ones on a log axis), padded a little.
-fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
-        lo = lo.min(v);
-        hi = hi.max(v);
-    }
-    if !lo.is_finite() {
-        return if log { (0.1, 10.0) } else { (0.0, 1.0) };
-    }
-    if log {
-        (lo / 1.3, hi * 1.3)
-    } else if hi - lo < 1e-12 {
-        (lo - 1.0, hi + 1.0)
-    } else {
-        let pad = 0.05 * (hi - lo);
-        (lo - pad, hi + pad)
-    }
-}
-
-fn plot_err<E: std::error::Error + Send + Sync + 'static>(
-    path: &Path,
-) -> impl FnOnce(E) -> anyhow::Error + '_ {
-    move |e| anyhow::anyhow!("cannot draw {}: {e}", path.display())
-}
-
-/// Draws `plot` into a 1000x640 PNG at `path`.
-pub fn draw_line_plot(plot: &LinePlot, path: &Path) -> anyhow::Result<()> {
-    register_font();
-    let root = BitMapBackend::new(path, (1000, 640)).into_drawing_area();
-    root.fill(&WHITE).map_err(plot_err(path))?;
-    let xs = plot
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.0));
-    let ys = plot
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.1));
-    let (x0, x1) = range(xs, plot.log_x);
-    let (y0, y1) = range(ys, plot.log_y);
-    let mut builder = ChartBuilder::on(&root);
-    builder
-        .caption(&plot.title, ("sans-serif", 24))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(70);
-    // The four axis combinations have different coordinate types.
-    macro_rules! draw {
-        ($chart:expr) => {{
-            let mut chart = $chart.map_err(plot_err(path))?;
-            chart
-                .configure_mesh()
-                .x_desc(plot.x_label.as_str())
-                .y_desc(plot.y_label.as_str())
-                .label_style(("sans-serif", 15))
-                .axis_desc_style(("sans-serif", 17))
-                .draw()
-                .map_err(plot_err(path))?;
-            for (i, s) in plot.series.iter().enumerate() {
-                let color = COLORS[i % COLORS.len()];
-                let pts: Vec<(f64, f64)> = s
-                    .points
-                    .iter()
-                    .copied()
-                    .filter(|(x, y)| {
-                        x.is_finite()
-                            && y.is_finite()
-                            && (!plot.log_x || *x > 0.0)
-                            && (!plot.log_y || *y > 0.0)
-                    })
-                    .collect();
-                let style = ShapeStyle::from(&color).stroke_width(2);
-                let series = if s.reference {
-                    chart.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, style))
-                } else {
-                    chart.draw_series(LineSeries::new(pts.clone(), style))
-                }
-                .map_err(plot_err(path))?;
-                series.label(s.name.as_str()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-                if !s.reference {
-                    chart
-                        .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
-                        .map_err(plot_err(path))?;
-                }
-            }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 14))
-                .position(SeriesLabelPosition::UpperLeft)
-                .draw()
-                .map_err(plot_err(path))?;
-        }};
-    }
-    match (plot.log_x, plot.log_y) {
-        (false, false) => draw!(builder.build_cartesian_2d(x0..x1, y0..y1)),
-        (true, false) => draw!(builder.build_cartesian_2d((x0..x1).log_scale(), y0..y1)),
-        (false, true) => draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())),
-        (true, true) => {
-            draw!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale()))
-        }
-    }
-    root.present().map_err(plot_err(path))?;
-    Ok(())
 }
 
 /// Formats a number with `digits` decimals, `-` for NaN (a cell with no value).

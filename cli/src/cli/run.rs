@@ -37,6 +37,10 @@ pub struct RunArgs {
     /// Print the summary as JSON on standard output (for scripts) instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Do not draw the PNG plots (track.png, skyplot.png, cn0.png, dop.png, dr.png) into
+    /// the output directory (config file: `plots = false` in `[run]`).
+    #[arg(long)]
+    pub no_plots: bool,
     /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
     #[arg(long, value_name = "FILE")]
     pub nav: Option<PathBuf>,
@@ -214,6 +218,7 @@ impl RunArgs {
             r.approx_llh = self.approx_llh;
         }
         r.allow_unhealthy |= self.allow_unhealthy;
+        r.plots &= !self.no_plots;
         c.validate()?;
         Ok(c)
     }

@@ -50,6 +50,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         loops: LoopArgs::default(),
         out: dir.join("run"),
         json: false,
+        // The plots only when the files are kept.
+        no_plots: args.keep.is_none(),
         nav: None,
         iono: Some(IonoModel::Klobuchar),
         tropo: Some(TropoModel::Saastamoinen),

@@ -95,6 +95,10 @@ mod tests {
         assert_eq!(c.run.rate_hz, 2.0);
         assert_eq!(c.run.tropo, TropoModel::None);
         assert_eq!(c.tracking.cn0_lost_dbhz, 30.0);
+        // Plots are on unless an option (a manifest column, a Python keyword) says no.
+        assert!(c.run.plots);
+        let off = config_with_options(None, &table("plots = false")).expect("valid options");
+        assert!(!off.run.plots);
         // Everything else keeps its default.
         assert_eq!(
             c.run.elevation_mask_deg,

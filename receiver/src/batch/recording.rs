@@ -148,6 +148,6 @@ pub fn run_recording_to(
     out_dir: &Path,
 ) -> Result<(RunSummary, Vec<String>), RecordingError> {
     let config = spec.receiver_config()?;
-    let mut files = FileSink::create(out_dir, config.run.rate_hz)?;
+    let mut files = FileSink::create(out_dir, config.run.rate_hz)?.with_plots(config.run.plots);
     run_recording(spec, &mut files)
 }

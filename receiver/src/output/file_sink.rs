@@ -6,8 +6,11 @@
 //! never written while the GPS week is unknown, see [`crate::pipeline::dating`]),
 //! `ephemeris.rnx` (the decoded ephemerides, at the end), `almanac.yuma` (the decoded almanac,
 //! when one was), `track.geojson`, `track.kml` and `track.gpx` (the
-//! fixes, at the end).
+//! fixes, at the end); with [`FileSink::with_plots`], the PNG plots of
+//! [`crate::output::plots`] (`track.png`, `skyplot.png`, `cn0.png`, `dop.png`, at the end; a
+//! plot that cannot be drawn is a warning).
 
+use crate::output::plots::{write_run_plots, RunPlotData};
 use crate::output::{
     create_file, rinex_nav::write_rinex_nav_file, write_geojson, write_kml, ChannelCsvWriter,
     ChannelRow, Fix, NavHeader, NavRecord, NmeaOptions, NmeaWriter, ObsEpoch, ObsHeader,
@@ -37,6 +40,8 @@ pub struct FileSink {
     /// Epochs dropped from the backlog while the week was unknown (memory bound).
     obs_dropped: usize,
     fixes: Vec<Fix>,
+    /// What the plots need, when they are drawn.
+    plots: Option<RunPlotData>,
 }
 
 impl FileSink {
@@ -64,7 +69,15 @@ impl FileSink {
             obs_week_known: false,
             obs_dropped: 0,
             fixes: Vec::new(),
+            plots: None,
         })
+    }
+
+    /// Draws the PNG plots at the end too when `enabled` (off by default: [`FileSink::create`]
+    /// makes the text files only; `gpsrx run` follows [`crate::config::RunSettings::plots`]).
+    pub fn with_plots(mut self, enabled: bool) -> Self {
+        self.plots = enabled.then(RunPlotData::default);
+        self
     }
 
     /// The fixes written.
@@ -121,6 +134,9 @@ impl Sink for FileSink {
         self.pvt_csv.flush()?;
         self.nmea.flush()?;
         self.fixes.push(report.fix.clone());
+        if let Some(p) = &mut self.plots {
+            p.add_fix(&report.fix, report.t_stream_s);
+        }
         Ok(())
     }
 
@@ -165,6 +181,9 @@ impl Sink for FileSink {
     }
 
     fn channel(&mut self, row: &ChannelRow) -> Result<(), SinkError> {
+        if let Some(p) = &mut self.plots {
+            p.add_channel(row);
+        }
         Ok(self.channels_csv.write_row(row)?)
     }
 
@@ -207,8 +226,10 @@ impl Sink for FileSink {
         let records: Vec<NavRecord> = end
             .ephemerides
             .iter()
-            .cloned()
-            .map(NavRecord::from)
+            .map(|e| NavRecord {
+                transmission_tow_s: end.transmission_tow_s.get(&e.prn).copied(),
+                ephemeris: e.clone(),
+            })
             .collect();
         let header = NavHeader {
             iono: end.iono,
@@ -226,6 +247,9 @@ impl Sink for FileSink {
         write_kml(&mut f, "track.kml", "gpsrx track", &self.fixes)?;
         let mut f = create_file(&self.dir.join("track.gpx"))?;
         super::write_gpx(&mut f, "track.gpx", "gpsrx track", &self.fixes)?;
+        if let Some(p) = &self.plots {
+            write_run_plots(&self.dir, p);
+        }
         Ok(())
     }
 }

@@ -6,6 +6,8 @@
 //! - [`nmea`]: NMEA 0183 GGA, RMC, GSA, GSV, GST and ZDA sentences (`pvt.nmea`);
 //! - [`geojson`], [`kml`] and [`gpx`]: the track for maps (`track.geojson`, `track.kml`,
 //!   `track.gpx`);
+//! - [`plots`]: PNG plots of the run (`track.png`, `skyplot.png`, `cn0.png`, `dop.png`,
+//!   `dr.png`) and the studies' line plots;
 //! - [`pvt_csv`]: one row per fix (`pvt.csv`) and one row per channel and epoch
 //!   (`channels.csv`).
 //!
@@ -20,6 +22,7 @@ pub mod geojson;
 pub mod gpx;
 pub mod kml;
 pub mod nmea;
+pub mod plots;
 pub mod pvt_csv;
 pub mod rinex_nav;
 pub mod rinex_obs;

@@ -7,11 +7,12 @@
 //! since 2017-01-01, from the leap-second table). While the GPS week is unknown
 //! ([`Fix::week_known`]) the RMC date is left empty.
 //!
-//! **Altitude.** GGA field 9 is meant to be the altitude above mean sea level (the geoid) and
-//! field 11 the geoid separation N (ellipsoid - geoid). We carry no geoid model: unless the
-//! caller gives [`NmeaOptions::geoid_separation_m`], we write the height above the WGS-84
-//! ellipsoid as the altitude and a separation of 0.0, so altitude + separation is the
-//! ellipsoidal height either way.
+//! **Altitude.** GGA field 9 is the altitude above mean sea level (the geoid), H = h - N, and
+//! field 11 the geoid separation N (the geoid's height above the WGS-84 ellipsoid), so
+//! altitude + separation is the ellipsoidal height h. N comes from the EGM96 model at the
+//! fix ([`gpsrx_nav::geoid::egm96_separation_m`], a 1-degree grid, within 0.5 m of the full
+//! model), unless the caller gives [`NmeaOptions::geoid_separation_m`] (0 writes the
+//! ellipsoidal height as the altitude).
 
 use super::{calendar_rounded, create_file, Fix, FixQuality, OutputError};
 use gpsrx_nav::{enu_rotation, GpsTime, Vector3};
@@ -29,12 +30,13 @@ const GSV_MAX_SENTENCES: usize = 9;
 const GSA_MAX_PRNS: usize = 12;
 
 /// How sentences are formed.
-/// The default: leap seconds from the table at each fix's date, no geoid separation.
+/// The default: leap seconds from the table at each fix's date, EGM96 geoid separation.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct NmeaOptions {
     /// GPS - UTC, s; `None`: the count in effect at each fix's date (18 since 2017-01-01).
     pub leap_seconds: Option<i32>,
-    /// Geoid separation N at the fix, m; `None` writes ellipsoidal height with N = 0.
+    /// Geoid separation N at every fix, m, overriding the EGM96 model (`None`: EGM96 at each
+    /// fix; `Some(0.0)`: the ellipsoidal height as the altitude).
     pub geoid_separation_m: Option<f64>,
 }
 
@@ -129,7 +131,12 @@ pub fn gga(fix: &Fix, opts: &NmeaOptions) -> String {
         let n = opts
             .geoid_separation_m
             .filter(|n| n.is_finite())
-            .unwrap_or(0.0);
+            .unwrap_or_else(|| {
+                gpsrx_nav::geoid::egm96_separation_m(
+                    fix.llh.lat_rad.to_degrees(),
+                    fix.llh.lon_rad.to_degrees(),
+                )
+            });
         (opt_num(fix.llh.h_m - n, 3), opt_num(n, 3))
     } else {
         (String::new(), String::new())
@@ -372,5 +379,47 @@ mod tests {
         // Widely published example GGA sentence; its checksum is 47.
         let body = "GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,";
         assert_eq!(checksum(body), 0x47);
+    }
+
+    #[test]
+    fn gga_altitude_is_above_the_egm96_geoid() {
+        use gpsrx_nav::Llh;
+        // Munich, h = 545.4 m above the ellipsoid. EGM96 there: 45.51 m (GeographicLib's
+        // egm96-5 grid, bilinear).
+        let llh = Llh::from_degrees(48.1173, 11.516_666_7, 545.4);
+        let e = llh.to_ecef();
+        let fix = Fix {
+            time: GpsTime::from_calendar(2022, 1, 1, 5, 30, 0.0),
+            week_known: true,
+            ecef_m: [e.x, e.y, e.z],
+            llh,
+            vel_ecef_mps: None,
+            clock_bias_m: 0.0,
+            clock_drift_mps: None,
+            n_sv: 8,
+            used_prns: Vec::new(),
+            pdop: 1.8,
+            hdop: 0.9,
+            vdop: 1.5,
+            raim: String::new(),
+            quality: FixQuality::Gnss,
+            sigma_enu_m: None,
+            sats_in_view: Vec::new(),
+        };
+        let fields = |opts: &NmeaOptions| -> (f64, f64) {
+            let s = gga(&fix, opts);
+            let f: Vec<&str> = s.split(',').collect();
+            let num = |i: usize| f[i].parse::<f64>().unwrap_or(f64::NAN);
+            (num(9), num(11))
+        };
+        let (alt, sep) = fields(&NmeaOptions::default());
+        assert!((sep - 45.51).abs() < 0.5, "N = {sep}");
+        assert!((alt + sep - 545.4).abs() < 1e-3, "H + N = h: {alt} + {sep}");
+        // The override: 0 writes the ellipsoidal height.
+        let zero = NmeaOptions {
+            geoid_separation_m: Some(0.0),
+            ..NmeaOptions::default()
+        };
+        assert_eq!(fields(&zero), (545.4, 0.0));
     }
 }

@@ -86,6 +86,12 @@ pub struct NavDecoder {
     assembler: EphemerisAssembler,
     /// Latest ephemeris.
     pub ephemeris: Option<Ephemeris>,
+    /// When the latest ephemeris's subframe 1 was sent: the HOW time of its start, s of the
+    /// GPS week of the ephemeris's toe (RINEX 3.04 Table A6 "transmission time of message":
+    /// negative when sent in the week before toe).
+    pub ephemeris_transmission_tow_s: Option<f64>,
+    /// Start (HOW time, s) and week of the latest subframe 1.
+    last_sf1: Option<(u32, u32)>,
     /// Latest ionosphere parameters (subframe 4 page 18).
     pub iono: Option<KlobucharParams>,
     /// Latest GPS-UTC parameters (weeks resolved).
@@ -126,6 +132,8 @@ impl NavDecoder {
             candidate: None,
             assembler: EphemerisAssembler::new(prn, reference_week),
             ephemeris: None,
+            ephemeris_transmission_tow_s: None,
+            last_sf1: None,
             iono: None,
             utc: None,
             utc_broadcast: None,
@@ -425,10 +433,9 @@ impl NavDecoder {
             tow_s,
         });
         if let SubframePayload::Subframe1(s1) = &sf.payload {
-            self.week = Some(GpsTime::resolve_week_10bit(
-                s1.week_mod_1024,
-                self.reference_week,
-            ));
+            let week = GpsTime::resolve_week_10bit(s1.week_mod_1024, self.reference_week);
+            self.week = Some(week);
+            self.last_sf1 = Some((tow_s, week));
         }
         match sf.payload {
             SubframePayload::Page18 { iono, utc } => {
@@ -442,6 +449,10 @@ impl NavDecoder {
             }
             _ => {
                 if let Some(eph) = self.assembler.push(&sf) {
+                    // The assembler keeps the latest subframe 1: the one recorded here.
+                    self.ephemeris_transmission_tow_s = self.last_sf1.map(|(tow, week)| {
+                        f64::from(tow) + (f64::from(week) - f64::from(eph.toe.week)) * 604_800.0
+                    });
                     self.ephemeris = Some(eph.clone());
                     events.push(NavEvent::Ephemeris(Box::new(eph)));
                 }

@@ -403,6 +403,11 @@ impl NavigationProcessor {
                 .values()
                 .filter_map(|d| d.ephemeris.clone())
                 .collect(),
+            transmission_tow_s: self
+                .decoders
+                .values()
+                .filter_map(|d| Some((d.ephemeris.as_ref()?.prn, d.ephemeris_transmission_tow_s?)))
+                .collect(),
             iono: self.decoders.values().find_map(|d| d.iono),
             utc: self.decoders.values().find_map(|d| d.utc),
             almanac: self.almanac.almanac_set(),

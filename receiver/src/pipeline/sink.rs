@@ -136,6 +136,9 @@ pub struct Progress {
 pub struct NavigationEnd {
     /// The decoded ephemerides, one per satellite (the latest).
     pub ephemerides: Vec<Ephemeris>,
+    /// When each of `ephemerides` was sent (its subframe 1's HOW time, s of the week of its
+    /// toe), by PRN: RINEX's "transmission time of message".
+    pub transmission_tow_s: std::collections::BTreeMap<u8, f64>,
     /// Broadcast ionosphere (subframe 4 page 18), if decoded.
     pub iono: Option<KlobucharParams>,
     /// Broadcast UTC parameters, if decoded.

@@ -10,6 +10,10 @@ use super::speed::GapResult;
 use super::summary::Gathered;
 use crate::report::{register_font, LinePlot, Series};
 use anyhow::Context;
+use gpsrx_receiver::output::plots::legend::{
+    corner_origin, draw_legend, free_corner, legend_size_px, LegendEntry, Swatch,
+};
+use gpsrx_receiver::output::plots::ticks::tick_label;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -214,8 +218,46 @@ fn plot_err<E: std::error::Error + Send + Sync + 'static>(
     move |e| anyhow::anyhow!("cannot draw {}: {e}", path.display())
 }
 
+/// The curves and the shaded windows (outline and inside) of a plot in fractions of its axes
+/// `x` and `y`: what the legend must not cover.
+fn legend_obstacles(
+    plot: &LinePlot,
+    shaded: &[(f64, f64)],
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Vec<Vec<(f64, f64)>> {
+    let frac = |(x, y): (f64, f64)| ((x - x0) / (x1 - x0), (y - y0) / (y1 - y0));
+    let mut shapes: Vec<Vec<(f64, f64)>> = plot
+        .series
+        .iter()
+        .map(|s| {
+            s.points
+                .iter()
+                .copied()
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .map(frac)
+                .collect()
+        })
+        .collect();
+    for &(a, b) in shaded {
+        shapes.push(
+            [(a, y0), (a, y1), (b, y1), (b, y0), (a, y0)]
+                .map(frac)
+                .to_vec(),
+        );
+        // A vertical line every 1 % of the width inside the window.
+        let n = (((b - a) / (x1 - x0)) * 100.0).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            let x = a + (b - a) * k as f64 / n as f64;
+            shapes.push(vec![frac((x, y0)), frac((x, y1))]);
+        }
+    }
+    shapes
+}
+
 /// A linear line plot (lines only, reference series dashed) with the `shaded` x windows filled
-/// in grey behind the curves, 1200x640; the y axis starts at 0 if `from_zero`.
+/// in grey behind the curves, 1200x640; the y axis starts at 0 if `from_zero`. The legend goes
+/// in a corner free of curves and windows, else beside the plot.
 fn draw_shaded(
     plot: &LinePlot,
     shaded: &[(f64, f64)],
@@ -223,8 +265,12 @@ fn draw_shaded(
     path: &Path,
 ) -> anyhow::Result<()> {
     register_font();
-    let root = BitMapBackend::new(path, (1200, 640)).into_drawing_area();
+    let (w, h) = (1200u32, 640u32);
+    let root = BitMapBackend::new(path, (w, h)).into_drawing_area();
     root.fill(&WHITE).map_err(plot_err(path))?;
+    let root = root
+        .titled(&plot.title, ("sans-serif", 24))
+        .map_err(plot_err(path))?;
     let finite = |s: &Series| {
         s.points
             .iter()
@@ -245,17 +291,55 @@ fn draw_shaded(
     }
     let pad = 0.05 * (y1 - y0).max(1e-6);
     let (y0, y1) = (if from_zero { 0.0 } else { y0 - pad }, y1 + pad);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(&plot.title, ("sans-serif", 24))
+    let x1 = x1.max(x0 + 1.0);
+    // Colours: an unnamed series continues the previous one's (e.g. the two +-1 % lines).
+    let mut colors = Vec::new();
+    let mut color_index = 0;
+    for (i, s) in plot.series.iter().enumerate() {
+        if i > 0 && !s.name.is_empty() {
+            color_index += 1;
+        }
+        colors.push(COLORS[color_index.min(COLORS.len() - 1)]);
+    }
+    let entries: Vec<LegendEntry> = plot
+        .series
+        .iter()
+        .zip(&colors)
+        .filter(|(s, _)| !s.name.is_empty())
+        .map(|(s, &color)| LegendEntry {
+            name: s.name.clone(),
+            color,
+            swatch: if s.reference {
+                Swatch::Dashed
+            } else {
+                Swatch::Line
+            },
+        })
+        .collect();
+    let shapes = legend_obstacles(plot, shaded, (x0, x1), (y0, y1));
+    let (lw, lh) = legend_size_px(&entries);
+    let (area_w, area_h) = (f64::from(w - 100), f64::from(h - 100));
+    let corner = free_corner(&shapes, (f64::from(lw) / area_w, f64::from(lh) / area_h));
+    let (chart_area, side) = match corner {
+        None if !entries.is_empty() => {
+            let (a, b) = root.split_horizontally(w - lw - 30);
+            (a, Some(b))
+        }
+        _ => (root.clone(), None),
+    };
+    let mut chart = ChartBuilder::on(&chart_area)
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1.max(x0 + 1.0), y0..y1)
+        .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(plot_err(path))?;
     chart
         .configure_mesh()
+        .light_line_style(TRANSPARENT)
         .x_desc(plot.x_label.as_str())
         .y_desc(plot.y_label.as_str())
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
         .draw()
@@ -268,13 +352,7 @@ fn draw_shaded(
             )
         }))
         .map_err(plot_err(path))?;
-    let mut color_index = 0;
-    for (i, s) in plot.series.iter().enumerate() {
-        // An unnamed series continues the previous one's colour (e.g. the two +-1 % lines).
-        if i > 0 && !s.name.is_empty() {
-            color_index += 1;
-        }
-        let color = COLORS[color_index.min(COLORS.len() - 1)];
+    for (s, &color) in plot.series.iter().zip(&colors) {
         let style = ShapeStyle::from(&color).stroke_width(if s.reference { 1 } else { 2 });
         // Break lines at NaN (no GNSS in an outage).
         let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
@@ -287,28 +365,24 @@ fn draw_shaded(
                 runs.push(Vec::new());
             }
         }
-        for (k, r) in runs.into_iter().enumerate() {
-            let drawn = if s.reference {
+        for r in runs {
+            if s.reference {
                 chart.draw_series(DashedLineSeries::new(r, 8, 5, style))
             } else {
                 chart.draw_series(LineSeries::new(r, style))
             }
             .map_err(plot_err(path))?;
-            if k == 0 && !s.name.is_empty() {
-                drawn.label(s.name.as_str()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-            }
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(plot_err(path))?;
+    if let Some(corner) = corner {
+        let area = chart.plotting_area().strip_coord_spec();
+        let (pw, ph) = area.dim_in_pixel();
+        let at = corner_origin(corner, 0..pw as i32, 0..ph as i32, (lw, lh));
+        draw_legend(&area, &entries, at).map_err(plot_err(path))?;
+    }
+    if let Some(side) = side {
+        draw_legend(&side, &entries, (0, 20)).map_err(plot_err(path))?;
+    }
     root.present().map_err(plot_err(path))?;
     Ok(())
 }

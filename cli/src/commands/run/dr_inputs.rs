@@ -10,6 +10,7 @@ use gpsrx_receiver::fusion::fuse::{fuse_dr, DrFusionSettings};
 use gpsrx_receiver::fusion::fused_csv::{fused_as_fixes, write_fused_csv};
 use gpsrx_receiver::fusion::gnss::GnssFix;
 use gpsrx_receiver::fusion::speed::{attach_speed, speed_track};
+use gpsrx_receiver::output::plots::dr::draw_dr_track;
 use gpsrx_receiver::output::{self, create_file, NmeaOptions, NmeaWriter};
 use gpsrx_receiver::ReceiverConfig;
 use std::path::Path;
@@ -72,12 +73,13 @@ impl DrInputs {
 }
 
 /// Fuses the fixes with the DR and accelerometer logs and writes `fused.csv`, `fused.nmea`,
-/// `fused.geojson`, `fused.kml` and (with `--dr`) `dr_params.toml`; returns the row counts by
-/// source (gnss, fused, dr) and the calibrated parameters.
+/// `fused.geojson`, `fused.kml`, (with `--dr`) `dr_params.toml` and (with `plots`) `dr.png`;
+/// returns the row counts by source (gnss, fused, dr) and the calibrated parameters.
 pub(super) fn write_fused_outputs(
     inputs: &DrInputs,
     gnss: &[GnssFix],
     dir: &Path,
+    plots: bool,
 ) -> anyhow::Result<([usize; 3], Option<DrParams>)> {
     let out = |name: &str| dir.join(name);
     let mut result = fuse_dr(gnss, inputs.dr.as_ref(), &inputs.settings)?;
@@ -98,6 +100,11 @@ pub(super) fn write_fused_outputs(
     output::write_kml(&mut f, "fused.kml", "gpsrx GNSS/DR", &fixes)?;
     if let (Some(p), Some(_)) = (&result.final_params, &inputs.dr) {
         p.save(&out("dr_params.toml"))?;
+    }
+    if plots && inputs.dr.is_some() && !result.fixes.is_empty() {
+        if let Err(e) = draw_dr_track(&result.fixes, &out("dr.png")) {
+            tracing::warn!("{e} (the fused outputs are complete)");
+        }
     }
     let count = |s: FixSource| result.fixes.iter().filter(|f| f.source == s).count();
     let rows = [

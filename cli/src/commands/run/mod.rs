@@ -3,8 +3,9 @@
 //! A thin layer over [`gpsrx_receiver::Receiver`]: the command line and configuration file
 //! become a [`gpsrx_receiver::ReceiverConfig`], the recording a sample source read once, and
 //! the outputs a [`FileSink`] in `--out DIR` (`pvt.csv`, `pvt.nmea`, `observables.rnx`,
-//! `ephemeris.rnx`, `track.geojson`, `track.kml`, `channels.csv`); with `--dr`/`--accel` the
-//! fixes are then fused with the DR logs (`dr_inputs`).
+//! `ephemeris.rnx`, `track.geojson`, `track.kml`, `channels.csv`, and unless `--no-plots` the
+//! PNG plots `track.png`, `skyplot.png`, `cn0.png`, `dop.png`); with `--dr`/`--accel` the
+//! fixes are then fused with the DR logs (`dr_inputs`, and `dr.png`).
 
 use crate::commands::source::{interrupted, open_interruptible};
 use crate::exit::Completion;
@@ -122,7 +123,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunRepor
         ProgressStyle::with_template("{bar:30} {percent:>3}% {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let files = FileSink::create(&args.out, config.run.rate_hz)?;
+    let files = FileSink::create(&args.out, config.run.rate_hz)?.with_plots(config.run.plots);
     let line = (show_progress && !std::io::stderr().is_terminal())
         .then(|| progress_line::ProgressLine::new(src.fs_hz(), src.total_samples()));
     let extra = CommandSink {
@@ -147,7 +148,7 @@ pub fn run_file(args: &RunArgs, show_progress: bool) -> anyhow::Result<(RunRepor
         ..RunReport::default()
     };
     if let (Some(inputs), Some(gnss)) = (&dr_inputs, &extra.gnss_fixes) {
-        let (rows, params) = write_fused_outputs(inputs, gnss, &args.out)?;
+        let (rows, params) = write_fused_outputs(inputs, gnss, &args.out, config.run.plots)?;
         report.fused_rows = Some(rows);
         report.dr_params = params;
     }
