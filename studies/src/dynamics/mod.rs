@@ -70,18 +70,20 @@ mod track;
 pub use aiding::Aiding;
 pub use manoeuvre::Manoeuvre;
 pub use params::{
-    lead_in_s, narrowing_s, CLOCK_DRIFT_S_S, FS_HZ, HEADLINE_BN_HZ, INS_RATE_HZ, LEAD_IN_S,
-    NARROW_BN_HZ, NARROW_INS1_BIAS_MG, ORDER1_BN_HZ, OSCILLATOR, RAMP_S, SPEED_MPS, START_TOW_S,
-    STEP_S, TAIL_S, TICK_S, TURN_S, WIDE_BN_HZ, WIDE_INS1_BIAS_MPS2,
+    lead_in_s, narrowing_s, CLOCK_DRIFT_S_S, FS_HZ, HAND_OVER_S, HEADLINE_BN_HZ, INS_RATE_HZ,
+    LEAD_IN_S, MG_MPS2, NARROW_BN_HZ, NARROW_DEFAULT_BIAS_MG, NARROW_INS1_BIAS_MG, NARROW_RATIO,
+    ORDER1_BN_HZ, OSCILLATOR, PULL_IN_BN_HZ, RAMP_S, SETTLE_BN_S, SPEED_MPS, STAGE_BN_S,
+    START_TOW_S, STEP_S, TAIL_S, TICK_S, TURN_S, WIDE_BN_HZ, WIDE_INS1_BIAS_MPS2,
 };
 
 use super::report::StudyReport;
 use super::{run_cases, CommonStudyArgs};
 use grid::grid;
+use result::NotRun;
 use scenario::prepare;
 use std::time::Instant;
 use summary::build_report;
-use track::run_case;
+use track::{case_config, run_case};
 
 /// `gpsrx study dynamics` options.
 #[derive(Debug, Clone, clap::Args)]
@@ -96,8 +98,24 @@ pub fn run(args: &DynamicsArgs, progress: bool) -> anyhow::Result<StudyReport> {
     let started = Instant::now();
     let scenarios = grid(args.common.quick);
     let mut results = Vec::new();
-    for (k, (spec, cases)) in scenarios.iter().enumerate() {
-        let p = prepare(spec, cases, args.common.seed)?;
+    let mut not_run = Vec::new();
+    for (k, (spec, all)) in scenarios.iter().enumerate() {
+        // Cases whose loops the receiver rejects (ChannelConfig::validate) are reported, not run.
+        let mut cases = Vec::new();
+        for c in all {
+            match case_config(c).validate() {
+                Ok(()) => cases.push(*c),
+                Err(e) => not_run.push(NotRun {
+                    spec: *spec,
+                    case: *c,
+                    why: e.to_string(),
+                }),
+            }
+        }
+        if cases.is_empty() {
+            continue;
+        }
+        let p = prepare(spec, &cases, args.common.seed)?;
         let what = format!(
             "dynamics {}/{}: {} at {} dB-Hz, {} s lead-in",
             k + 1,
@@ -106,13 +124,14 @@ pub fn run(args: &DynamicsArgs, progress: bool) -> anyhow::Result<StudyReport> {
             spec.cn0_dbhz,
             spec.lead_in_s
         );
-        for r in run_cases(cases, &what, progress, |c| run_case(&p, c)) {
+        for r in run_cases(&cases, &what, progress, |c| run_case(&p, c)) {
             results.push(r?);
         }
     }
     Ok(build_report(
         args,
         &results,
+        &not_run,
         started.elapsed().as_secs_f64(),
     ))
 }

@@ -4,9 +4,9 @@ use crate::if_sim::Oscillator;
 
 /// Bandwidth ratio between consecutive narrowing stages (`NARROW_RATIO` of
 /// `tracking/src/channel/narrowing.rs`, private to the channel).
-const NARROW_RATIO: f64 = 2.0;
+pub const NARROW_RATIO: f64 = 2.0;
 /// Length of a narrowing stage in units of its own `1 / Bn` (`STAGE_BN_S` there).
-const STAGE_BN_S: f64 = 2.0;
+pub const STAGE_BN_S: f64 = 2.0;
 
 /// GPS time of week of the first sample (week 2190, 2022-01-01 14:00 GPS time: 12 satellites
 /// above 5 deg at Seoul, 10 of them healthy; G22 and G28 are flagged unhealthy), s.

@@ -9,6 +9,15 @@ use super::track::ChannelLog;
 use crate::if_sim;
 use gpsrx_dsp::constants::LAMBDA_L1_M;
 
+/// A case of the grid that was not run: the receiver rejects its loops.
+#[derive(Debug, Clone)]
+pub(super) struct NotRun {
+    pub(super) spec: ScenarioSpec,
+    pub(super) case: Case,
+    /// The receiver's reason.
+    pub(super) why: String,
+}
+
 /// The result of one case.
 #[derive(Debug, Clone)]
 pub(super) struct CaseResult {

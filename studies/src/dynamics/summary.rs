@@ -11,7 +11,7 @@ use super::params::{
     TICK_S, TURN_S, WIDE_INS1_BIAS_MPS2,
 };
 use super::plots::plots;
-use super::result::CaseResult;
+use super::result::{CaseResult, NotRun};
 use super::seed_tables::{fig12_15, table3_rows};
 use super::table::table;
 use super::DynamicsArgs;
@@ -148,9 +148,53 @@ fn summary_json(args: &DynamicsArgs, results: &[CaseResult], wall_s: f64) -> ser
     })
 }
 
+/// The cases not run, grouped by loop and reason (one line each).
+fn not_run_md(not_run: &[NotRun]) -> String {
+    let mut lines: Vec<String> = not_run
+        .iter()
+        .map(|n| {
+            format!(
+                "order {} Bn {} Hz {}: {}",
+                n.case.order,
+                n.case.bn_hz,
+                n.case.aiding.label(),
+                n.why
+            )
+        })
+        .collect();
+    lines.sort();
+    lines.dedup();
+    if lines.is_empty() {
+        return String::new();
+    }
+    format!(
+        "**Not run** ({} cases over {} scenario(s): the receiver rejects these loops when it \
+configures a channel, so `gpsrx run` could not use them either): {}.",
+        not_run.len(),
+        {
+            let mut s: Vec<String> = not_run
+                .iter()
+                .map(|n| {
+                    format!(
+                        "{} {} {}",
+                        n.spec.manoeuvre.label(),
+                        n.spec.cn0_dbhz,
+                        n.spec.lead_in_s
+                    )
+                })
+                .collect();
+            s.sort();
+            s.dedup();
+            s.len()
+        },
+        lines.join("; ")
+    )
+}
+
 pub(super) fn build_report(
     args: &DynamicsArgs,
     results: &[CaseResult],
+    not_run: &[NotRun],
     wall_s: f64,
 ) -> StudyReport {
     let figs = fig12_15(results);
@@ -171,6 +215,7 @@ Hz** (INS 1 {NARROW_DEFAULT_BIAS_MG} mg, INS 2 twice; plots `tracked_10g_*.png`)
             figs_md,
             conclusions_md(results),
             grid_md(results),
+            not_run_md(not_run),
             format!("Wall time of this run: {wall_s:.0} s."),
         ]
         .iter()
@@ -178,7 +223,23 @@ Hz** (INS 1 {NARROW_DEFAULT_BIAS_MG} mg, INS 2 twice; plots `tracked_10g_*.png`)
         .filter(|p| !p.is_empty())
         .collect::<Vec<_>>()
         .join("\n\n"),
-        summary: summary_json(args, results, wall_s),
+        summary: {
+            let mut j = summary_json(args, results, wall_s);
+            j["not_run"] = not_run
+                .iter()
+                .map(|n| {
+                    json!({
+                        "manoeuvre": n.spec.manoeuvre.label(),
+                        "cn0_dbhz": n.spec.cn0_dbhz,
+                        "order": n.case.order,
+                        "bn_hz": n.case.bn_hz,
+                        "aiding": n.case.aiding.key(),
+                        "why": n.why,
+                    })
+                })
+                .collect();
+            j
+        },
         plots: plots(results),
     }
 }
