@@ -4,7 +4,7 @@
 //! [`super::table3_md`].
 
 use super::aiding::Aiding;
-use super::headline::{cn0s, Headline, Trio, TEN_G};
+use super::headline::{always_lost_before, cn0s, Headline, Trio, TEN_G};
 use super::params::HEADLINE_BN_HZ;
 use super::result::CaseResult;
 use super::table3_md::table3_md;
@@ -17,8 +17,11 @@ pub(super) const COSTAS_SLIP_CYCLES: f64 = 0.25;
 pub(super) fn conclusions_md(results: &[CaseResult]) -> String {
     let h = Headline::new(results);
     let mut s = String::new();
-    for (t, order) in [(&h.order2, 2u8), (&h.order3, 3)] {
-        s += &figs_md(t, order, h.cn0_dbhz);
+    for cn0 in cn0s(results).iter().rev() {
+        let at = Headline::at(results, *cn0);
+        for (t, order) in [(&at.order2, 2u8), (&at.order3, 3)] {
+            s += &figs_md(t, order, *cn0);
+        }
     }
     s += &narrowest_md(results);
     s += &table3_md(results);
@@ -119,6 +122,18 @@ pub(super) fn narrowest_md(results: &[CaseResult]) -> String {
             }
             unaided.sort_by(|a, b| a.case.bn_hz.total_cmp(&b.case.bn_hz));
             let tried: Vec<String> = unaided.iter().map(|r| r.case.bn_hz.to_string()).collect();
+            // Satellites no case tracked into the manoeuvre at this C/N0 are left out.
+            let always = always_lost_before(results, cn0);
+            let skip = always.len();
+            let left_out = if always.is_empty() {
+                String::new()
+            } else {
+                let p: Vec<String> = always.iter().map(|p| format!("G{p:02}")).collect();
+                format!(
+                    ", leaving out {} (never tracked into the turn)",
+                    p.join(", ")
+                )
+            };
             let narrowest = |held: &dyn Fn(&CaseResult) -> bool| {
                 unaided
                     .iter()
@@ -126,10 +141,11 @@ pub(super) fn narrowest_md(results: &[CaseResult]) -> String {
                     .map_or("none".to_string(), |r| format!("{} Hz", r.case.bn_hz))
             };
             parts.push(format!(
-                "order {order} at {cn0} dB-Hz (Bn tried: {} Hz): through the turn {}, before it {}",
+                "order {order} at {cn0} dB-Hz (Bn tried: {} Hz{left_out}): through the turn {}, \
+before it {}",
                 tried.join(", "),
-                narrowest(&|r| r.kept == r.satellites),
-                narrowest(&|r| r.tracked_at_start == r.satellites),
+                narrowest(&|r| r.kept + skip == r.satellites),
+                narrowest(&|r| r.tracked_at_start + skip == r.satellites),
             ));
         }
     }
@@ -333,5 +349,33 @@ mod tests {
         );
         let md = conclusions_md(&results(1.3));
         assert!(md.contains("(0 of 1 within the paper's"), "{md}");
+        // Nothing tracked in the window: no ratio, no claim about the bias.
+        let mut r = results(1.0);
+        for x in r.iter_mut().filter(|x| x.case.aiding != Aiding::Unaided) {
+            x.disc_std_cycles = f64::NAN;
+            x.phase_std_cycles = f64::NAN;
+            x.kept = 0;
+        }
+        let md = conclusions_md(&r);
+        assert!(
+            md.contains("no satellite was tracked through the window"),
+            "{md}"
+        );
+        assert!(!md.contains("The bias does not change the std"), "{md}");
+    }
+
+    #[test]
+    fn a_satellite_no_case_tracked_is_left_out_of_the_narrowest_loop() {
+        let mut r = results(1.0);
+        for x in r.iter_mut() {
+            x.lost_before_prns = vec![1];
+            x.tracked_at_start = N - 1;
+            x.kept = N - 1;
+        }
+        let md = conclusions_md(&r);
+        assert!(
+            md.contains("leaving out G01 (never tracked into the turn)): through the turn 0.4 Hz"),
+            "{md}"
+        );
     }
 }

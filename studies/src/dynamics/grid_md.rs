@@ -4,6 +4,7 @@
 use super::aiding::Aiding;
 use super::conclusions::COSTAS_SLIP_CYCLES;
 use super::grid::ScenarioSpec;
+use super::headline::always_lost_before;
 use super::params::MG_MPS2;
 use super::result::CaseResult;
 use gpsrx_dsp::constants::LAMBDA_L1_M;
@@ -121,6 +122,26 @@ the cause is not measured here): {}.",
     s
 }
 
+/// `(group, item)` pairs as `group (items, n cases)`, groups in order of first appearance.
+fn grouped(pairs: impl Iterator<Item = (String, String)>) -> Vec<String> {
+    let mut groups: Vec<(String, Vec<String>, usize)> = Vec::new();
+    for (g, item) in pairs {
+        match groups.iter_mut().find(|x| x.0 == g) {
+            Some(x) => {
+                x.2 += 1;
+                if !x.1.contains(&item) {
+                    x.1.push(item);
+                }
+            }
+            None => groups.push((g, vec![item], 1)),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(g, items, n)| format!("{g} with {} ({n} cases)", items.join(", ")))
+        .collect()
+}
+
 /// What the whole grid shows (empty for the quick grid's single scenario).
 pub(super) fn grid_md(results: &[CaseResult]) -> String {
     let mut scenarios: Vec<ScenarioSpec> = Vec::new();
@@ -155,15 +176,19 @@ pub(super) fn grid_md(results: &[CaseResult]) -> String {
         .iter()
         .filter(|r| r.case.aiding != Aiding::Unaided && r.case.order >= 2)
         .collect();
-    let dropped: Vec<String> = aided
-        .iter()
-        .filter(|r| r.kept < r.tracked_at_start)
-        .map(|r| format!("{} {}", case_name(r), r.case.aiding.label()))
-        .collect();
+    let dropped_n = aided.iter().filter(|r| r.kept < r.tracked_at_start).count();
+    let dropped: Vec<String> = grouped(aided.iter().filter(|r| r.kept < r.tracked_at_start).map(
+        |r| {
+            (
+                format!("order {} Bn {} Hz", r.case.order, r.case.bn_hz),
+                format!("{:.1} mg", r.case.bias_mps2() / MG_MPS2),
+            )
+        },
+    ));
     s += &format!(
         "Aided (order >= 2), {} of {} cases kept every satellite they were tracking when the \
 manoeuvre began{}.\n\n",
-        aided.len() - dropped.len(),
+        aided.len() - dropped_n,
         aided.len(),
         if dropped.is_empty() {
             String::new()
@@ -177,6 +202,7 @@ manoeuvre began{}.\n\n",
     cn0s.dedup();
     s += "**Before the manoeuvre** (channels start from truth): ";
     let mut short_all: Vec<&CaseResult> = Vec::new();
+    let mut always_md = String::new();
     let parts: Vec<String> = cn0s
         .iter()
         .map(|&c| {
@@ -186,10 +212,21 @@ manoeuvre began{}.\n\n",
                 .map(|r| r.handover_df_rms_hz)
                 .filter(|v| v.is_finite())
                 .collect();
+            // Satellites lost before the manoeuvre in every case at this C/N0: not a loop's doing.
+            let always = always_lost_before(results, c);
+            if !always.is_empty() {
+                let prns: Vec<String> = always.iter().map(|p| format!("G{p:02}")).collect();
+                always_md += &format!(
+                    " At {c} dB-Hz {} never reached the manoeuvre tracked, in any case (whatever \
+the loop or aiding: the channel's start, not the loop under test); it is left out of the counts \
+of this paragraph.",
+                    prns.join(", ")
+                );
+            }
             let short: Vec<&CaseResult> = at
                 .iter()
                 .copied()
-                .filter(|r| r.tracked_at_start < r.satellites)
+                .filter(|r| r.lost_before_prns.iter().any(|p| !always.contains(p)))
                 .collect();
             short_all.extend(&short);
             let mut loops: Vec<String> = short
@@ -214,6 +251,7 @@ manoeuvre began{}.\n\n",
         .collect();
     s += &parts.join("; ");
     s += ".";
+    s += &always_md;
     s += &lead_in_losses_md(&short_all);
     s += " The *sats at start* column shows who was tracking when the manoeuvre began; *kept* \
 counts from those.";

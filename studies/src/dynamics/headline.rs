@@ -44,6 +44,21 @@ pub(super) fn cn0s(results: &[CaseResult]) -> Vec<f64> {
     v
 }
 
+/// PRNs lost before the manoeuvre in every case at `cn0_dbhz`, whatever the loop or aiding
+/// (a channel that never started, not a loop's doing).
+pub(super) fn always_lost_before(results: &[CaseResult], cn0_dbhz: f64) -> Vec<u8> {
+    let at: Vec<&CaseResult> = results
+        .iter()
+        .filter(|r| r.spec.cn0_dbhz == cn0_dbhz)
+        .collect();
+    at.first()
+        .map(|r| r.lost_before_prns.clone())
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|p| at.iter().all(|r| r.lost_before_prns.contains(p)))
+        .collect()
+}
+
 /// The INS 1 biases of the aided cases at `bn_hz`, ascending, m/s^2.
 pub(super) fn ins1_biases(results: &[CaseResult], bn_hz: f64) -> Vec<f64> {
     let mut v: Vec<f64> = results

@@ -38,6 +38,8 @@ pub(super) struct CaseResult {
     pub(super) disc_std_per_sat: Vec<f64>,
     /// The satellites' PRNs (simulator order).
     pub(super) prns: Vec<u8>,
+    /// PRNs not tracked when the manoeuvre began.
+    pub(super) lost_before_prns: Vec<u8>,
     /// Largest line-of-sight acceleration of a satellite during the lead-in (the satellites'
     /// own motion and the Earth's rotation: the vehicle cruises straight), m/s^2.
     pub(super) lead_in_accel_max_mps2: f64,
@@ -106,6 +108,12 @@ pub(super) fn summarise(p: &Prepared, case: &Case, logs: &[ChannelLog]) -> CaseR
             .map(|l| pooled_std(std::iter::once(l.disc_cycles.as_slice())))
             .collect(),
         prns: p.truth.sats.iter().map(|s| s.prn.get()).collect(),
+        lost_before_prns: logs
+            .iter()
+            .zip(&p.truth.sats)
+            .filter(|(l, _)| !l.ticks[k0])
+            .map(|(_, s)| s.prn.get())
+            .collect(),
         lead_in_accel_max_mps2: (0..logs.len())
             .map(|i| lead_in_accel_mps2(p, i))
             .fold(0.0, f64::max),
@@ -150,6 +158,7 @@ pub(super) fn test_result(spec: ScenarioSpec, case: Case, n: usize, disc_std: f6
         disc_std_cycles: disc_std,
         disc_std_per_sat: vec![disc_std; n],
         prns: (1..=n as u8).collect(),
+        lost_before_prns: Vec::new(),
         lead_in_accel_max_mps2: 0.1,
         disc_mean_abs_deg: f64::NAN,
         predicted_mean_abs_deg: f64::NAN,

@@ -44,6 +44,7 @@ fn result_json(r: &CaseResult) -> serde_json::Value {
             .map(|(p, v)| json!({"prn": p, "std_cycles": num(*v)}))
             .collect::<Vec<_>>(),
         "lead_in_accel_max_mps2": num(r.lead_in_accel_max_mps2),
+        "lost_before_prns": r.lost_before_prns,
         "mean_abs_phase_error_deg": num(r.disc_mean_abs_deg),
         "predicted_mean_abs_phase_error_deg": num(r.predicted_mean_abs_deg),
         "phase_error_growth_deg_s": num(r.growth_abs_deg_s),

@@ -70,6 +70,16 @@ fn row_group_md(cn0: f64, order: u8, at: &[&Table3Row<'_>]) -> String {
         list(&phase, 3),
     );
     let finite: Vec<f64> = ratios.iter().copied().filter(|r| r.is_finite()).collect();
+    if finite.is_empty() {
+        return format!(
+            "- {cn0} dB-Hz, order {order}: no satellite was tracked through the window with \
+either INS (kept {}), so there is no ratio.\n",
+            at.iter()
+                .map(|r| format!("{}/{}", r.ins1.kept, r.ins2.kept))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     let rising = finite.len() >= 2 && finite.windows(2).all(|w| w[1] > w[0]);
     let all_same = finite.iter().all(|r| (r - 1.0).abs() < SAME);
     let phase_same = phase
@@ -88,7 +98,11 @@ fn row_group_md(cn0: f64, order: u8, at: &[&Table3Row<'_>]) -> String {
 larger discriminator std comes from the discriminator, not from the loop, consistent with \
 atan(Q/I) folding more of its noise at +-90 deg about INS 2's larger static offset. ";
     }
-    let d1: Vec<f64> = at.iter().map(|r| r.ins1.disc_std_cycles).collect();
+    let d1: Vec<f64> = at
+        .iter()
+        .map(|r| r.ins1.disc_std_cycles)
+        .filter(|d| d.is_finite())
+        .collect();
     let lo = d1.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = d1.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     s += &format!(
@@ -110,14 +124,21 @@ atan(Q/I) folding more of its noise at +-90 deg about INS 2's larger static offs
 /// INS runs that lost satellites in the window, against the slip limit of their static offset.
 fn slips_md(at: &[&Table3Row<'_>]) -> String {
     let mut out = Vec::new();
+    let mut seen: Vec<f64> = Vec::new();
     for r in at {
         for (k, c) in [(1.0, r.ins1), (2.0, r.ins2)] {
+            // INS 2 of one pair and INS 1 of the next can be the same INS (same bias): once.
+            let b = c.case.bias_mps2();
+            if seen.contains(&b) {
+                continue;
+            }
+            seen.push(b);
             if c.kept < c.tracked_at_start {
                 let o = r.offset_bound_cycles(k);
                 out.push(format!(
-                    "INS {k} at {:.1} mg lost {} of {} (largest offset {o:.3} cycle, {} the \
+                    "the {:.1} mg INS lost {} of {} (largest offset {o:.3} cycle, {} the \
 Costas loop's {COSTAS_SLIP_CYCLES})",
-                    k * r.ins1_bias_mps2 / MG_MPS2,
+                    b / MG_MPS2,
                     c.tracked_at_start - c.kept,
                     c.tracked_at_start,
                     if o > COSTAS_SLIP_CYCLES {
@@ -132,6 +153,10 @@ Costas loop's {COSTAS_SLIP_CYCLES})",
     if out.is_empty() {
         "Every aided run kept every satellite it tracked at the start of the turn.".into()
     } else {
-        out.join("; ") + "."
+        let mut s = out.join("; ") + ".";
+        if let Some(first) = s.get_mut(0..1) {
+            first.make_ascii_uppercase();
+        }
+        s
     }
 }
