@@ -44,7 +44,7 @@ fn figs_plot(results: &[CaseResult], cn0: f64) -> Option<LinePlot> {
     Some(LinePlot {
         file_name: format!("tracked_10g_{cn0}dbhz.png"),
         title: format!(
-            "Satellites tracked, 10 g turn {w0}-{w1} s, {cn0} dB-Hz, Bn {HEADLINE_BN_HZ} Hz (seed 004 Figs. 12/15; overlapping curves hide each other)"
+            "Satellites tracked, 10 g turn {w0}-{w1} s, {cn0} dB-Hz, Bn {HEADLINE_BN_HZ} Hz (Figs. 12/15)"
         ),
         x_label: "time (s)".into(),
         y_label: "satellites in Track with PLL lock".into(),
