@@ -245,6 +245,42 @@ fn ins_aiding_keeps_a_3hz_pll_locked_through_a_5g_turn() {
         fu < 0.7,
         "unaided 3 Hz loops lose lock in a 5 g turn ({fu})"
     );
+    // channels.csv: the aided 2nd-order 3 Hz loop's predicted static phase offset under the
+    // nominal bias (1 mg per axis, sqrt 3 mg on the line of sight): B / (lambda w0^2),
+    // w0 = Bn / 0.53 (seed 004 Table 1), on the aided rows; empty without the aid.
+    let lambda = 299_792_458.0 / 1575.42e6;
+    let w0: f64 = 3.0 / 0.53;
+    let want = 3f64.sqrt() * 9.80665e-3 / (lambda * w0 * w0);
+    let offsets = |out: &Path| -> (usize, Vec<f64>) {
+        let mut rdr =
+            csv::Reader::from_path(out.join("channels.csv")).unwrap_or_else(|e| panic!("{e}"));
+        let h = rdr.headers().unwrap_or_else(|e| panic!("{e}")).clone();
+        let c = h
+            .iter()
+            .position(|x| x == "predicted_offset_cycles")
+            .unwrap_or_else(|| panic!("no predicted_offset_cycles column"));
+        let rows: Vec<csv::StringRecord> = rdr.records().map_while(Result::ok).collect();
+        let v = rows
+            .iter()
+            .filter(|r| !r[c].is_empty())
+            .map(|r| r[c].parse().unwrap_or(f64::NAN))
+            .collect();
+        (rows.len(), v)
+    };
+    let (na_rows, na_vals) = offsets(&aided_out);
+    assert!(
+        na_vals.len() * 4 > na_rows,
+        "{} of {na_rows} aided rows have an offset",
+        na_vals.len()
+    );
+    for v in &na_vals {
+        assert!((v - want).abs() < 6e-5, "predicted offset {v} vs {want}");
+    }
+    let (nu_rows, nu_vals) = offsets(&unaided_out);
+    assert!(
+        nu_rows > 0 && nu_vals.is_empty(),
+        "unaided rows with an offset: {nu_vals:?}"
+    );
 
     let truth = truth(dir.path());
     let in_turn = |f: &&Fix| (t0..=t1).contains(&f.time.tow_s);

@@ -413,6 +413,7 @@ fn pvt_and_channel_csv_columns() {
         carrier_lock: true,
         bit_sync: true,
         frame_sync: false,
+        predicted_offset_cycles: None,
     };
     w.write_row(&row).expect("in memory");
     // The week unknown (never a system-clock week), then the time not yet known at all.
@@ -425,23 +426,33 @@ fn pvt_and_channel_csv_columns() {
         time: None,
         week_known: false,
         t_stream_s: 0.25,
+        ..row.clone()
+    })
+    .expect("in memory");
+    // An aided 2nd-order loop's predicted static phase offset.
+    w.write_row(&ChannelRow {
+        predicted_offset_cycles: Some(0.15672),
         ..row
     })
     .expect("in memory");
     let text = String::from_utf8(w.finish().expect("flush")).expect("UTF-8");
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines[0], "gps_week,tow_s,channel,prn,state,cn0_dbhz,doppler_hz,code_phase_chips,pll_lock_indicator,code_lock,carrier_lock,bit_sync,frame_sync,t_stream_s");
+    assert_eq!(lines[0], "gps_week,tow_s,channel,prn,state,cn0_dbhz,doppler_hz,code_phase_chips,pll_lock_indicator,code_lock,carrier_lock,bit_sync,frame_sync,t_stream_s,predicted_offset_cycles");
     assert_eq!(
         lines[1],
-        "2190,541800.000,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,12.500"
+        "2190,541800.000,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,12.500,"
     );
     assert_eq!(
         lines[2],
-        ",541800.000,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,12.500"
+        ",541800.000,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,12.500,"
     );
     assert_eq!(
         lines[3],
-        ",,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,0.250"
+        ",,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,0.250,"
+    );
+    assert_eq!(
+        lines[4],
+        "2190,541800.000,3,14,tracking,44.50,-1520.250,,0.980,1,1,1,0,12.500,0.1567"
     );
 }
 

@@ -108,6 +108,21 @@ pub fn static_phase_offset_cycles(order: u8, bn_hz: f64, bias_mps2: f64) -> Opti
     }
 }
 
+/// The INS accelerometer bias the receiver assumes when it predicts the static phase offset of
+/// its aided loops, m/s^2: 1 mg per axis, all of it on the line of sight (`sqrt(3)` mg), a
+/// tactical-grade IMU's worst case.
+pub const NOMINAL_INS_BIAS_LOS_MPS2: f64 = 1.732_050_807_568_877_2 * 9.806_65e-3;
+
+/// The static phase offset (cycles) the aided loops of `cfg` (`aided_track`, else `track`)
+/// keep under [`NOMINAL_INS_BIAS_LOS_MPS2`]: [`static_phase_offset_cycles`] of a 2nd-order
+/// loop; `None` for other orders (3rd order keeps none, 1st order drifts without bound).
+pub fn nominal_aided_offset_cycles(cfg: &crate::ChannelConfig) -> Option<f64> {
+    let loops = cfg.aided_track.unwrap_or(cfg.track);
+    (loops.pll_order == 2)
+        .then(|| static_phase_offset_cycles(2, loops.pll_bw_hz, NOMINAL_INS_BIAS_LOS_MPS2))
+        .flatten()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -121,6 +136,28 @@ mod tests {
         assert!((c - 0.0905).abs() < 5e-4, "{c}");
         assert_eq!(static_phase_offset_cycles(3, 0.4, 9.80665e-3), Some(0.0));
         assert_eq!(static_phase_offset_cycles(1, 0.4, 9.80665e-3), None);
+    }
+
+    #[test]
+    fn the_nominal_offset_is_given_for_2nd_order_aided_loops_only() {
+        let mut cfg = crate::ChannelConfig::default();
+        // Default tracking loops: 3rd order, no offset.
+        assert_eq!(nominal_aided_offset_cycles(&cfg), None);
+        let mut aided = cfg.track;
+        aided.pll_order = 2;
+        aided.pll_bw_hz = 0.4;
+        cfg.aided_track = Some(aided);
+        // sqrt(3) x 0.0905 cycle (the 1 mg case above).
+        let c = nominal_aided_offset_cycles(&cfg).unwrap_or(f64::NAN);
+        assert!((c - 3f64.sqrt() * 0.0905).abs() < 1e-3, "{c}");
+        aided.pll_order = 1;
+        cfg.aided_track = Some(aided);
+        assert_eq!(nominal_aided_offset_cycles(&cfg), None);
+        // Without aided loops the tracking loops are the aided ones.
+        cfg.aided_track = None;
+        cfg.track.pll_order = 2;
+        cfg.track.pll_bw_hz = 3.0;
+        assert!(nominal_aided_offset_cycles(&cfg).is_some_and(|c| c > 0.0 && c < 0.01));
     }
 
     #[test]

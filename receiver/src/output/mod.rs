@@ -254,6 +254,10 @@ pub struct ChannelRow {
     pub bit_sync: bool,
     /// Subframe (preamble) synchronisation achieved.
     pub frame_sync: bool,
+    /// While the channel is fed forward by an INS and its aided loop is 2nd order: the static
+    /// phase offset that loop keeps under a nominal accelerometer bias
+    /// (`gpsrx_tracking::aiding::nominal_aided_offset_cycles`), cycles; `None` otherwise.
+    pub predicted_offset_cycles: Option<f64>,
 }
 
 /// A calendar date and time rounded to a number of decimals of the second, without ever

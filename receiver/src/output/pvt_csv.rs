@@ -43,8 +43,10 @@ pub const PVT_COLUMNS: [&str; 24] = [
 
 /// Columns of `channels.csv`. `gps_week` and `tow_s` are the receiver time of the row, empty
 /// until it is known (the time of week from frame sync; the week is empty while unknown, see
-/// [`crate::pipeline::dating`]); `t_stream_s` is the time from the first sample, always given.
-pub const CHANNEL_COLUMNS: [&str; 14] = [
+/// [`crate::pipeline::dating`]); `t_stream_s` is the time from the first sample, always given;
+/// `predicted_offset_cycles` is the static phase offset an aided 2nd-order loop keeps under a
+/// nominal INS accelerometer bias (empty unaided, or for other loop orders).
+pub const CHANNEL_COLUMNS: [&str; 15] = [
     "gps_week",
     "tow_s",
     "channel",
@@ -59,6 +61,7 @@ pub const CHANNEL_COLUMNS: [&str; 14] = [
     "bit_sync",
     "frame_sync",
     "t_stream_s",
+    "predicted_offset_cycles",
 ];
 
 /// `v` with `decimals` decimals, or empty when not finite.
@@ -207,6 +210,7 @@ impl<W: Write> ChannelCsvWriter<W> {
             flag(row.bit_sync),
             flag(row.frame_sync),
             cell(row.t_stream_s, 3),
+            opt_cell(row.predicted_offset_cycles, 4),
         ];
         self.out.write_record(&record).map_err(csv_err(&self.file))
     }

@@ -38,6 +38,8 @@ use std::collections::{BTreeMap, BTreeSet};
 pub struct NavigationProcessor {
     fs_hz: f64,
     settings: RunSettings,
+    /// See [`NavigationProcessor::with_aided_offset`].
+    aided_offset_cycles: Option<f64>,
     reference_week: u32,
     /// Whether `reference_week` may date outputs (it is not from the system clock).
     reference_week_known: bool,
@@ -181,7 +183,16 @@ impl NavigationProcessor {
             coarse_warned: false,
             fixes_from_sample: 0.0,
             quick: nav_assist_given.then(QuickSync::default),
+            aided_offset_cycles: None,
         }
+    }
+
+    /// The static phase offset the aided loops keep under a nominal INS bias
+    /// (`gpsrx_tracking::aiding::nominal_aided_offset_cycles`), written in `channels.csv` for
+    /// the channels fed forward (`None`: no column value).
+    pub fn with_aided_offset(mut self, cycles: Option<f64>) -> Self {
+        self.aided_offset_cycles = cycles;
+        self
     }
 
     /// Enables the coarse-time first fix ([`crate::pipeline::coarse_fix`]) when the settings
@@ -941,6 +952,9 @@ impl NavigationProcessor {
             carrier_lock: e.pll_lock,
             bit_sync: e.bit_edge || synced,
             frame_sync: synced,
+            predicted_offset_cycles: self.aided_offset_cycles.filter(|_| {
+                e.state == ChannelState::Track && e.feedforward_hz.is_some_and(f64::is_finite)
+            }),
         };
         sink.channel(&row)
     }

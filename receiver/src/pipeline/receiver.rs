@@ -308,9 +308,10 @@ impl Receiver {
         );
         reference.log(assistance.recording_start.as_ref());
         let reference_week = reference.week;
-        if assistance.ins.is_some() {
+        let aided_offset = assistance.ins.as_ref().and_then(|_| {
             log_aided_static_offset(&config.tracking);
-        }
+            gpsrx_tracking::aiding::nominal_aided_offset_cycles(&config.tracking)
+        });
         let aiding = match assistance.ins {
             Some(ins) => Some(Self::feedforward(
                 ins,
@@ -329,6 +330,7 @@ impl Receiver {
             assistance.landmarks,
         )
         .with_reference_week_known(reference.known())
+        .with_aided_offset(aided_offset)
         .with_coarse_time(
             run.approx_time
                 .or(assistance.recording_start.as_ref().map(|r| r.time)),
@@ -657,7 +659,7 @@ fn gated_aid<'a>(
 /// Table 1; the lock test allows 0.2 cycle, a Costas loop slips at 0.25), none for 3rd order.
 fn log_aided_static_offset(tracking: &gpsrx_tracking::ChannelConfig) {
     let loops = tracking.aided_track.unwrap_or(tracking.track);
-    let bias_mps2 = 3f64.sqrt() * 9.80665e-3;
+    let bias_mps2 = gpsrx_tracking::aiding::NOMINAL_INS_BIAS_LOS_MPS2;
     match gpsrx_tracking::aiding::static_phase_offset_cycles(loops.pll_order, loops.pll_bw_hz, bias_mps2) {
         Some(c) if c > 0.0 => tracing::info!(
             "aided loops: 2nd-order PLL at {} Hz: an INS accelerometer bias of 1 mg per axis leaves up to {c:.3} cycle of static phase offset (B / (lambda w0^2); lock allows 0.2, slips at 0.25): a 3rd-order aided loop leaves none (--aided-pll-order 3)",

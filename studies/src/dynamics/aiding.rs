@@ -1,7 +1,5 @@
 //! How a case's carrier loop is aided: unaided, or by INS 1 or INS 2 (biases `B` and `2B`).
 
-use super::params::INS1_BIAS_MPS2;
-
 /// How a case's carrier loop is aided.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Aiding {
@@ -31,12 +29,12 @@ impl Aiding {
         }
     }
 
-    /// Accelerometer bias magnitude, m/s^2 (0 unaided).
-    pub fn bias_mps2(&self) -> f64 {
+    /// Accelerometer bias in units of INS 1's: 0 unaided, 1 for INS 1, 2 for INS 2.
+    pub fn bias_factor(&self) -> f64 {
         match self {
             Self::Unaided => 0.0,
-            Self::Ins1 => INS1_BIAS_MPS2,
-            Self::Ins2 => 2.0 * INS1_BIAS_MPS2,
+            Self::Ins1 => 1.0,
+            Self::Ins2 => 2.0,
         }
     }
 }

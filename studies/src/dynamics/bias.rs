@@ -49,10 +49,10 @@ pub(super) fn bias_theory(p: &Prepared, case: &Case, logs: &[ChannelLog]) -> Bia
     if case.aiding == Aiding::Unaided {
         return none;
     }
-    let (w0, w1) = p.spec.manoeuvre.window_s();
+    let (w0, w1) = p.spec.window_s();
     let min_epochs = (0.5 * (w1 - w0) * 1e3) as usize;
     let d = bias_direction_enu();
-    let b = case.aiding.bias_mps2();
+    let b = case.bias_mps2();
     let omega0 = case.bn_hz / BN_OVER_OMEGA0[usize::from(case.order.clamp(1, 3)) - 1];
     let mut acc = [0.0; 4];
     let mut n = 0.0;

@@ -1,6 +1,6 @@
 //! The manoeuvres: a level turn or a longitudinal acceleration step after the lead-in.
 
-use super::params::{DURATION_S, LEAD_IN_S, RAMP_S, STEP_S, TURN_S};
+use super::params::{RAMP_S, STEP_S, TAIL_S, TURN_S};
 use gpsrx_samples::sim::trajectory::G0_MPS2;
 
 /// A manoeuvre after the lead-in.
@@ -28,21 +28,17 @@ impl Manoeuvre {
         }
     }
 
-    /// Length of the manoeuvre segment, s.
-    fn segment_s(&self) -> f64 {
+    /// Length of the manoeuvre segment (ramp-in included), s.
+    pub(super) fn segment_s(&self) -> f64 {
         match self {
             Self::Turn(_) => TURN_S,
             Self::Step(_) => STEP_S,
         }
     }
 
-    /// The window the statistics cover: from the start of the ramp-in to the end of the
-    /// ramp-out, s.
-    pub fn window_s(&self) -> (f64, f64) {
-        (LEAD_IN_S, LEAD_IN_S + self.segment_s() + RAMP_S)
-    }
-
-    pub(super) fn segments_toml(&self) -> String {
+    /// The simulator's `segments`: a cruise of `lead_in_s`, the manoeuvre, a cruise past the
+    /// end of the recording (ramp-out and [`TAIL_S`]).
+    pub(super) fn segments_toml(&self, lead_in_s: f64) -> String {
         let seg = match self {
             Self::Turn(g) => format!(
                 "{{ type = \"turn\", duration_s = {TURN_S:?}, accel_g = {g:?}, direction = \"left\" }}"
@@ -52,9 +48,9 @@ impl Manoeuvre {
                 g * G0_MPS2
             ),
         };
-        let rest = DURATION_S - LEAD_IN_S - self.segment_s() + 2.0;
+        let rest = RAMP_S + TAIL_S + 2.0;
         format!(
-            "[{{ type = \"cruise\", duration_s = {LEAD_IN_S:?} }}, {seg}, {{ type = \"cruise\", duration_s = {rest:?} }}]"
+            "[{{ type = \"cruise\", duration_s = {lead_in_s:?} }}, {seg}, {{ type = \"cruise\", duration_s = {rest:?} }}]"
         )
     }
 }

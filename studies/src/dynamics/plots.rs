@@ -1,61 +1,70 @@
-//! The plots: satellites tracked through the 10 g turn, phase error std and fewest satellites
-//! tracked against the turn acceleration.
+//! The plots: satellites tracked through the 10 g turn at 0.4 Hz (seed 004 Figs. 12/15), phase
+//! error std and fewest satellites tracked against the turn acceleration.
 
 use super::aiding::Aiding;
-use super::headline::headline;
+use super::headline::{cn0s, Trio};
 use super::manoeuvre::Manoeuvre;
-use super::params::{HEADLINE_BN_HZ, ORDER1_BN_HZ, TICK_S};
+use super::params::{HEADLINE_BN_HZ, MG_MPS2, NARROW_DEFAULT_BIAS_MG, TICK_S};
 use super::result::CaseResult;
 use crate::report::{LinePlot, Series};
 
-pub(super) fn plots(results: &[CaseResult]) -> Vec<LinePlot> {
-    let mut out = Vec::new();
-    // The 2nd-order aided curves last, so that they are drawn on top.
-    let cases = [
-        (1u8, ORDER1_BN_HZ, Aiding::Ins1),
-        (1, ORDER1_BN_HZ, Aiding::Ins2),
-        (2, HEADLINE_BN_HZ, Aiding::Unaided),
-        (2, HEADLINE_BN_HZ, Aiding::Ins1),
-        (2, HEADLINE_BN_HZ, Aiding::Ins2),
-    ];
-    let series: Vec<Series> = cases
-        .iter()
-        .filter_map(|&(o, bn, a)| headline(results, o, bn, a))
-        .map(|r| Series {
-            name: format!(
-                "order {} Bn {} Hz {}",
-                r.case.order,
-                r.case.bn_hz,
-                r.case.aiding.label()
-            ),
-            points: r
-                .tracked_per_tick
-                .iter()
-                .enumerate()
-                .map(|(k, &n)| ((k + 1) as f64 * TICK_S, n as f64))
-                .collect(),
-            reference: false,
-        })
-        .collect();
-    let cn0 = results
-        .iter()
-        .map(|r| r.spec.cn0_dbhz)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let (w0, w1) = Manoeuvre::Turn(10.0).window_s();
-    out.push(LinePlot {
-        file_name: "tracked_10g.png".into(),
+/// Satellites tracked against time: one series per case.
+fn tracked_series(r: &CaseResult) -> Series {
+    Series {
+        name: format!(
+            "order {} Bn {} Hz {}",
+            r.case.order,
+            r.case.bn_hz,
+            r.case.aiding.label()
+        ),
+        points: r
+            .tracked_per_tick
+            .iter()
+            .enumerate()
+            .map(|(k, &n)| ((k + 1) as f64 * TICK_S, n as f64))
+            .collect(),
+        reference: false,
+    }
+}
+
+/// Seed 004 Figs. 12/15 at one C/N0: satellites tracked through the 10 g turn, orders 2 and 3
+/// at 0.4 Hz, unaided and aided (None when none of these cases ran).
+fn figs_plot(results: &[CaseResult], cn0: f64) -> Option<LinePlot> {
+    let b = NARROW_DEFAULT_BIAS_MG * MG_MPS2;
+    let mut series = Vec::new();
+    let mut window = None;
+    for order in [2u8, 3] {
+        let t = Trio::new(results, cn0, order, HEADLINE_BN_HZ, b);
+        for r in [t.unaided, t.ins1, t.ins2].into_iter().flatten() {
+            window = Some(r.spec.window_s());
+            series.push(tracked_series(r));
+        }
+    }
+    let (w0, w1) = window?;
+    Some(LinePlot {
+        file_name: format!("tracked_10g_{cn0}dbhz.png"),
         title: format!(
-            "Satellites tracked, 10 g turn {w0}-{w1} s, {cn0} dB-Hz (overlapping curves hide each other)"
+            "Satellites tracked, 10 g turn {w0}-{w1} s, {cn0} dB-Hz, Bn {HEADLINE_BN_HZ} Hz (Figs. 12/15)"
         ),
         x_label: "time (s)".into(),
         y_label: "satellites in Track with PLL lock".into(),
         series,
         ..LinePlot::default()
-    });
+    })
+}
+
+pub(super) fn plots(results: &[CaseResult]) -> Vec<LinePlot> {
+    let all_cn0 = cn0s(results);
+    let mut out: Vec<LinePlot> = all_cn0
+        .iter()
+        .filter_map(|&c| figs_plot(results, c))
+        .collect();
+    let cn0 = all_cn0.last().copied().unwrap_or(f64::NAN);
     let turn_g = |r: &CaseResult| match r.spec.manoeuvre {
         Manoeuvre::Turn(g) => Some(g),
         Manoeuvre::Step(_) => None,
     };
+    let bias = NARROW_DEFAULT_BIAS_MG * MG_MPS2;
     let by_g = |order: u8, bn: f64, a: Aiding, y: &dyn Fn(&CaseResult) -> f64| Series {
         name: format!("order {order} Bn {bn} Hz {}", a.label()),
         points: results
@@ -65,6 +74,7 @@ pub(super) fn plots(results: &[CaseResult]) -> Vec<LinePlot> {
                     && r.case.order == order
                     && r.case.bn_hz == bn
                     && r.case.aiding == a
+                    && (a == Aiding::Unaided || r.case.ins1_bias_mps2 == bias)
             })
             .filter_map(|r| turn_g(r).map(|g| (g, y(r))))
             .collect(),
@@ -74,14 +84,20 @@ pub(super) fn plots(results: &[CaseResult]) -> Vec<LinePlot> {
     out.push(LinePlot {
         file_name: "phase_std_vs_g.png".into(),
         title: format!(
-            "Phase error std vs turn acceleration (order 2, Bn {HEADLINE_BN_HZ} Hz, {cn0} dB-Hz; INS 1 and 2 coincide)"
+            "Phase error std vs turn acceleration (Bn {HEADLINE_BN_HZ} Hz, {cn0} dB-Hz, INS 1 {NARROW_DEFAULT_BIAS_MG} mg)"
         ),
         x_label: "turn acceleration (g)".into(),
         y_label: "phase error std over locked intervals (cycle)".into(),
         log_y: true,
-        series: modes
+        series: [2u8, 3]
             .iter()
-            .map(|&a| by_g(2, HEADLINE_BN_HZ, a, &|r| r.phase_std_cycles))
+            .flat_map(|&o| {
+                modes
+                    .iter()
+                    .map(move |&a| (o, a))
+            })
+            .map(|(o, a)| by_g(o, HEADLINE_BN_HZ, a, &|r| r.phase_std_cycles))
+            .filter(|s| !s.points.is_empty())
             .collect(),
         ..LinePlot::default()
     });
@@ -104,7 +120,7 @@ fn min_tracked_series(results: &[CaseResult], cn0: f64) -> Vec<Series> {
         |r: &&CaseResult| r.spec.cn0_dbhz == cn0 && matches!(r.spec.manoeuvre, Manoeuvre::Turn(_));
     let mut out = Vec::new();
     for order in [2u8, 3] {
-        for bn in [5.0, 10.0, 18.0] {
+        for bn in [HEADLINE_BN_HZ, 5.0, 10.0, 18.0] {
             let points: Vec<(f64, f64)> = results
                 .iter()
                 .filter(turns)

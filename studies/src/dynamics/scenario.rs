@@ -1,12 +1,9 @@
 //! Simulation of a scenario: its scenario file, the IF samples in memory, truth, channel starts
 //! and the INS feed-forwards, ready to be tracked by every case.
 
-use super::aiding::Aiding;
-use super::grid::ScenarioSpec;
+use super::grid::{Case, ScenarioSpec};
 use super::ins::feedforward;
-use super::params::{
-    ALLAN_DEVIATION_1S, CLOCK_DRIFT_S_S, DURATION_S, FS_HZ, RAMP_S, SPEED_MPS, START_TOW_S,
-};
+use super::params::{CLOCK_DRIFT_S_S, FS_HZ, OSCILLATOR, RAMP_S, SPEED_MPS, START_TOW_S};
 use crate::if_sim::{self, Truth};
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
 use gpsrx_receiver::pipeline::aiding::InsFeedForward;
@@ -15,12 +12,13 @@ use num_complex::Complex32;
 use rayon::prelude::*;
 use std::path::Path;
 
-/// The scenario file of a spec (motion receiver near Seoul, every visible satellite).
+/// The scenario file of a spec (motion receiver near Seoul, every visible satellite, the
+/// receiver oscillator [`OSCILLATOR`]).
 pub(super) fn scenario_toml(spec: &ScenarioSpec, seed: u64, prns: Option<&[u8]>) -> String {
     let prns = prns.map_or(String::new(), |p| format!("prns = {p:?}\n"));
     format!(
         r#"description = "gpsrx study dynamics: {label} at {cn0} dB-Hz"
-duration_s = {DURATION_S:?}
+duration_s = {duration:?}
 seed = {seed}
 nav = "builtin:brdc0010.22n"
 [start]
@@ -39,7 +37,8 @@ segments = {segments}
 [clock]
 bias_s = 1.0e-4
 drift_s_s = {CLOCK_DRIFT_S_S:e}
-allan_deviation_1s = {ALLAN_DEVIATION_1S:e}
+allan_deviation_1s = {allan:e}
+random_walk_fm_h_m2 = {h_m2:e}
 [satellites]
 {prns}cn0_all_dbhz = {cn0:?}
 [truth]
@@ -47,7 +46,10 @@ rate_hz = 1.0
 "#,
         label = spec.manoeuvre.label(),
         cn0 = spec.cn0_dbhz,
-        segments = spec.manoeuvre.segments_toml(),
+        segments = spec.manoeuvre.segments_toml(spec.lead_in_s),
+        duration = spec.duration_s(),
+        allan = OSCILLATOR.allan_deviation_1s,
+        h_m2 = OSCILLATOR.h_m2,
     )
 }
 
@@ -61,8 +63,8 @@ pub(super) struct Prepared {
     pub(super) starts: Vec<ChannelStart>,
     /// Per satellite: unit vector receiver -> satellite (east, north, up) mid-window.
     pub(super) los_enu: Vec<[f64; 3]>,
-    /// Feed-forwards of INS 1 and INS 2.
-    pub(super) feedforwards: [InsFeedForward; 2],
+    /// Feed-forwards of the INS the cases use, by accelerometer bias magnitude (m/s^2).
+    pub(super) feedforwards: Vec<(f64, InsFeedForward)>,
 }
 
 impl Prepared {
@@ -76,10 +78,20 @@ impl Prepared {
     pub(super) fn truth_doppler_hz(&self, sat: usize, t0_s: f64, t1_s: f64) -> f64 {
         self.truth.sats[sat].mean_doppler_hz(t0_s, t1_s)
     }
+
+    /// The feed-forward of `case`'s INS (None unaided).
+    pub(super) fn feedforward(&self, case: &Case) -> Option<&InsFeedForward> {
+        let b = case.bias_mps2();
+        (b > 0.0)
+            .then(|| self.feedforwards.iter().find(|(x, _)| *x == b))
+            .flatten()
+            .map(|(_, f)| f)
+    }
 }
 
-/// Simulates a scenario into memory and prepares truth, channel starts and the INS aiding.
-pub(super) fn prepare(spec: &ScenarioSpec, seed: u64) -> anyhow::Result<Prepared> {
+/// Simulates a scenario into memory and prepares truth, channel starts and the INS aiding of
+/// `cases`.
+pub(super) fn prepare(spec: &ScenarioSpec, cases: &[Case], seed: u64) -> anyhow::Result<Prepared> {
     let mut sim = if_sim::simulator(&scenario_toml(spec, seed, None))?;
     // Unhealthy satellites are left out: a receiver does not use them, and the feed-forward
     // rejects their ephemerides.
@@ -106,7 +118,7 @@ pub(super) fn prepare(spec: &ScenarioSpec, seed: u64) -> anyhow::Result<Prepared
         .iter()
         .map(|s| if_sim::start_from_truth(&sim, s, FS_HZ, 0.0))
         .collect();
-    let (w0, w1) = spec.manoeuvre.window_s();
+    let (w0, w1) = spec.window_s();
     let los_enu = sim
         .satellites
         .iter()
@@ -119,10 +131,17 @@ pub(super) fn prepare(spec: &ScenarioSpec, seed: u64) -> anyhow::Result<Prepared
         .collect();
     let (nav_text, nav_name) = sim.scenario.nav_text(Path::new("."))?;
     let nav = parse_rinex_nav(&nav_text).map_err(|e| anyhow::anyhow!("{nav_name}: {e}"))?;
-    let feedforwards = [
-        feedforward(&sim, &nav, Aiding::Ins1, seed)?,
-        feedforward(&sim, &nav, Aiding::Ins2, seed)?,
-    ];
+    let mut biases: Vec<f64> = cases
+        .iter()
+        .map(Case::bias_mps2)
+        .filter(|&b| b > 0.0)
+        .collect();
+    biases.sort_by(f64::total_cmp);
+    biases.dedup();
+    let feedforwards = biases
+        .iter()
+        .map(|&b| Ok((b, feedforward(&sim, &nav, b, spec.duration_s(), seed)?)))
+        .collect::<anyhow::Result<Vec<_>>>()?;
     Ok(Prepared {
         spec: *spec,
         samples,

@@ -3,15 +3,16 @@
 use super::aiding::bias_direction_enu;
 use super::conclusions::conclusions_md;
 use super::grid_md::grid_md;
-use super::headline::Headline;
+use super::headline::{Headline, Trio, TEN_G};
 use super::intro::intro_md;
-use super::manoeuvre::Manoeuvre;
 use super::params::{
-    ALLAN_DEVIATION_1S, DURATION_S, FS_HZ, HEADLINE_BN_HZ, INS1_BIAS_MPS2, INS_RATE_HZ, LEAD_IN_S,
-    ORDER1_BN_HZ, RAMP_S, SPEED_MPS, START_TOW_S, STEP_S, TICK_S, TURN_S,
+    CLOCK_DRIFT_S_S, FS_HZ, HEADLINE_BN_HZ, INS_RATE_HZ, MG_MPS2, NARROW_DEFAULT_BIAS_MG,
+    NARROW_INS1_BIAS_MG, ORDER1_BN_HZ, OSCILLATOR, RAMP_S, SPEED_MPS, START_TOW_S, STEP_S, TAIL_S,
+    TICK_S, TURN_S, WIDE_INS1_BIAS_MPS2,
 };
 use super::plots::plots;
-use super::result::CaseResult;
+use super::result::{CaseResult, NotRun};
+use super::seed_tables::{fig12_15, table3_rows};
 use super::table::table;
 use super::DynamicsArgs;
 use crate::report::StudyReport;
@@ -23,9 +24,12 @@ fn result_json(r: &CaseResult) -> serde_json::Value {
         "manoeuvre": r.spec.manoeuvre.label(),
         "g": r.spec.manoeuvre.g(),
         "cn0_dbhz": r.spec.cn0_dbhz,
+        "lead_in_s": r.spec.lead_in_s,
         "order": r.case.order,
         "bn_hz": r.case.bn_hz,
         "aiding": r.case.aiding.key(),
+        "bias_mps2": r.case.bias_mps2(),
+        "ins1_bias_mps2": r.case.ins1_bias_mps2,
         "satellites": r.satellites,
         "tracked_at_start": r.tracked_at_start,
         "tracked_min": r.tracked_min,
@@ -36,6 +40,11 @@ fn result_json(r: &CaseResult) -> serde_json::Value {
         "channels_lost": r.channels_lost,
         "phase_std_cycles": num(r.phase_std_cycles),
         "disc_std_cycles": num(r.disc_std_cycles),
+        "disc_std_per_sat_cycles": r.prns.iter().zip(&r.disc_std_per_sat)
+            .map(|(p, v)| json!({"prn": p, "std_cycles": num(*v)}))
+            .collect::<Vec<_>>(),
+        "lead_in_accel_max_mps2": num(r.lead_in_accel_max_mps2),
+        "lost_before_prns": r.lost_before_prns,
         "mean_abs_phase_error_deg": num(r.disc_mean_abs_deg),
         "predicted_mean_abs_phase_error_deg": num(r.predicted_mean_abs_deg),
         "phase_error_growth_deg_s": num(r.growth_abs_deg_s),
@@ -55,14 +64,46 @@ fn json_num(v: f64) -> serde_json::Value {
     }
 }
 
-pub(super) fn build_report(
-    args: &DynamicsArgs,
-    results: &[CaseResult],
-    wall_s: f64,
-) -> StudyReport {
+/// A trio (unaided, INS 1, INS 2) and its INS 2 / INS 1 std ratios.
+fn trio_json(t: &Trio<'_>) -> serde_json::Value {
+    let mode = |r: Option<&CaseResult>| r.map(result_json).unwrap_or(serde_json::Value::Null);
+    json!({
+        "unaided": mode(t.unaided),
+        "ins1": mode(t.ins1),
+        "ins2": mode(t.ins2),
+        "disc_std_ratio_ins2_ins1": json_num(t.ratio(|r| r.disc_std_cycles)),
+        "phase_std_ratio_ins2_ins1": json_num(t.ratio(|r| r.phase_std_cycles)),
+        "mean_abs_phase_error_ratio_ins2_ins1": json_num(t.ratio(|r| r.disc_mean_abs_deg)),
+        "growth_ratio_ins2_ins1": json_num(t.ratio(|r| r.growth_abs_deg_s)),
+    })
+}
+
+/// The summary of `study.json`: setup, the 10 g turn's headline cases, Table 3 and every row.
+fn summary_json(args: &DynamicsArgs, results: &[CaseResult], wall_s: f64) -> serde_json::Value {
     let h = Headline::new(results);
-    let mode_json = |r: Option<&CaseResult>| r.map(result_json).unwrap_or(serde_json::Value::Null);
-    let summary = json!({
+    let table3: Vec<serde_json::Value> = table3_rows(results)
+        .iter()
+        .map(|r| {
+            let (lo, hi) = r.sat_ratio_range();
+            json!({
+                "cn0_dbhz": r.cn0_dbhz,
+                "order": r.order,
+                "ins1_bias_mps2": r.ins1_bias_mps2,
+                "satellites": r.ins1.satellites,
+                "kept_ins1": r.ins1.kept,
+                "kept_ins2": r.ins2.kept,
+                "disc_std_ins1_cycles": json_num(r.ins1.disc_std_cycles),
+                "disc_std_ins2_cycles": json_num(r.ins2.disc_std_cycles),
+                "disc_std_ratio_ins2_ins1": json_num(r.disc_ratio()),
+                "phase_std_ratio_ins2_ins1": json_num(r.phase_ratio()),
+                "sat_ratio_min": json_num(lo),
+                "sat_ratio_max": json_num(hi),
+                "largest_offset_ins1_cycles": json_num(r.offset_bound_cycles(1.0)),
+                "largest_offset_ins2_cycles": json_num(r.offset_bound_cycles(2.0)),
+            })
+        })
+        .collect();
+    json!({
         "study": "dynamics",
         "quick": args.common.quick,
         "seed": args.common.seed,
@@ -72,45 +113,110 @@ pub(super) fn build_report(
             "fs_hz": FS_HZ,
             "start_tow_s": START_TOW_S,
             "speed_mps": SPEED_MPS,
-            "lead_in_s": LEAD_IN_S,
             "ramp_s": RAMP_S,
             "turn_s": TURN_S,
             "step_s": STEP_S,
-            "duration_s": DURATION_S,
-            "allan_deviation_1s": ALLAN_DEVIATION_1S,
-            "ins1_bias_mps2": INS1_BIAS_MPS2,
-            "ins2_bias_mps2": 2.0 * INS1_BIAS_MPS2,
+            "tail_s": TAIL_S,
+            "oscillator": {
+                "name": OSCILLATOR.name,
+                "allan_deviation_1s": OSCILLATOR.allan_deviation_1s,
+                "random_walk_fm_h_m2": OSCILLATOR.h_m2,
+            },
+            "clock_drift_s_s": CLOCK_DRIFT_S_S,
+            "narrow_ins1_bias_mg": NARROW_INS1_BIAS_MG,
+            "narrow_default_ins1_bias_mg": NARROW_DEFAULT_BIAS_MG,
+            "wide_ins1_bias_mps2": WIDE_INS1_BIAS_MPS2,
             "bias_direction_enu": bias_direction_enu(),
             "ins_rate_hz": INS_RATE_HZ,
             "tick_s": TICK_S,
         },
         "ten_g": {
-            "manoeuvre": Manoeuvre::Turn(10.0).label(),
-            "cn0_dbhz": h.unaided.map(|r| r.spec.cn0_dbhz),
-            "order": 2,
+            "manoeuvre": TEN_G.label(),
+            "cn0_dbhz": h.cn0_dbhz,
             "bn_hz": HEADLINE_BN_HZ,
-            "satellites": h.unaided.map(|r| r.satellites),
-            "unaided": mode_json(h.unaided),
-            "ins1": mode_json(h.ins1),
-            "ins2": mode_json(h.ins2),
-            "phase_std_ratio_ins2_ins1": json_num(h.std_ratio()),
+            "ins1_bias_mps2": NARROW_DEFAULT_BIAS_MG * MG_MPS2,
+            "satellites": h.order2.unaided.map(|r| r.satellites),
+            "lead_in_s": h.order2.unaided.map(|r| r.spec.lead_in_s),
+            "order2": trio_json(&h.order2),
+            "order3": trio_json(&h.order3),
             "order1": {
                 "bn_hz": ORDER1_BN_HZ,
-                "ins1": mode_json(h.order1_ins1),
-                "ins2": mode_json(h.order1_ins2),
-                "mean_abs_phase_error_ratio_ins2_ins1": json_num(h.order1_mean_ratio()),
-                "growth_ratio_ins2_ins1": json_num(h.order1_growth_ratio()),
+                "cases": trio_json(&h.order1),
             },
         },
+        "table3": table3,
         "rows": results.iter().map(result_json).collect::<Vec<_>>(),
-    });
+    })
+}
+
+/// The cases not run, grouped by loop and reason (one line each).
+fn not_run_md(not_run: &[NotRun]) -> String {
+    let mut lines: Vec<String> = not_run
+        .iter()
+        .map(|n| {
+            format!(
+                "order {} Bn {} Hz {}: {}",
+                n.case.order,
+                n.case.bn_hz,
+                n.case.aiding.label(),
+                n.why
+            )
+        })
+        .collect();
+    lines.sort();
+    lines.dedup();
+    if lines.is_empty() {
+        return String::new();
+    }
+    format!(
+        "**Not run** ({} cases over {} scenario(s): the receiver rejects these loops when it \
+configures a channel, so `gpsrx run` could not use them either): {}.",
+        not_run.len(),
+        {
+            let mut s: Vec<String> = not_run
+                .iter()
+                .map(|n| {
+                    format!(
+                        "{} {} {}",
+                        n.spec.manoeuvre.label(),
+                        n.spec.cn0_dbhz,
+                        n.spec.lead_in_s
+                    )
+                })
+                .collect();
+            s.sort();
+            s.dedup();
+            s.len()
+        },
+        lines.join("; ")
+    )
+}
+
+pub(super) fn build_report(
+    args: &DynamicsArgs,
+    results: &[CaseResult],
+    not_run: &[NotRun],
+    wall_s: f64,
+) -> StudyReport {
+    let figs = fig12_15(results);
+    let figs_md = if figs.rows.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "**Seed 004 Figs. 12/15: satellites through the 10 g turn at Bn = {HEADLINE_BN_HZ} \
+Hz** (INS 1 {NARROW_DEFAULT_BIAS_MG} mg, INS 2 twice; plots `tracked_10g_*.png`).\n\n{}",
+            figs.to_markdown()
+        )
+    };
     StudyReport {
         title: "High dynamics: unaided vs INS-aided carrier tracking (seed 004)".into(),
         intro_md: intro_md(args),
         table: table(results),
         conclusions_md: [
-            conclusions_md(&h),
+            figs_md,
+            conclusions_md(results),
             grid_md(results),
+            not_run_md(not_run),
             format!("Wall time of this run: {wall_s:.0} s."),
         ]
         .iter()
@@ -118,7 +224,23 @@ pub(super) fn build_report(
         .filter(|p| !p.is_empty())
         .collect::<Vec<_>>()
         .join("\n\n"),
-        summary,
+        summary: {
+            let mut j = summary_json(args, results, wall_s);
+            j["not_run"] = not_run
+                .iter()
+                .map(|n| {
+                    json!({
+                        "manoeuvre": n.spec.manoeuvre.label(),
+                        "cn0_dbhz": n.spec.cn0_dbhz,
+                        "order": n.case.order,
+                        "bn_hz": n.case.bn_hz,
+                        "aiding": n.case.aiding.key(),
+                        "why": n.why,
+                    })
+                })
+                .collect();
+            j
+        },
         plots: plots(results),
     }
 }

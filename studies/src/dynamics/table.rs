@@ -1,5 +1,6 @@
 //! The study table: one row per case.
 
+use super::params::MG_MPS2;
 use super::result::CaseResult;
 use crate::report::{fmt, Table};
 
@@ -7,9 +8,11 @@ pub(super) fn table(results: &[CaseResult]) -> Table {
     let mut t = Table::new(&[
         "manoeuvre",
         "C/N0 (dB-Hz)",
+        "lead-in (s)",
         "order",
         "Bn (Hz)",
         "aiding",
+        "bias (mg)",
         "sats at start",
         "tracked min",
         "tracked mean",
@@ -29,9 +32,11 @@ pub(super) fn table(results: &[CaseResult]) -> Table {
         t.push(vec![
             r.spec.manoeuvre.label(),
             fmt(r.spec.cn0_dbhz, 0),
+            fmt(r.spec.lead_in_s, 0),
             r.case.order.to_string(),
-            fmt(r.case.bn_hz, 0),
+            r.case.bn_hz.to_string(),
             r.case.aiding.label().to_string(),
+            fmt(r.case.bias_mps2() / MG_MPS2, 1),
             format!("{}/{}", r.tracked_at_start, r.satellites),
             r.tracked_min.to_string(),
             fmt(r.tracked_mean, 1),

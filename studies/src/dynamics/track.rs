@@ -3,14 +3,14 @@
 use super::aiding::Aiding;
 use super::grid::Case;
 use super::mem_source::MemSource;
-use super::params::{DURATION_S, FS_HZ, TICK_S};
+use super::params::{FS_HZ, TICK_S};
 use super::result::{summarise, CaseResult};
 use super::scenario::Prepared;
 use crate::if_sim;
 use gpsrx_dsp::constants::LAMBDA_L1_M;
 use gpsrx_receiver::pipeline::tracker::{track, AidSource};
 use gpsrx_samples::SampleFormat;
-use gpsrx_tracking::{Channel, ChannelEpoch, ChannelState};
+use gpsrx_tracking::{Channel, ChannelConfig, ChannelEpoch, ChannelState, LoopConfig};
 
 /// Epochs in Track over which the hand-over frequency error is averaged (20 ms at T = 1 ms).
 const HANDOVER_EPOCHS: usize = 20;
@@ -43,17 +43,36 @@ pub(super) struct ChannelLog {
     pub(super) handover_epochs: usize,
 }
 
+/// The channel configuration of `case`, as `gpsrx run` sets it up: unaided
+/// (`--no-aiding --pll-order N --pll-bw B`), the default pull-in, then the case's PLL as the
+/// tracking loops (no FLL, 1 Hz 1st-order carrier-aided DLL, T = 1 ms); aided
+/// (`--ins --aided-pll-order N --aided-pll-bw B`), the default tracking loops (3rd order,
+/// 18 Hz) with the case's PLL as `aided_track`, which the channel takes (in stages, from the
+/// pull-in loop) once the feed-forward is on. No weak-signal loops in either: the study measures
+/// the loops it names.
+pub(super) fn case_config(case: &Case) -> ChannelConfig {
+    if case.aiding == Aiding::Unaided {
+        return if_sim::track_config(case.order, case.bn_hz, 1e-3, 1.0);
+    }
+    let defaults = ChannelConfig::default().track;
+    let mut cfg = if_sim::track_config(defaults.pll_order, defaults.pll_bw_hz, 1e-3, 1.0);
+    cfg.aided_track = Some(LoopConfig {
+        pll_order: case.order,
+        pll_bw_hz: case.bn_hz,
+        ..cfg.track
+    });
+    cfg
+}
+
 /// Tracks every satellite of `p` with the loops and aiding of `case`.
 pub(super) fn run_case(p: &Prepared, case: &Case) -> anyhow::Result<CaseResult> {
-    // The default pull-in, then the case's PLL (no FLL), a 1 Hz 1st-order carrier-aided DLL,
-    // T = 1 ms.
-    let cfg = if_sim::track_config(case.order, case.bn_hz, 1e-3, 1.0);
+    let cfg = case_config(case);
     let channels = p
         .starts
         .iter()
         .map(|s| Channel::new(s, FS_HZ, &cfg))
         .collect::<Result<Vec<_>, _>>()?;
-    let n_ticks = (DURATION_S / TICK_S).round() as usize;
+    let n_ticks = (p.spec.duration_s() / TICK_S).round() as usize;
     let mut logs = vec![
         ChannelLog {
             ticks: vec![false; n_ticks],
@@ -61,17 +80,16 @@ pub(super) fn run_case(p: &Prepared, case: &Case) -> anyhow::Result<CaseResult> 
         };
         channels.len()
     ];
-    let (w0, w1) = p.spec.manoeuvre.window_s();
+    let (w0, w1) = p.spec.window_s();
     let mut src = MemSource {
         data: &p.samples,
         pos: 0,
         format: SampleFormat::Cf32Le,
     };
-    let ff = match case.aiding {
-        Aiding::Unaided => None,
-        Aiding::Ins1 => Some(&p.feedforwards[0]),
-        Aiding::Ins2 => Some(&p.feedforwards[1]),
-    };
+    let ff = p.feedforward(case);
+    if ff.is_none() && case.aiding != Aiding::Unaided {
+        anyhow::bail!("no INS prepared for {case:?}: prepare() was given other cases");
+    }
     let aid_fn = |prn: gpsrx_dsp::Prn, t: f64| ff.and_then(|f| f.aid(prn.get(), t));
     let aid: Option<AidSource<'_>> = ff.map(|_| &aid_fn as AidSource<'_>);
     track(&mut src, channels, aid, |i, e: &ChannelEpoch| {
