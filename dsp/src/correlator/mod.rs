@@ -29,6 +29,8 @@ mod simd;
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 #[cfg(target_arch = "x86_64")]
+mod avx2_ci8;
+#[cfg(target_arch = "x86_64")]
 mod avx512;
 
 #[cfg(test)]
