@@ -221,7 +221,11 @@ unsafe fn replica(job: &Ci8Job<'_>, t: usize, chip: usize, bx: __m256i) -> __m25
                 .add(chip + plan.whole[t])
                 .cast(),
         ));
-        _mm256_or_si256(_mm256_shuffle_epi8(window, idx), _mm256_set1_epi16(1))
+        // `| 1` as a 32-bit pattern: rematerialised from memory, a broadcast is a plain load.
+        _mm256_or_si256(
+            _mm256_shuffle_epi8(window, idx),
+            _mm256_set1_epi32(0x0001_0001),
+        )
     }
 }
 
