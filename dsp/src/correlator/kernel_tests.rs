@@ -14,7 +14,8 @@
 //!   (`2^-14.5 < 4.5e-5` relative), and ci16 the rounding of `w` to multiples of 2^8 in Q14
 //!   units, `2^-7 sqrt 2` sample units per sample; the AVX2 16-lane ci8 kernel rounds each
 //!   of the two products of a component to 2^-7 sample (`vpmulhrsw`), also at most
-//!   `2^-7 sqrt 2` per sample;
+//!   `2^-7 sqrt 2` per sample, and its carrier, rotated in i16 between f32 steps, is off by
+//!   at most `4.1e-4` relative (avx2_ci8 module doc);
 //! - f32 accumulation: `n 2^-24` relative (worst case, sequential sums).
 
 use super::*;
@@ -110,10 +111,11 @@ fn reference(
 /// Carrier error bound relative to `sum |x|`, per kernel (module doc).
 fn carrier_bound(c: &Correlator, fmt: Fmt) -> f64 {
     let base = if c.isa() == Isa::Scalar { 7.7e-4 } else { 2e-4 };
-    if c.arithmetic() == Arithmetic::I16 && fmt != Fmt::Cf32 {
-        base + 4.5e-5
-    } else {
-        base
+    match (c.isa(), c.arithmetic(), fmt) {
+        // The 16-lane ci8 kernel rotates 3 of 4 carrier vectors in i16 (avx2_ci8 module doc).
+        (Isa::Avx2Fma, Arithmetic::I16, Fmt::Ci8) => base + 4.1e-4,
+        (_, Arithmetic::I16, Fmt::Ci16 | Fmt::Ci8) => base + 4.5e-5,
+        _ => base,
     }
 }
 
@@ -471,7 +473,7 @@ fn avx2_i16_ci8_kernel_matches_the_references_from_1p1_to_40_mhz() {
             worst = worst.max(check(&c, Fmt::Ci8, x, &code, &case));
         }
     }
-    println!("avx2+fma/i16 ci8: worst |err - edge - rounding| / sum|x| = {worst:.2e}");
+    println!("avx2+fma/i16 ci8: worst |err - edge| / sum|x| = {worst:.2e}");
 }
 
 /// `sum_k x[k] code(p(k) >> 32)` with the fixed-point code NCO (no carrier), exact in f64.
