@@ -10,18 +10,22 @@
 #    (carrier wipe-off + dot products) and its fastest fixed-point one, 16ic_16i_rotator.
 #    GNSS-SDR's 16ic_16i and our AVX2 int16 3-tap ci8 kernel (`gpsrx bench --correlators-only
 #    --correlator avx2`, replicas and carrier generated inside) are timed back to back,
-#    REPEATS times alternately, best of each: the issue-17 target is ours >= 2x theirs on the
-#    same machine (AVX2 is what users' CPUs have). Our AVX-512 kernels are reported apart.
+#    REPEATS times alternately, best of each (a round times 16ic_16i in VOLK_RUNS profiler
+#    runs of a few ms per architecture, ours in 5 ms stretches for 0.15 s: the best of many
+#    short bursts on both sides, so other load on the machine hurts neither more): the
+#    issue-17 target is ours >= 2x theirs on the same machine (AVX2 is what users' CPUs have). Our AVX-512 kernels are reported apart.
 #    GNSS-SDR's complete per-channel figure is 1/(1/resampler + 1/rotator): it first writes
 #    the replicas, then correlates.
-# 2. End to end: gnss-sdr (through scripts/gnss-sdr/run-gnss-sdr.sh) and `gpsrx run` on the
+# 2. End to end: gnss-sdr (through scripts/gnss-sdr/run-gnss-sdr.sh) and `gpsrx run` (with its
+#    default correlator and with `--correlator avx2`, what an AVX2-only CPU runs) on the
 #    same simulated recording (samples/scenarios/static-seoul-4msps.toml: 4 MHz ci8, 12
 #    satellites), both wall times.
 #
 # Installs Debian's gnss-sdr (which provides volk_gnsssdr_profile) when missing. Builds gpsrx
 # in release mode (CARGO_TARGET_DIR is honoured) unless GPSRX names a binary. Environment:
 # VLEN [4000] and ITER [2000] for the profiler (samples = VLEN x ITER per kernel), REPEATS [3]
-# (best of), WORK [mktemp -d], GPSRX [build]. Targets: issue 7, ours >= 3x GNSS-SDR's
+# (best of), VOLK_RUNS [5] (profiler runs per back-to-back round), WORK [mktemp -d], GPSRX
+# [build]. Targets: issue 7, ours >= 3x GNSS-SDR's
 # complete per-channel figure; issue 17, our AVX2 int16 kernel >= 2x its 16ic_16i kernel;
 # end to end >= 6x faster than GNSS-SDR on the same file.
 set -euo pipefail
@@ -31,6 +35,7 @@ DURATION=${1:-60}
 VLEN=${VLEN:-4000}
 ITER=${ITER:-2000}
 REPEATS=${REPEATS:-3}
+VOLK_RUNS=${VOLK_RUNS:-5}
 WORK=${WORK:-$(mktemp -d)}
 mkdir -p "$WORK"
 die() { echo "bench-vs-gnss-sdr: $*" >&2; exit 1; }
@@ -109,7 +114,7 @@ fmax() { python3 -c 'import sys; print(max(float(a) for a in sys.argv[1:] if a))
 echo "timing GNSS-SDR 16ic_16i_rotator and gpsrx avx2+fma/i16 back to back ($REPEATS rounds)..." >&2
 ROTATOR16="" OURS_AVX2="" OURS_AVX2_RAN=""
 for r in $(seq "$REPEATS"); do
-    V=$(REPEATS=1 volk_msps 16ic_16i_rotator)
+    V=$(REPEATS=$VOLK_RUNS volk_msps 16ic_16i_rotator)
     "$GPSRX" bench --correlators-only --correlator avx2 --json >"$WORK/bench-avx2-$r.json" ||
         die "gpsrx bench --correlators-only --correlator avx2 failed"
     read -r O RAN < <(ours_msps "$WORK/bench-avx2-$r.json" "avx2+fma/i16") || true
@@ -161,11 +166,14 @@ DATA=$WORK/sim/signal.ci8
 WEEK=$(python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print(m["global"].get("gpsrx:start_gps_week", ""))' "$WORK/sim/signal.sigmf-meta" 2>/dev/null || true)
 
 now() { python3 -c 'import time; print(time.monotonic())'; }
-echo "running gpsrx run..." >&2
+echo "running gpsrx run (correlator auto, then --correlator avx2)..." >&2
 T0=$(now)
 "$GPSRX" run "$DATA" --out "$WORK/gpsrx-run" ${WEEK:+--week "$WEEK"} >"$WORK/gpsrx-run.log" 2>&1 ||
     die "gpsrx run failed: see $WORK/gpsrx-run.log"
 T1=$(now)
+"$GPSRX" run "$DATA" --out "$WORK/gpsrx-run-avx2" --correlator avx2 ${WEEK:+--week "$WEEK"} \
+    >"$WORK/gpsrx-run-avx2.log" 2>&1 || die "gpsrx run --correlator avx2 failed: see $WORK/gpsrx-run-avx2.log"
+T1B=$(now)
 echo "running gnss-sdr (scripts/gnss-sdr/run-gnss-sdr.sh)..." >&2
 set +e
 "$ROOT/scripts/gnss-sdr/run-gnss-sdr.sh" "$DATA" ci8 4000000 37.5665 126.9780 40.0 "$WORK/gnss-sdr" >"$WORK/gnss-sdr.log" 2>&1
@@ -173,17 +181,18 @@ GNSS_STATUS=$?
 set -e
 T2=$(now)
 
-python3 - "$T0" "$T1" "$T2" "$DURATION" "$GNSS_STATUS" "$MACHINE" <<'EOF'
+python3 - "$T0" "$T1" "$T1B" "$T2" "$DURATION" "$GNSS_STATUS" "$MACHINE" <<'EOF'
 import sys
-t0, t1, t2, dur = map(float, sys.argv[1:5])
-status = int(sys.argv[5])
-ours, theirs = t1 - t0, t2 - t1
+t0, t1, t1b, t2, dur = map(float, sys.argv[1:6])
+status = int(sys.argv[6])
+ours, ours_avx2, theirs = t1 - t0, t1b - t1, t2 - t1b
 print()
-print(f"end to end, {dur:g} s of 4 MHz ci8 with 12 satellites, file to fixes (wall time; {sys.argv[6]}):")
-print(f"  gpsrx run   {ours:8.2f} s  ({dur / ours:6.1f}x real time)")
-print(f"  gnss-sdr    {theirs:8.2f} s  ({dur / theirs:6.1f}x real time; run-gnss-sdr.sh exit {status}"
+print(f"end to end, {dur:g} s of 4 MHz ci8 with 12 satellites, file to fixes (wall time; {sys.argv[7]}):")
+print(f"  gpsrx run                    {ours:8.2f} s  ({dur / ours:6.1f}x real time; tracking correlator auto)")
+print(f"  gpsrx run --correlator avx2  {ours_avx2:8.2f} s  ({dur / ours_avx2:6.1f}x real time; an AVX2-only CPU's tracking)")
+print(f"  gnss-sdr                     {theirs:8.2f} s  ({dur / theirs:6.1f}x real time; run-gnss-sdr.sh exit {status}"
       + (", see the log" if status else ", fixes within 10 m") + ")")
-print(f"  gpsrx is {theirs / ours:.1f}x faster (target >= 6x)")
+print(f"  gpsrx is {theirs / ours:.1f}x faster, {theirs / ours_avx2:.1f}x with AVX2 only (target >= 6x)")
 EOF
 echo
 echo "logs and outputs in $WORK (gpsrx-run.log, gnss-sdr.log, bench.json)"

@@ -84,8 +84,8 @@ pub struct ChannelConfig {
     /// The widest instruction set of the correlator kernel (`auto`: the widest this CPU runs;
     /// `avx2` on an AVX-512 machine times what an AVX2-only CPU does).
     pub correlator: CorrelatorIsa,
-    /// The correlator's arithmetic (`f32` or `i16`; the channels get f32 samples, on which
-    /// both run the f32 kernel, see [`CorrelatorArithmetic`]).
+    /// The correlator's arithmetic: `auto` (the faster per block format: int16 on ci8 with
+    /// AVX2, f32 otherwise), `f32` or `i16` ([`CorrelatorArithmetic`]).
     pub correlator_arithmetic: CorrelatorArithmetic,
 }
 
@@ -135,7 +135,7 @@ impl Default for ChannelConfig {
             lost_estimates: 5,
             weak_pull_in: Some(WeakPullInConfig::default()),
             correlator: CorrelatorIsa::Auto,
-            correlator_arithmetic: CorrelatorArithmetic::F32,
+            correlator_arithmetic: CorrelatorArithmetic::Auto,
         }
     }
 }

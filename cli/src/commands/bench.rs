@@ -129,7 +129,7 @@ pub struct EndToEnd {
     pub peak_rss_reset: bool,
     /// Wall time of the simulation (not part of the run), s.
     pub simulate_s: f64,
-    /// The tracking channels' correlator kernel (they correlate f32 samples).
+    /// The tracking channels' correlator and the kernel it runs per block format.
     pub correlator: String,
 }
 
@@ -573,11 +573,20 @@ fn bench_end_to_end(
         peak_rss_mb,
         peak_rss_reset,
         simulate_s: 0.0,
-        correlator: config
-            .tracking
-            .correlator
-            .correlator(config.tracking.correlator_arithmetic)
-            .kernel_for("cf32", src.fs_hz()),
+        correlator: {
+            let c = config
+                .tracking
+                .correlator
+                .correlator(config.tracking.correlator_arithmetic);
+            let k = |f: &str| c.kernel_for(f, src.fs_hz());
+            format!(
+                "{} (on ci8 blocks {}, ci16 {}, cf32 {})",
+                c.name(),
+                k("ci8"),
+                k("ci16"),
+                k("cf32")
+            )
+        },
     })
 }
 
@@ -708,7 +717,7 @@ fn print_end_to_end(out: &mut dyn Write, name: &str, e: &EndToEnd) -> std::io::R
             ", mean fix {h:.2} m from the antenna (horizontal)"
         ))
     )?;
-    writeln!(out, "  tracking correlator: {} on cf32", e.correlator)?;
+    writeln!(out, "  tracking correlator: {}", e.correlator)?;
     match e.peak_rss_mb {
         Some(m) => writeln!(
             out,

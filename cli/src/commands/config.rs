@@ -61,7 +61,7 @@ pub fn default_toml() -> anyhow::Result<String> {
          weak_enter_dbhz = {:?}    # below this C/N0 a channel takes [tracking.weak_track], dB-Hz (0: never)\n\
          weak_leave_dbhz = {:?}    # above this it goes back to [tracking.track], dB-Hz\n\
          correlator = \"{}\"       # widest correlator instruction set: auto, avx512, avx2 or scalar (--correlator)\n\
-         correlator_arithmetic = \"{}\"  # f32 or i16 (--correlator avx2/i16)\n\
+         correlator_arithmetic = \"{}\"  # auto (int16 on ci8 with AVX2, else f32), f32 or i16 (--correlator avx2/i16)\n\
          \n\
          # Pull-in loops: 1 ms, wide, FLL-assisted.\n{}\n\
          # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n\

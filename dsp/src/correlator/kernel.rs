@@ -91,6 +91,11 @@ pub enum Arithmetic {
     /// table carrier in Q14 and i64 sums. Cf32 input has no integer scale to quantise to: with
     /// it, an I16 correlator runs the F32 kernel of the same ISA.
     I16,
+    /// The faster of the two for each block's format: I16 on ci8 where the CPU has AVX2 (the
+    /// AVX2 16-lane kernel, faster on ci8 than the AVX-512 ones too; its accuracy is I16's),
+    /// F32 on ci16 and cf32 and on a CPU without AVX2. Never listed by
+    /// [`Correlator::available`]: it picks among those.
+    Auto,
 }
 
 impl Arithmetic {
@@ -99,6 +104,7 @@ impl Arithmetic {
         match self {
             Arithmetic::F32 => "f32",
             Arithmetic::I16 => "i16",
+            Arithmetic::Auto => "auto",
         }
     }
 }
@@ -117,6 +123,10 @@ enum Kernel {
 pub struct Correlator {
     kernel: Kernel,
     arithmetic: Arithmetic,
+    /// The AVX2 kernel when the CPU has it and `kernel`'s ISA is AVX2 or wider: what
+    /// [`Arithmetic::Auto`] runs on ci8.
+    #[cfg(target_arch = "x86_64")]
+    avx2: Option<Avx2Kernel>,
 }
 
 impl Correlator {
@@ -136,6 +146,8 @@ impl Correlator {
             .unwrap_or(Self {
                 kernel: Kernel::Scalar,
                 arithmetic,
+                #[cfg(target_arch = "x86_64")]
+                avx2: None,
             })
     }
 
@@ -150,7 +162,15 @@ impl Correlator {
             #[cfg(not(target_arch = "x86_64"))]
             Isa::Avx2Fma | Isa::Avx512 => None,
         }?;
-        Some(Self { kernel, arithmetic })
+        Some(Self {
+            kernel,
+            arithmetic,
+            #[cfg(target_arch = "x86_64")]
+            avx2: match kernel {
+                Kernel::Scalar => None,
+                _ => Avx2Kernel::new(),
+            },
+        })
     }
 
     /// Every kernel this CPU runs, scalar first.
@@ -190,17 +210,34 @@ impl Correlator {
     /// e.g. `"avx2+fma/i16 (16 lanes)"`: an I16 correlator runs the F32 kernel on cf32, and
     /// the AVX2 I16 one has a 16-lane kernel for ci8 from about 1.1 MHz.
     pub fn kernel_for(&self, format: &str, fs_hz: f64) -> String {
-        let arithmetic = match (self.arithmetic, format) {
-            (Arithmetic::I16, "cf32") => Arithmetic::F32,
-            (a, _) => a,
+        let (isa, arithmetic) = match (self.arithmetic, format) {
+            (Arithmetic::I16, "cf32") => (self.isa(), Arithmetic::F32),
+            (Arithmetic::Auto, "ci8") if self.isa() >= Isa::Avx2Fma => {
+                (Isa::Avx2Fma, Arithmetic::I16)
+            }
+            (Arithmetic::Auto, _) => (self.isa(), Arithmetic::F32),
+            (a, _) => (self.isa(), a),
         };
-        let lanes = match (self.isa(), arithmetic, format) {
+        let lanes = match (isa, arithmetic, format) {
             (Isa::Scalar, _, _) => "",
             (Isa::Avx2Fma, Arithmetic::I16, "ci8") if fs_hz >= 1.1e6 => " (16 lanes)",
             (Isa::Avx2Fma, _, _) => " (8 lanes)",
             (Isa::Avx512, _, _) => " (16 lanes)",
         };
-        format!("{}/{}{lanes}", self.isa().name(), arithmetic.name())
+        format!("{}/{}{lanes}", isa.name(), arithmetic.name())
+    }
+
+    /// The kernel and arithmetic a block of `samples` runs ([`Arithmetic::Auto`] resolved).
+    fn resolve(&self, samples: &SampleSlice<'_>) -> (Kernel, Arithmetic) {
+        match (self.arithmetic, samples) {
+            #[cfg(target_arch = "x86_64")]
+            (Arithmetic::Auto, SampleSlice::Ci8(_)) => match self.avx2 {
+                Some(k) => (Kernel::Avx2(k), Arithmetic::I16),
+                None => (self.kernel, Arithmetic::F32),
+            },
+            (Arithmetic::Auto, _) => (self.kernel, Arithmetic::F32),
+            (a, _) => (self.kernel, a),
+        }
     }
 
     /// Correlates `samples` with the replica of `code` described by `state`, one sum per entry
@@ -241,23 +278,22 @@ impl Correlator {
             out.fill(Complex32::new(f32::NAN, f32::NAN));
             return;
         }
+        let (kernel, arithmetic) = self.resolve(&samples);
         for (taps, out) in tap_offsets_chips
             .chunks(MAX_TAPS)
             .zip(out.chunks_mut(MAX_TAPS))
         {
-            let done = match self.kernel {
+            let done = match kernel {
                 Kernel::Scalar => false,
                 #[cfg(target_arch = "x86_64")]
-                Kernel::Avx2(k) => {
-                    k.correlate(self.arithmetic, samples, fs_hz, code, state, taps, out)
-                }
+                Kernel::Avx2(k) => k.correlate(arithmetic, samples, fs_hz, code, state, taps, out),
                 #[cfg(target_arch = "x86_64")]
                 Kernel::Avx512(k) => {
-                    k.correlate(self.arithmetic, samples, fs_hz, code, state, taps, out)
+                    k.correlate(arithmetic, samples, fs_hz, code, state, taps, out)
                 }
             };
             if !done {
-                scalar_kernel(self.arithmetic, samples, fs_hz, code, state, taps, out);
+                scalar_kernel(arithmetic, samples, fs_hz, code, state, taps, out);
             }
         }
     }
@@ -275,17 +311,14 @@ fn scalar_kernel(
     let chips = code.chips();
     match (arithmetic, samples) {
         (_, SampleSlice::Cf32(x)) => scalar::correlate_f32(x, fs_hz, chips, state, taps, out),
-        (Arithmetic::F32, SampleSlice::Ci16(x)) => {
-            scalar::correlate_f32(x, fs_hz, chips, state, taps, out)
-        }
-        (Arithmetic::F32, SampleSlice::Ci8(x)) => {
-            scalar::correlate_f32(x, fs_hz, chips, state, taps, out)
-        }
         (Arithmetic::I16, SampleSlice::Ci16(x)) => {
             scalar::correlate_i16(x, fs_hz, chips, state, taps, out)
         }
         (Arithmetic::I16, SampleSlice::Ci8(x)) => {
             scalar::correlate_i16(x, fs_hz, chips, state, taps, out)
         }
+        // F32 (and an unresolved Auto: `resolve` never passes one).
+        (_, SampleSlice::Ci16(x)) => scalar::correlate_f32(x, fs_hz, chips, state, taps, out),
+        (_, SampleSlice::Ci8(x)) => scalar::correlate_f32(x, fs_hz, chips, state, taps, out),
     }
 }

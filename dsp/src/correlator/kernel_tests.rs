@@ -578,3 +578,43 @@ mod prop {
         }
     }
 }
+
+#[test]
+fn auto_arithmetic_runs_the_faster_kernel_of_each_format() {
+    // Auto = I16 on ci8 with the AVX2 kernel when the CPU has AVX2 (whatever the ISA ceiling
+    // above it), F32 of the correlator's own ISA on ci16 and cf32: bit-identical outputs.
+    let mut rng = StdRng::seed_from_u64(404);
+    let code = CaCode::new(Prn::new(8).unwrap_or_else(|e| panic!("{e}")));
+    let block = Block::random(&mut rng, 3001);
+    let case = random_case(&mut rng, 3001);
+    for isa in Isa::ALL.into_iter().filter(|i| i.is_available()) {
+        let auto = Correlator::best_up_to(isa, Arithmetic::Auto);
+        assert_eq!(auto.isa(), isa);
+        assert_eq!(auto.arithmetic(), Arithmetic::Auto);
+        assert!(!Correlator::available()
+            .iter()
+            .any(|c| c.arithmetic() == Arithmetic::Auto));
+        for fmt in [Fmt::Ci8, Fmt::Ci16, Fmt::Cf32] {
+            let explicit = match fmt {
+                Fmt::Ci8 if isa >= Isa::Avx2Fma => Correlator::new(Isa::Avx2Fma, Arithmetic::I16),
+                _ => Correlator::new(isa, Arithmetic::F32),
+            }
+            .unwrap_or_else(|| panic!("{isa:?} is available"));
+            let x = block.slice(fmt, 0..3001);
+            let mut a = vec![Complex32::new(0.0, 0.0); case.taps.len()];
+            let mut b = a.clone();
+            auto.correlate(x, case.fs, code.chips(), &case.state, &case.taps, &mut a);
+            explicit.correlate(x, case.fs, code.chips(), &case.state, &case.taps, &mut b);
+            assert_eq!(a, b, "{isa:?} {fmt:?}");
+            let name = match fmt {
+                Fmt::Ci8 => "ci8",
+                Fmt::Ci16 => "ci16",
+                Fmt::Cf32 => "cf32",
+            };
+            assert_eq!(
+                auto.kernel_for(name, case.fs),
+                explicit.kernel_for(name, case.fs)
+            );
+        }
+    }
+}
