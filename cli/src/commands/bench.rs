@@ -659,8 +659,8 @@ fn print_correlators(out: &mut dyn Write, r: &BenchReport) -> std::io::Result<()
     writeln!(out, "correlator throughput, Msamples/s on one core (4000-sample blocks at 4 MHz, code and carrier generated inside):")?;
     writeln!(
         out,
-        "  {:<14} {:<6} {:>9} {:>9} {:>9}   {}",
-        "kernel", "input", "1 tap", "3 taps", "5 taps", "ran"
+        "  {:<14} {:<6} {:>9} {:>9} {:>9}   ran",
+        "kernel", "input", "1 tap", "3 taps", "5 taps"
     )?;
     let mut keys: Vec<(String, String, String)> = Vec::new();
     for c in &r.correlators {
