@@ -3,7 +3,11 @@
 //! Doppler, with a rate) and code generated inside the kernel, the code prepared once
 //! ([`PackedCode`]) as tracking does.
 //!
-//! Throughput is in samples. Target (AMD EPYC, one core): 3-tap ci8 >= 500 Msamples/s.
+//! Throughput is in samples. Targets, one core: 3-tap ci8 >= 500 Msamples/s (AMD EPYC, issue
+//! 7); `avx2+fma/i16` 3-tap ci8 >= 2x GNSS-SDR's `16ic_16i_rotator` on the same machine (issue
+//! 17; `scripts/bench-vs-gnss-sdr.sh` times the two back to back). The carrier here has a
+//! rate, which takes the AVX2 int16 ci8 kernel's per-step f32 carrier; tracking (and `gpsrx
+//! bench`) correlate at a constant frequency per block.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use gpsrx_dsp::correlator::{Arithmetic, Correlator, PackedCode, ReplicaState, SampleSlice};

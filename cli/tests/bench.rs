@@ -59,14 +59,22 @@ fn quick_bench_reports_every_kernel_acquisition_and_end_to_end() {
                     &r["msps_per_core"],
                     &format!("{} {format} {taps}", k.name()),
                 );
-                // isa and arithmetic spell the kernel's name.
+                // isa and arithmetic spell the kernel's name; `runs` names the kernel that ran.
                 let isa = r["isa"].as_str().unwrap_or_default();
                 let arith = r["arithmetic"].as_str().unwrap_or_default();
                 assert_eq!(format!("{isa}/{arith}"), k.name());
+                assert_eq!(r["runs"].as_str(), Some(k.kernel_for(format, 4e6).as_str()));
             }
         }
     }
     positive(&v["reference_msps_per_core"], "reference correlator");
+    // The CPU and its instruction sets come with the figures.
+    assert!(!v["cpu"].as_str().unwrap_or_default().is_empty());
+    for f in ["avx2", "fma", "avx512f", "avx512bw"] {
+        assert!(v["cpu_features"][f].is_boolean(), "cpu_features.{f}");
+    }
+    assert_eq!(v["correlator_ceiling"], "auto");
+    assert!(v["end_to_end"]["correlator"].is_string());
 
     // Acquisition: a positive time, the median of the runs, and the simulated satellites found.
     let acq_ms = positive(&v["acquisition_ms"], "acquisition_ms");
@@ -107,4 +115,46 @@ fn quick_bench_reports_every_kernel_acquisition_and_end_to_end() {
             assert!(mb < 200.0, "peak RSS {mb} MB");
         }
     }
+}
+
+#[test]
+fn correlator_ceiling_limits_the_kernels_and_bad_names_are_refused() {
+    // --correlator avx2: no AVX-512 row even on an AVX-512 machine (the figure an AVX2-only
+    // CPU would give); --correlators-only: no simulation, acquisition or end-to-end.
+    let out = Command::new(env!("CARGO_BIN_EXE_gpsrx"))
+        .args([
+            "bench",
+            "--quick",
+            "--json",
+            "--correlators-only",
+            "--correlator",
+            "avx2",
+        ])
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run gpsrx: {e}"));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}"));
+    let rows = v["correlators"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no correlators array"));
+    let expected = Correlator::available()
+        .iter()
+        .filter(|k| k.isa() != gpsrx_dsp::correlator::Isa::Avx512)
+        .count();
+    assert_eq!(rows.len(), expected * 3 * 3);
+    assert!(rows.iter().all(|r| r["isa"] != "avx512"));
+    assert_eq!(v["correlator_ceiling"], "avx2");
+    assert!(v["acquisition"].is_null() && v["end_to_end"].is_null());
+
+    let out = Command::new(env!("CARGO_BIN_EXE_gpsrx"))
+        .args(["bench", "--correlators-only", "--correlator", "sse4"])
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run gpsrx: {e}"));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("auto, avx512, avx2, scalar"), "{err}");
 }

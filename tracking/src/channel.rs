@@ -23,6 +23,7 @@ use crate::carrier_loop::{CarrierLoop, CarrierOutput};
 use crate::cn0::SmoothedNwpr;
 use crate::code_loop::{CodeLoop, CodeOutput};
 use crate::config::{ConfigError, LoopConfig};
+use crate::correlator_choice::{CorrelatorArithmetic, CorrelatorIsa};
 use crate::fade_detector::FadeDetector;
 use crate::lock_detector::{CodeLockDetector, PllLockConfig, PllLockDetector};
 use gpsrx_dsp::acquisition::AcqResult;
@@ -80,6 +81,12 @@ pub struct ChannelConfig {
     /// 10 ms sums, differential bit synchronisation and a bit-aligned 20 ms PLL instead, then
     /// tracks with `weak_track` ([`weak_pull_in`](crate::channel::WeakPullInConfig)).
     pub weak_pull_in: Option<WeakPullInConfig>,
+    /// The widest instruction set of the correlator kernel (`auto`: the widest this CPU runs;
+    /// `avx2` on an AVX-512 machine times what an AVX2-only CPU does).
+    pub correlator: CorrelatorIsa,
+    /// The correlator's arithmetic: `auto` (the faster per block format: int16 on ci8 with
+    /// AVX2, f32 otherwise), `f32` or `i16` ([`CorrelatorArithmetic`]).
+    pub correlator_arithmetic: CorrelatorArithmetic,
 }
 
 impl Default for ChannelConfig {
@@ -127,6 +134,8 @@ impl Default for ChannelConfig {
             cn0_window_s: 0.2,
             lost_estimates: 5,
             weak_pull_in: Some(WeakPullInConfig::default()),
+            correlator: CorrelatorIsa::Auto,
+            correlator_arithmetic: CorrelatorArithmetic::Auto,
         }
     }
 }
@@ -299,7 +308,7 @@ pub struct Channel {
     prn: Prn,
     /// The C/A code, bit-packed for the correlator, built once.
     packed_code: PackedCode,
-    /// The fastest correlator kernel of this CPU, chosen once.
+    /// The correlator kernel ([`ChannelConfig::correlator`]), chosen once.
     correlator: Correlator,
     fs_hz: f64,
     cfg: ChannelConfig,
@@ -392,7 +401,7 @@ impl Channel {
         Ok(Self {
             prn: start.prn,
             packed_code: PackedCode::new(CaCode::new(start.prn).chips()),
-            correlator: Correlator::best(),
+            correlator: cfg.correlator.correlator(cfg.correlator_arithmetic),
             fs_hz,
             cfg: *cfg,
             state: ChannelState::PullIn,

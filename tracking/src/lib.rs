@@ -27,6 +27,7 @@ pub mod channel;
 pub mod cn0;
 pub mod code_loop;
 pub mod config;
+pub mod correlator_choice;
 pub mod discriminator;
 pub mod fade_detector;
 pub mod lock_detector;
@@ -41,5 +42,6 @@ pub use channel::{Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelSta
 pub use cn0::{M2m4Estimator, NwprEstimator};
 pub use code_loop::{CodeLoop, CodeOutput};
 pub use config::{ConfigError, DllDiscriminator, FllDiscriminator, LoopConfig, PllDiscriminator};
+pub use correlator_choice::{CorrelatorArithmetic, CorrelatorChoice, CorrelatorIsa};
 pub use lock_detector::{CodeLockDetector, Hysteresis, PllLockConfig, PllLockDetector};
 pub use loop_filter::LoopFilter;

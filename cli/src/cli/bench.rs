@@ -22,4 +22,12 @@ pub struct BenchArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Correlator ceiling `auto`, `avx512`, `avx2` or `scalar` (optionally `/auto`, `/f32` or `/i16`):
+    /// only kernels up to that instruction set are timed, and the end-to-end runs use it
+    /// (`avx2` on an AVX-512 machine: what an AVX2-only CPU would do).
+    #[arg(long, value_name = "ISA[/ARITH]")]
+    pub correlator: Option<gpsrx_tracking::CorrelatorChoice>,
+    /// Time the correlator kernels only (no simulation, acquisition or end-to-end run).
+    #[arg(long)]
+    pub correlators_only: bool,
 }

@@ -232,6 +232,11 @@ pub struct LoopArgs {
     /// 1st-order aided loop drifts with the INS bias.
     #[arg(long, value_name = "N")]
     pub aided_pll_order: Option<u8>,
+    /// Correlator kernel: the widest instruction set `auto`, `avx512`, `avx2` or `scalar`,
+    /// optionally with the arithmetic (`avx2/i16`); overrides `[tracking] correlator`.
+    /// `avx2` on an AVX-512 machine runs what an AVX2-only CPU would.
+    #[arg(long, value_name = "ISA[/ARITH]")]
+    pub correlator: Option<gpsrx_tracking::CorrelatorChoice>,
 }
 
 impl LoopArgs {
@@ -290,8 +295,59 @@ impl LoopArgs {
             }
             cfg.aided_track = Some(a);
         }
+        if let Some(c) = self.correlator {
+            cfg.correlator = c.isa;
+            if let Some(a) = c.arithmetic {
+                cfg.correlator_arithmetic = a;
+            }
+        }
         cfg.validate()
             .map_err(|e| anyhow::anyhow!("tracking configuration: {e}"))?;
         Ok(cfg)
+    }
+}
+
+#[cfg(test)]
+mod correlator_option_tests {
+    use super::LoopArgs;
+    use gpsrx_tracking::{CorrelatorArithmetic, CorrelatorIsa};
+
+    #[test]
+    fn correlator_option_overrides_the_config_file() {
+        let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+        let path = dir.path().join("gpsrx.toml");
+        std::fs::write(
+            &path,
+            "[tracking]\ncorrelator = \"scalar\"\ncorrelator_arithmetic = \"i16\"\n",
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        let mut args = LoopArgs {
+            config: Some(path.clone()),
+            ..LoopArgs::default()
+        };
+        let t = args.channel_config().unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(t.correlator, CorrelatorIsa::Scalar);
+        assert_eq!(t.correlator_arithmetic, CorrelatorArithmetic::I16);
+        // `--correlator avx2` keeps the file's arithmetic; `avx512/f32` sets both.
+        args.correlator = Some("avx2".parse().unwrap_or_else(|e| panic!("{e}")));
+        let t = args.channel_config().unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(t.correlator, CorrelatorIsa::Avx2);
+        assert_eq!(t.correlator_arithmetic, CorrelatorArithmetic::I16);
+        args.correlator = Some("avx512/f32".parse().unwrap_or_else(|e| panic!("{e}")));
+        let t = args.channel_config().unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(t.correlator, CorrelatorIsa::Avx512);
+        assert_eq!(t.correlator_arithmetic, CorrelatorArithmetic::F32);
+        // A bad value in the file is an error that names the valid ones.
+        std::fs::write(&path, "[tracking]\ncorrelator = \"neon\"\n")
+            .unwrap_or_else(|e| panic!("{e}"));
+        let err = LoopArgs {
+            config: Some(path),
+            ..LoopArgs::default()
+        }
+        .channel_config()
+        .err()
+        .map(|e| format!("{e:#}"))
+        .unwrap_or_default();
+        assert!(err.contains("correlator") && err.contains("avx2"), "{err}");
     }
 }

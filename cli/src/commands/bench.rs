@@ -1,10 +1,14 @@
 //! `gpsrx bench`: how fast this machine runs the receiver.
 //!
+//! Every figure comes with the CPU model, the instruction sets detected and the kernel that
+//! produced it. `--correlator avx2` limits the kernels to AVX2 and runs the end-to-end cases
+//! with it; `--correlators-only` times the kernels alone.
+//!
 //! Three measurements, each of the code the receiver runs:
 //! - correlator throughput, Msamples/s on one core, for every kernel this CPU runs
 //!   ([`Correlator::available`]: ISA x arithmetic), input format (ci8, ci16, cf32) and tap count
 //!   (1, 3, 5): 1 ms blocks at 4 MHz (4000 samples), code and carrier generated inside the
-//!   kernel, as tracking calls it; the best of three timed stretches (the least disturbed by
+//!   kernel, as tracking calls it; the best of many 5 ms stretches (the least disturbed by
 //!   other processes);
 //! - the wall time of a 32-PRN cold search (1 ms coherent x 10 non-coherent, +-5 kHz) at
 //!   4 MHz with [`AcquisitionEngine`] on every core, on simulated samples: the median of a
@@ -21,15 +25,14 @@ use crate::commands::simulate::simulate;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
 use gpsrx_dsp::ca_code::CaCode;
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ};
-use gpsrx_dsp::correlator::{
-    correlate, Arithmetic, Correlator, Isa, PackedCode, ReplicaState, SampleSlice,
-};
+use gpsrx_dsp::correlator::{correlate, Correlator, Isa, PackedCode, ReplicaState, SampleSlice};
 use gpsrx_dsp::Prn;
 use gpsrx_receiver::output::FileSink;
 use gpsrx_receiver::{Assistance, Receiver};
 use gpsrx_samples::sim::scenario::ReceiverConfig;
 use gpsrx_samples::sim::Scenario;
 use gpsrx_samples::{open_source, SourceConfig};
+use gpsrx_tracking::{CorrelatorChoice, CorrelatorIsa};
 use num_complex::Complex32;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -65,6 +68,9 @@ pub struct CorrelatorRow {
     pub arithmetic: String,
     /// The kernel's name, e.g. `avx512/i16`.
     pub kernel: String,
+    /// The kernel that ran on this format, e.g. `avx2+fma/i16 (16 lanes)` (an i16
+    /// correlator runs the f32 kernel on cf32).
+    pub runs: String,
     /// Input format: `ci8`, `ci16` or `cf32`.
     pub format: String,
     /// Correlator taps accumulated in one pass.
@@ -123,6 +129,62 @@ pub struct EndToEnd {
     pub peak_rss_reset: bool,
     /// Wall time of the simulation (not part of the run), s.
     pub simulate_s: f64,
+    /// The tracking channels' correlator and the kernel it runs per block format.
+    pub correlator: String,
+}
+
+/// The instruction sets this CPU reports (what the kernels can use).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CpuFeatures {
+    /// AVX2.
+    pub avx2: bool,
+    /// FMA.
+    pub fma: bool,
+    /// AVX-512 F.
+    pub avx512f: bool,
+    /// AVX-512 BW.
+    pub avx512bw: bool,
+}
+
+impl CpuFeatures {
+    fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            Self {
+                avx2: is_x86_feature_detected!("avx2"),
+                fma: is_x86_feature_detected!("fma"),
+                avx512f: is_x86_feature_detected!("avx512f"),
+                avx512bw: is_x86_feature_detected!("avx512bw"),
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            Self {
+                avx2: false,
+                fma: false,
+                avx512f: false,
+                avx512bw: false,
+            }
+        }
+    }
+
+    /// E.g. `AVX2 FMA AVX-512F AVX-512BW`, or `none of AVX2, FMA, AVX-512`.
+    fn describe(&self) -> String {
+        let names: Vec<&str> = [
+            (self.avx2, "AVX2"),
+            (self.fma, "FMA"),
+            (self.avx512f, "AVX-512F"),
+            (self.avx512bw, "AVX-512BW"),
+        ]
+        .into_iter()
+        .filter_map(|(on, n)| on.then_some(n))
+        .collect();
+        if names.is_empty() {
+            "none of AVX2, FMA, AVX-512".into()
+        } else {
+            names.join(" ")
+        }
+    }
 }
 
 /// Everything `gpsrx bench` measured.
@@ -130,16 +192,20 @@ pub struct EndToEnd {
 pub struct BenchReport {
     /// The CPU (`model name` of /proc/cpuinfo).
     pub cpu: String,
+    /// The instruction sets detected.
+    pub cpu_features: CpuFeatures,
+    /// The correlator ceiling of this run (`--correlator`; `auto` without it).
+    pub correlator_ceiling: String,
     /// Logical cores the rayon pool uses.
     pub threads: usize,
     /// Correlator throughput per kernel, format and tap count.
     pub correlators: Vec<CorrelatorRow>,
     /// The scalar reference `gpsrx_dsp::correlator::correlate` (cf32, 3 taps), Msamples/s.
     pub reference_msps_per_core: f64,
-    /// The acquisition measurement (median), ms.
-    pub acquisition_ms: f64,
+    /// The acquisition measurement (median), ms (None with --correlators-only).
+    pub acquisition_ms: Option<f64>,
     /// The acquisition measurement in detail.
-    pub acquisition: AcquisitionBench,
+    pub acquisition: Option<AcquisitionBench>,
     /// End-to-end recording seconds per wall second (None with --no-end-to-end).
     pub realtime_factor: Option<f64>,
     /// The end-to-end run in detail.
@@ -178,9 +244,31 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
         }
     };
 
+    let choice = args.correlator.unwrap_or(CorrelatorChoice {
+        isa: CorrelatorIsa::Auto,
+        arithmetic: None,
+    });
     log("timing the correlator kernels (one core)...");
-    let correlators = bench_correlators(timed_s);
+    let correlators = bench_correlators(timed_s, choice.isa.max_isa());
     let reference_msps_per_core = bench_reference(timed_s);
+    let mut report = BenchReport {
+        cpu: cpu_name(),
+        cpu_features: CpuFeatures::detect(),
+        correlator_ceiling: args.correlator.map_or("auto".into(), |_| {
+            format!("{:?}", choice.isa).to_lowercase()
+        }),
+        threads,
+        correlators,
+        reference_msps_per_core,
+        acquisition_ms: None,
+        acquisition: None,
+        realtime_factor: None,
+        end_to_end: None,
+        weak_end_to_end: None,
+    };
+    if args.correlators_only {
+        return Ok(report);
+    }
 
     let (dir, _tmp) = super::work_dir(args.keep.as_deref())?;
     let mut scenario = Scenario::from_toml(SEOUL_SCENARIO_TOML)?;
@@ -201,50 +289,43 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
 
     log("timing a 32-PRN cold search...");
     let acquisition = bench_acquisition(&sim.data_path, if args.quick { 3 } else { 7 })?;
-    let acquisition_ms = median(&acquisition.runs_ms);
+    report.acquisition_ms = Some(median(&acquisition.runs_ms));
+    report.acquisition = Some(acquisition);
+    if args.no_end_to_end {
+        return Ok(report);
+    }
 
-    let end_to_end = if args.no_end_to_end {
-        None
-    } else {
-        log(&format!(
-            "running the receiver on {} ({:.1} s)...",
-            sim.data_path.display(),
-            scenario.duration_s
-        ));
-        let mut e = timed_run(&scenario, &sim.data_path, &dir.join("run"))?;
-        e.satellites_simulated = sim.satellites.len();
-        e.simulate_s = simulate_s;
-        Some(e)
-    };
-    let weak_end_to_end = if args.no_end_to_end {
-        None
-    } else {
-        let mut weak = Scenario::from_toml(WEAK_SCENARIO_TOML)?;
-        weak.duration_s = 1.5 * duration;
-        let weak_dir = dir.join("weak");
-        log(&format!(
-            "simulating and running the weak-signal case ({:.1} s, {})...",
-            weak.duration_s, weak.description
-        ));
-        let t = Instant::now();
-        let sim = simulate(&weak, Path::new(""), &weak_dir, false)?;
-        let simulate_s = t.elapsed().as_secs_f64();
-        let mut e = timed_run(&weak, &sim.data_path, &weak_dir.join("run"))?;
-        e.satellites_simulated = sim.satellites.len();
-        e.simulate_s = simulate_s;
-        Some(e)
-    };
-    Ok(BenchReport {
-        cpu: cpu_name(),
-        threads,
-        correlators,
-        reference_msps_per_core,
-        acquisition_ms,
-        acquisition,
-        realtime_factor: end_to_end.as_ref().map(|e| e.realtime_factor),
-        end_to_end,
-        weak_end_to_end,
-    })
+    log(&format!(
+        "running the receiver on {} ({:.1} s)...",
+        sim.data_path.display(),
+        scenario.duration_s
+    ));
+    let mut e = timed_run(&scenario, &sim.data_path, &dir.join("run"), args.correlator)?;
+    e.satellites_simulated = sim.satellites.len();
+    e.simulate_s = simulate_s;
+    report.realtime_factor = Some(e.realtime_factor);
+    report.end_to_end = Some(e);
+
+    let mut weak = Scenario::from_toml(WEAK_SCENARIO_TOML)?;
+    weak.duration_s = 1.5 * duration;
+    let weak_dir = dir.join("weak");
+    log(&format!(
+        "simulating and running the weak-signal case ({:.1} s, {})...",
+        weak.duration_s, weak.description
+    ));
+    let t = Instant::now();
+    let sim = simulate(&weak, Path::new(""), &weak_dir, false)?;
+    let simulate_s = t.elapsed().as_secs_f64();
+    let mut e = timed_run(
+        &weak,
+        &sim.data_path,
+        &weak_dir.join("run"),
+        args.correlator,
+    )?;
+    e.satellites_simulated = sim.satellites.len();
+    e.simulate_s = simulate_s;
+    report.weak_end_to_end = Some(e);
+    Ok(report)
 }
 
 /// Seeded random samples in the three formats (the same values: cf32 and ci16 hold the ci8
@@ -294,18 +375,23 @@ fn bench_state() -> ReplicaState {
 }
 
 /// Calls `f` (one block of `n` samples each) for about `timed_s` in all and returns the best
-/// of three stretches in Msamples/s.
+/// stretch in Msamples/s. Stretches last about 5 ms (at least 3 of them): on a machine shared
+/// with other work the shortest time of many short stretches is the least disturbed, the way
+/// `volk_gnsssdr_profile` times a kernel in one burst of a few ms.
 fn throughput(n: usize, timed_s: f64, mut f: impl FnMut()) -> f64 {
+    const STRETCH_S: f64 = 5e-3;
     f(); // warm-up: caches, page faults
+    let stretches = ((timed_s / STRETCH_S).round() as usize).max(3);
+    let stretch_s = timed_s / stretches as f64;
     let mut best = 0.0f64;
-    for _ in 0..3 {
+    for _ in 0..stretches {
         let t = Instant::now();
         let mut calls = 0u64;
-        while t.elapsed().as_secs_f64() < timed_s / 3.0 || calls == 0 {
-            for _ in 0..16 {
+        while t.elapsed().as_secs_f64() < stretch_s || calls == 0 {
+            for _ in 0..4 {
                 f();
             }
-            calls += 16;
+            calls += 4;
         }
         let msps = (calls * n as u64) as f64 / t.elapsed().as_secs_f64() / 1e6;
         best = best.max(msps);
@@ -313,28 +399,16 @@ fn throughput(n: usize, timed_s: f64, mut f: impl FnMut()) -> f64 {
     best
 }
 
-fn isa_name(isa: Isa) -> &'static str {
-    match isa {
-        Isa::Scalar => "scalar",
-        Isa::Avx2Fma => "avx2+fma",
-        Isa::Avx512 => "avx512",
-    }
-}
-
-fn arithmetic_name(a: Arithmetic) -> &'static str {
-    match a {
-        Arithmetic::F32 => "f32",
-        Arithmetic::I16 => "i16",
-    }
-}
-
-/// Every available kernel x format x tap set, on the calling thread.
-fn bench_correlators(timed_s: f64) -> Vec<CorrelatorRow> {
+/// Every available kernel up to `max_isa` x format x tap set, on the calling thread.
+fn bench_correlators(timed_s: f64, max_isa: Isa) -> Vec<CorrelatorRow> {
     let inputs = Inputs::new(BLOCK_SAMPLES);
     let code = PackedCode::new(CaCode::new(prn1()).chips());
     let state = bench_state();
     let mut rows = Vec::new();
-    for k in Correlator::available() {
+    for k in Correlator::available()
+        .into_iter()
+        .filter(|k| k.isa() <= max_isa)
+    {
         for (format, samples) in inputs.slices() {
             for taps in TAP_SETS {
                 let mut out = [Complex32::new(0.0, 0.0); 8];
@@ -351,9 +425,10 @@ fn bench_correlators(timed_s: f64) -> Vec<CorrelatorRow> {
                     black_box(&out);
                 });
                 rows.push(CorrelatorRow {
-                    isa: isa_name(k.isa()).into(),
-                    arithmetic: arithmetic_name(k.arithmetic()).into(),
+                    isa: k.isa().name().into(),
+                    arithmetic: k.arithmetic().name().into(),
                     kernel: k.name(),
+                    runs: k.kernel_for(format, BENCH_FS_HZ),
                     format: format.into(),
                     taps: taps.len(),
                     msps_per_core: msps,
@@ -436,28 +511,39 @@ fn bench_acquisition(file: &Path, runs: usize) -> anyhow::Result<AcquisitionBenc
 
 /// [`bench_end_to_end`] on the recording `file` of `scenario` (its week and, when static,
 /// its antenna position as the truth).
-fn timed_run(scenario: &Scenario, file: &Path, out: &Path) -> anyhow::Result<EndToEnd> {
+fn timed_run(
+    scenario: &Scenario,
+    file: &Path,
+    out: &Path,
+    correlator: Option<CorrelatorChoice>,
+) -> anyhow::Result<EndToEnd> {
     let week = scenario.start_time()?.week;
     let llh = match scenario.receiver {
         ReceiverConfig::Static { llh_deg, .. } => llh_deg,
         _ => None,
     };
-    bench_end_to_end(file, out, week, llh)
+    let mut config = gpsrx_receiver::ReceiverConfig::default();
+    config.run.week = Some(week);
+    if let Some(c) = correlator {
+        config.tracking.correlator = c.isa;
+        if let Some(a) = c.arithmetic {
+            config.tracking.correlator_arithmetic = a;
+        }
+    }
+    bench_end_to_end(file, out, &config, llh)
 }
 
 /// Times the receiver ([`Receiver::run`], what `gpsrx run` does) on `file`.
 fn bench_end_to_end(
     file: &Path,
     out: &Path,
-    week: u32,
+    config: &gpsrx_receiver::ReceiverConfig,
     truth_llh_deg: Option<[f64; 3]>,
 ) -> anyhow::Result<EndToEnd> {
     let src_cfg = SourceConfig::new(file.to_path_buf());
-    let mut config = gpsrx_receiver::ReceiverConfig::default();
-    config.run.week = Some(week);
     let peak_rss_reset = std::fs::write("/proc/self/clear_refs", "5").is_ok();
     let mut source = open_source(&src_cfg)?;
-    let mut receiver = Receiver::new(&config, source.fs_hz(), Assistance::default())?;
+    let mut receiver = Receiver::new(config, source.fs_hz(), Assistance::default())?;
     let mut sink = FileSink::create(out, config.run.rate_hz)?;
     let summary = receiver.run(source.as_mut(), &mut sink)?;
     let fixes = sink.into_fixes();
@@ -487,6 +573,20 @@ fn bench_end_to_end(
         peak_rss_mb,
         peak_rss_reset,
         simulate_s: 0.0,
+        correlator: {
+            let c = config
+                .tracking
+                .correlator
+                .correlator(config.tracking.correlator_arithmetic);
+            let k = |f: &str| c.kernel_for(f, src.fs_hz());
+            format!(
+                "{} (on ci8 blocks {}, ci16 {}, cf32 {})",
+                c.name(),
+                k("ci8"),
+                k("ci16"),
+                k("cf32")
+            )
+        },
     })
 }
 
@@ -521,55 +621,28 @@ fn median(v: &[f64]) -> f64 {
 
 fn print_report(out: &mut dyn Write, r: &BenchReport) -> std::io::Result<()> {
     writeln!(out, "gpsrx bench on {} ({} threads)", r.cpu, r.threads)?;
-    writeln!(out)?;
-    writeln!(out, "correlator throughput, Msamples/s on one core (4000-sample blocks at 4 MHz, code and carrier generated inside):")?;
     writeln!(
         out,
-        "  {:<14} {:<6} {:>9} {:>9} {:>9}",
-        "kernel", "input", "1 tap", "3 taps", "5 taps"
+        "instruction sets: {}; correlator ceiling: {}",
+        r.cpu_features.describe(),
+        r.correlator_ceiling
     )?;
-    let mut keys: Vec<(String, String)> = Vec::new();
-    for c in &r.correlators {
-        let k = (c.kernel.clone(), c.format.clone());
-        if !keys.contains(&k) {
-            keys.push(k);
-        }
-    }
-    for (kernel, format) in &keys {
-        let cell = |taps: usize| {
-            r.correlators
-                .iter()
-                .find(|c| &c.kernel == kernel && &c.format == format && c.taps == taps)
-                .map_or("-".to_string(), |c| format!("{:.0}", c.msps_per_core))
-        };
-        writeln!(
-            out,
-            "  {:<14} {:<6} {:>9} {:>9} {:>9}",
-            kernel,
-            format,
-            cell(1),
-            cell(3),
-            cell(5)
+    writeln!(out)?;
+    print_correlators(out, r)?;
+    if let (Some(a), Some(ms)) = (&r.acquisition, r.acquisition_ms) {
+        writeln!(out)?;
+        writeln!(out, "acquisition: {}-PRN cold search, {} ms x {} non-coherent, +-{:.0} Hz, {:.0} MHz, {} threads: {:.0} ms (median of {}; {} satellites found)",
+            a.prns,
+            a.coherent_ms,
+            a.noncoherent,
+            a.doppler_max_hz,
+            a.fs_hz / 1e6,
+            a.threads,
+            ms,
+            a.runs,
+            a.detected
         )?;
     }
-    writeln!(
-        out,
-        "  (scalar reference correlate(), cf32, 3 taps: {:.0})",
-        r.reference_msps_per_core
-    )?;
-    writeln!(out)?;
-    let a = &r.acquisition;
-    writeln!(out, "acquisition: {}-PRN cold search, {} ms x {} non-coherent, +-{:.0} Hz, {:.0} MHz, {} threads: {:.0} ms (median of {}; {} satellites found)",
-        a.prns,
-        a.coherent_ms,
-        a.noncoherent,
-        a.doppler_max_hz,
-        a.fs_hz / 1e6,
-        a.threads,
-        r.acquisition_ms,
-        a.runs,
-        a.detected
-    )?;
     for (name, e) in [
         ("end to end", &r.end_to_end),
         ("weak signals", &r.weak_end_to_end),
@@ -579,6 +652,46 @@ fn print_report(out: &mut dyn Write, r: &BenchReport) -> std::io::Result<()> {
         }
     }
     Ok(())
+}
+
+/// The correlator table: one line per kernel and format, the kernel that ran at the end.
+fn print_correlators(out: &mut dyn Write, r: &BenchReport) -> std::io::Result<()> {
+    writeln!(out, "correlator throughput, Msamples/s on one core (4000-sample blocks at 4 MHz, code and carrier generated inside):")?;
+    writeln!(
+        out,
+        "  {:<14} {:<6} {:>9} {:>9} {:>9}   ran",
+        "kernel", "input", "1 tap", "3 taps", "5 taps"
+    )?;
+    let mut keys: Vec<(String, String, String)> = Vec::new();
+    for c in &r.correlators {
+        let k = (c.kernel.clone(), c.format.clone(), c.runs.clone());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    for (kernel, format, runs) in &keys {
+        let cell = |taps: usize| {
+            r.correlators
+                .iter()
+                .find(|c| &c.kernel == kernel && &c.format == format && c.taps == taps)
+                .map_or("-".to_string(), |c| format!("{:.0}", c.msps_per_core))
+        };
+        writeln!(
+            out,
+            "  {:<14} {:<6} {:>9} {:>9} {:>9}   {}",
+            kernel,
+            format,
+            cell(1),
+            cell(3),
+            cell(5),
+            runs
+        )?;
+    }
+    writeln!(
+        out,
+        "  (scalar reference correlate(), cf32, 3 taps: {:.0})",
+        r.reference_msps_per_core
+    )
 }
 
 /// One end-to-end run's lines of the report.
@@ -604,6 +717,7 @@ fn print_end_to_end(out: &mut dyn Write, name: &str, e: &EndToEnd) -> std::io::R
             ", mean fix {h:.2} m from the antenna (horizontal)"
         ))
     )?;
+    writeln!(out, "  tracking correlator: {}", e.correlator)?;
     match e.peak_rss_mb {
         Some(m) => writeln!(
             out,

@@ -60,6 +60,8 @@ pub fn default_toml() -> anyhow::Result<String> {
          lost_estimates = {}       # consecutive low estimates that release the channel\n\
          weak_enter_dbhz = {:?}    # below this C/N0 a channel takes [tracking.weak_track], dB-Hz (0: never)\n\
          weak_leave_dbhz = {:?}    # above this it goes back to [tracking.track], dB-Hz\n\
+         correlator = \"{}\"       # widest correlator instruction set: auto, avx512, avx2 or scalar (--correlator)\n\
+         correlator_arithmetic = \"{}\"  # auto (int16 on ci8 with AVX2, else f32), f32 or i16 (--correlator avx2/i16)\n\
          \n\
          # Pull-in loops: 1 ms, wide, FLL-assisted.\n{}\n\
          # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n\
@@ -114,6 +116,8 @@ pub fn default_toml() -> anyhow::Result<String> {
         c.lost_estimates,
         c.weak_enter_dbhz,
         c.weak_leave_dbhz,
+        enum_name(&c.correlator)?,
+        enum_name(&c.correlator_arithmetic)?,
         loops("pull_in", &c.pull_in)?,
         loops("track", &c.track)?,
         loops("weak_track", &c.weak_track.unwrap_or(c.track))?,

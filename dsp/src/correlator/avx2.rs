@@ -7,9 +7,10 @@
 //! (`vpsllvd`), flip the wiped sample's sign by XOR and accumulate. No gathers, no per-sample
 //! branches. The int16 kernel packs the rotator to Q14 int16 pairs and wipes off with `vpmaddwd`.
 
+use super::avx2_ci8;
 use super::kernel::{Arithmetic, SampleSlice};
 use super::packed::PackedCode;
-use super::plan::{code_window, CarrierNco, CODE_LEN_FIX, RESEED_STEPS};
+use super::plan::{code_window, CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
 use super::scalar::Q14;
 use super::simd::{by_taps, bytes_per_sample, dispatch, step_ptr, tail_copy, Job, CF32, CI16, CI8};
 use super::ReplicaState;
@@ -46,6 +47,15 @@ impl Avx2Kernel {
         let nt = taps.len();
         if nt == 0 {
             return true;
+        }
+        if let (Arithmetic::I16, SampleSlice::Ci8(x)) = (arithmetic, samples) {
+            let nco = CodeNco::new(state, fs_hz, taps);
+            if let Some(plan) = avx2_ci8::Ci8Plan::new(&nco, nt) {
+                let carrier = CarrierNco::new(state, fs_hz);
+                // SAFETY: `self` exists only if the CPU check of `new` passed.
+                unsafe { avx2_ci8::correlate(x, code, &nco, &carrier, &plan, out) };
+                return true;
+            }
         }
         let Some(job) = Job::<L>::new(&samples, fs_hz, code, state, taps, CF32_ORDER) else {
             return false;

@@ -40,8 +40,8 @@ impl SampleSlice<'_> {
     }
 }
 
-/// Instruction set of a kernel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Instruction set of a kernel, ordered from the most portable to the widest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Isa {
     /// Portable scalar code (the reference; every CPU).
     Scalar,
@@ -51,8 +51,27 @@ pub enum Isa {
     Avx512,
 }
 
+impl Isa {
+    /// Every instruction set, scalar first.
+    pub const ALL: [Isa; 3] = [Isa::Scalar, Isa::Avx2Fma, Isa::Avx512];
+
+    /// The short name used in kernel names and options: `scalar`, `avx2+fma`, `avx512`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Isa::Scalar => "scalar",
+            Isa::Avx2Fma => "avx2+fma",
+            Isa::Avx512 => "avx512",
+        }
+    }
+
+    /// Whether the running CPU has this instruction set.
+    pub fn is_available(self) -> bool {
+        Correlator::new(self, Arithmetic::F32).is_some()
+    }
+}
+
 /// Arithmetic of a kernel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Arithmetic {
     /// f32 wipe-off and accumulation.
     F32,
@@ -62,9 +81,32 @@ pub enum Arithmetic {
     /// (|w| <= 2^22) are summed as they are; ci16 products are first rounded to multiples of
     /// 2^8 (`(w + 128) >> 8`, at most 2^-7 sample units per sample) to stay within 2^22; the
     /// i32 lane sums are flushed to i64 every 256 vector steps, so nothing overflows. The
-    /// scalar I16 kernel uses the table carrier in Q14 and i64 sums. Cf32 input has no integer
-    /// scale to quantise to: with it, an I16 correlator runs the F32 kernel of the same ISA.
+    /// AVX2 kernel on ci8 (above about 1.1 MHz) works in 16-bit lanes instead: each product
+    /// `I c`, `Q s` is rounded to 2^-7 sample (`vpmulhrsw`), so a wiped sample is off by at
+    /// most `2^-7 sqrt 2` sample units, as with ci16; then `vpmaddwd` with the +-1 code sums
+    /// exactly. At a constant frequency 3 of every 4 of its carrier vectors are the previous
+    /// one rotated in i16, which bounds its carrier error by `4.1e-4` (relative, instead of
+    /// `4.3e-5`). These roundings are far below the noise of any real recording (2^-7 against
+    /// a noise sigma of about 1 or more sample units, -68 dB: < 1e-3 dB of loss). The scalar I16 kernel uses the
+    /// table carrier in Q14 and i64 sums. Cf32 input has no integer scale to quantise to: with
+    /// it, an I16 correlator runs the F32 kernel of the same ISA.
     I16,
+    /// The faster of the two for each block's format: I16 on ci8 where the CPU has AVX2 (the
+    /// AVX2 16-lane kernel, faster on ci8 than the AVX-512 ones too; its accuracy is I16's),
+    /// F32 on ci16 and cf32 and on a CPU without AVX2. Never listed by
+    /// [`Correlator::available`]: it picks among those.
+    Auto,
+}
+
+impl Arithmetic {
+    /// The short name: `f32` or `i16`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Arithmetic::F32 => "f32",
+            Arithmetic::I16 => "i16",
+            Arithmetic::Auto => "auto",
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -81,17 +123,31 @@ enum Kernel {
 pub struct Correlator {
     kernel: Kernel,
     arithmetic: Arithmetic,
+    /// The AVX2 kernel when the CPU has it and `kernel`'s ISA is AVX2 or wider: what
+    /// [`Arithmetic::Auto`] runs on ci8.
+    #[cfg(target_arch = "x86_64")]
+    avx2: Option<Avx2Kernel>,
 }
 
 impl Correlator {
     /// The fastest f32 kernel this CPU runs (AVX-512, else AVX2+FMA, else scalar).
     pub fn best() -> Self {
-        [Isa::Avx512, Isa::Avx2Fma]
+        Self::best_up_to(Isa::Avx512, Arithmetic::F32)
+    }
+
+    /// The fastest kernel of `arithmetic` whose instruction set is at most `max_isa` and that
+    /// this CPU runs (e.g. `Isa::Avx2Fma` times an AVX2-only machine on an AVX-512 one).
+    pub fn best_up_to(max_isa: Isa, arithmetic: Arithmetic) -> Self {
+        Isa::ALL
             .into_iter()
-            .find_map(|isa| Self::new(isa, Arithmetic::F32))
+            .rev()
+            .filter(|&isa| isa <= max_isa)
+            .find_map(|isa| Self::new(isa, arithmetic))
             .unwrap_or(Self {
                 kernel: Kernel::Scalar,
-                arithmetic: Arithmetic::F32,
+                arithmetic,
+                #[cfg(target_arch = "x86_64")]
+                avx2: None,
             })
     }
 
@@ -106,7 +162,15 @@ impl Correlator {
             #[cfg(not(target_arch = "x86_64"))]
             Isa::Avx2Fma | Isa::Avx512 => None,
         }?;
-        Some(Self { kernel, arithmetic })
+        Some(Self {
+            kernel,
+            arithmetic,
+            #[cfg(target_arch = "x86_64")]
+            avx2: match kernel {
+                Kernel::Scalar => None,
+                _ => Avx2Kernel::new(),
+            },
+        })
     }
 
     /// Every kernel this CPU runs, scalar first.
@@ -139,16 +203,41 @@ impl Correlator {
 
     /// A short name, e.g. `"avx512/f32"`, `"avx2+fma/i16"`.
     pub fn name(&self) -> String {
-        let isa = match self.isa() {
-            Isa::Scalar => "scalar",
-            Isa::Avx2Fma => "avx2+fma",
-            Isa::Avx512 => "avx512",
+        format!("{}/{}", self.isa().name(), self.arithmetic.name())
+    }
+
+    /// The kernel that actually runs on `format` (`"ci8"`, `"ci16"` or `"cf32"`) at `fs_hz`,
+    /// e.g. `"avx2+fma/i16 (16 lanes)"`: an I16 correlator runs the F32 kernel on cf32, and
+    /// the AVX2 I16 one has a 16-lane kernel for ci8 from about 1.1 MHz.
+    pub fn kernel_for(&self, format: &str, fs_hz: f64) -> String {
+        let (isa, arithmetic) = match (self.arithmetic, format) {
+            (Arithmetic::I16, "cf32") => (self.isa(), Arithmetic::F32),
+            (Arithmetic::Auto, "ci8") if self.isa() >= Isa::Avx2Fma => {
+                (Isa::Avx2Fma, Arithmetic::I16)
+            }
+            (Arithmetic::Auto, _) => (self.isa(), Arithmetic::F32),
+            (a, _) => (self.isa(), a),
         };
-        let arith = match self.arithmetic {
-            Arithmetic::F32 => "f32",
-            Arithmetic::I16 => "i16",
+        let lanes = match (isa, arithmetic, format) {
+            (Isa::Scalar, _, _) => "",
+            (Isa::Avx2Fma, Arithmetic::I16, "ci8") if fs_hz >= 1.1e6 => " (16 lanes)",
+            (Isa::Avx2Fma, _, _) => " (8 lanes)",
+            (Isa::Avx512, _, _) => " (16 lanes)",
         };
-        format!("{isa}/{arith}")
+        format!("{}/{}{lanes}", isa.name(), arithmetic.name())
+    }
+
+    /// The kernel and arithmetic a block of `samples` runs ([`Arithmetic::Auto`] resolved).
+    fn resolve(&self, samples: &SampleSlice<'_>) -> (Kernel, Arithmetic) {
+        match (self.arithmetic, samples) {
+            #[cfg(target_arch = "x86_64")]
+            (Arithmetic::Auto, SampleSlice::Ci8(_)) => match self.avx2 {
+                Some(k) => (Kernel::Avx2(k), Arithmetic::I16),
+                None => (self.kernel, Arithmetic::F32),
+            },
+            (Arithmetic::Auto, _) => (self.kernel, Arithmetic::F32),
+            (a, _) => (self.kernel, a),
+        }
     }
 
     /// Correlates `samples` with the replica of `code` described by `state`, one sum per entry
@@ -189,23 +278,22 @@ impl Correlator {
             out.fill(Complex32::new(f32::NAN, f32::NAN));
             return;
         }
+        let (kernel, arithmetic) = self.resolve(&samples);
         for (taps, out) in tap_offsets_chips
             .chunks(MAX_TAPS)
             .zip(out.chunks_mut(MAX_TAPS))
         {
-            let done = match self.kernel {
+            let done = match kernel {
                 Kernel::Scalar => false,
                 #[cfg(target_arch = "x86_64")]
-                Kernel::Avx2(k) => {
-                    k.correlate(self.arithmetic, samples, fs_hz, code, state, taps, out)
-                }
+                Kernel::Avx2(k) => k.correlate(arithmetic, samples, fs_hz, code, state, taps, out),
                 #[cfg(target_arch = "x86_64")]
                 Kernel::Avx512(k) => {
-                    k.correlate(self.arithmetic, samples, fs_hz, code, state, taps, out)
+                    k.correlate(arithmetic, samples, fs_hz, code, state, taps, out)
                 }
             };
             if !done {
-                scalar_kernel(self.arithmetic, samples, fs_hz, code, state, taps, out);
+                scalar_kernel(arithmetic, samples, fs_hz, code, state, taps, out);
             }
         }
     }
@@ -223,17 +311,14 @@ fn scalar_kernel(
     let chips = code.chips();
     match (arithmetic, samples) {
         (_, SampleSlice::Cf32(x)) => scalar::correlate_f32(x, fs_hz, chips, state, taps, out),
-        (Arithmetic::F32, SampleSlice::Ci16(x)) => {
-            scalar::correlate_f32(x, fs_hz, chips, state, taps, out)
-        }
-        (Arithmetic::F32, SampleSlice::Ci8(x)) => {
-            scalar::correlate_f32(x, fs_hz, chips, state, taps, out)
-        }
         (Arithmetic::I16, SampleSlice::Ci16(x)) => {
             scalar::correlate_i16(x, fs_hz, chips, state, taps, out)
         }
         (Arithmetic::I16, SampleSlice::Ci8(x)) => {
             scalar::correlate_i16(x, fs_hz, chips, state, taps, out)
         }
+        // F32 (and an unresolved Auto: `resolve` never passes one).
+        (_, SampleSlice::Ci16(x)) => scalar::correlate_f32(x, fs_hz, chips, state, taps, out),
+        (_, SampleSlice::Ci8(x)) => scalar::correlate_f32(x, fs_hz, chips, state, taps, out),
     }
 }

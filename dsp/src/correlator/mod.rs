@@ -14,7 +14,10 @@
 //!   or cf32 samples directly ([`SampleSlice`]). The SIMD kernels (AVX2+FMA, AVX-512) generate
 //!   the carrier with a vectorised rotator seeded exactly (f64) at the start of every call and
 //!   every 256 vector steps, and the code replicas from a bit-packed code ([`PackedCode`]) with
-//!   the same 2^-32-chip code NCO as the reference, so their chips agree with it exactly.
+//!   the same 2^-32-chip code NCO as the reference, so their chips agree with it exactly. The
+//!   AVX2 int16 kernel on ci8 works on 16 samples in 16-bit lanes (`vpmulhrsw` wipe-off, the
+//!   code looked up with `vpshufb` from a byte per chip): about 2.5 times fewer instructions
+//!   than the 8-lane kernels (6.0 per sample with 3 taps).
 //!
 //! Build a [`Correlator`] once (e.g. [`Correlator::best`]) and a [`PackedCode`] once per PRN,
 //! then call [`Correlator::correlate_packed`] per block: it allocates nothing.
@@ -28,6 +31,8 @@ mod simd;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+#[cfg(target_arch = "x86_64")]
+mod avx2_ci8;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
 

@@ -138,6 +138,12 @@ impl CarrierNco {
         self.phi0 + (ak - ak.floor()) + (bk - bk.floor())
     }
 
+    /// The phasor of `n` samples at the initial frequency, `exp(-j 2 pi a n)` (re, im).
+    pub fn step_phasor(&self, n: usize) -> (f64, f64) {
+        let d = cis_neg(self.a * n as f64);
+        (d.re, d.im)
+    }
+
     /// The chirp phasor `Q = exp(-j 2 pi 2 b L^2)` as f32 (re, im).
     pub fn chirp<const L: usize>(&self) -> (f32, f32) {
         let l = L as f64;
@@ -148,8 +154,20 @@ impl CarrierNco {
     /// Seeds for the vector step starting at sample `k0`: lane `j` at sample `k0 + order[j]`,
     /// `P` scaled by `scale`. Natural-order lanes by f64 recurrences (3 sin/cos in all).
     pub fn seed<const L: usize>(&self, k0: usize, order: &[usize; L], scale: f64) -> Seed<L> {
+        self.seed_stride(k0, order, scale, L)
+    }
+
+    /// [`CarrierNco::seed`] with step phasors `D` for an advance of `stride` samples (a
+    /// multiple of `L` when one rotator step serves several vector steps).
+    pub fn seed_stride<const L: usize>(
+        &self,
+        k0: usize,
+        order: &[usize; L],
+        scale: f64,
+        stride: usize,
+    ) -> Seed<L> {
         let k = k0 as f64;
-        let l = L as f64;
+        let l = stride as f64;
         let mut p = cis_neg(self.phase(k)) * scale;
         // phi(k+1) - phi(k) = a + (2k + 1) b, growing by 2b per sample.
         let mut e = cis_neg(self.a + (2.0 * k + 1.0) * self.b);

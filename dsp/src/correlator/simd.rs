@@ -139,13 +139,14 @@ macro_rules! dispatch {
                     f32_kernel::<CF32>(x.as_ptr().cast(), x.len(), $job, $out)
                 )
             }
-            (Arithmetic::F32, SampleSlice::Ci16(x)) => {
+            // F32 (and an unresolved Auto, which `Correlator` never passes).
+            (_, SampleSlice::Ci16(x)) => {
                 by_taps!(
                     $nt,
                     f32_kernel::<CI16>(x.as_ptr().cast(), x.len(), $job, $out)
                 )
             }
-            (Arithmetic::F32, SampleSlice::Ci8(x)) => {
+            (_, SampleSlice::Ci8(x)) => {
                 by_taps!(
                     $nt,
                     f32_kernel::<CI8>(x.as_ptr().cast(), x.len(), $job, $out)
