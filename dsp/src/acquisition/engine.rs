@@ -87,7 +87,7 @@ impl AcquisitionEngine {
         let inv = planner.plan_fft_inverse(layout.inv_len);
         let fine_len = (8 * config.refine_ms as usize).next_power_of_two().max(256);
         let fine = planner.plan_fft_forward(fine_len);
-        let fwd_replica = planner.plan_fft_forward(layout.spec_len);
+        let fwd_replica = planner.plan_fft_forward(layout.replica_len);
         let (replicas, replica_power) = replica_spectra(&layout, fs_hz, &fwd_replica);
         let wipeoffs = fractional_wipeoffs(&layout);
         Ok(Self {
