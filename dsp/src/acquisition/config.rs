@@ -145,14 +145,28 @@ pub(crate) fn is_fast_len(mut n: usize) -> bool {
 /// The inverse FFT length for a decimated block spectrum of `spec_len` bins (one code
 /// period): the smallest fast length ([`is_fast_len`]) at least `spec_len` (the spectrum
 /// zero-padded: band-limited interpolation, nothing lost), at most [`SEARCH_SAMPLES_PER_MS`]
-/// (the spectrum truncated to its lowest frequencies).
+/// (the spectrum truncated to its lowest frequencies); but the power of two above it when that
+/// is at most [`POW2_MARGIN`] longer, since powers of two run 20 % faster per point than
+/// lengths with factors of 5 (4 MHz: 4000 -> 4096; measured on AVX2, 4000 points 1.4 ns per
+/// point, 4096 1.1: the 4000-point transform, radix 5 and a transpose, was 64 % of a 10 ms x
+/// 50 search).
 pub(crate) fn search_len(spec_len: usize) -> usize {
     let cap = SEARCH_SAMPLES_PER_MS;
     if spec_len >= cap {
         return cap;
     }
-    (spec_len..cap).find(|&n| is_fast_len(n)).unwrap_or(cap)
+    let fast = (spec_len..cap).find(|&n| is_fast_len(n)).unwrap_or(cap);
+    let pow2 = spec_len.next_power_of_two();
+    if pow2 <= cap && pow2 as f64 <= fast as f64 * POW2_MARGIN {
+        pow2
+    } else {
+        fast
+    }
 }
+
+/// How much longer than the smallest fast length a power-of-two search length may be (see
+/// [`search_len`]).
+pub(crate) const POW2_MARGIN: f64 = 1.05;
 
 /// Where the coherent blocks lie and how the FFT correlation is organised; derived from the
 /// sampling rate and an [`AcqConfig`].

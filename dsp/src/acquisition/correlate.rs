@@ -87,7 +87,20 @@ impl AcquisitionEngine {
         s.grid.resize(rows * lags, 0.0);
         let replica = &self.replicas[prn.index()];
         let starts = &l.block_start_ms[pass];
-        for (row, bin) in (b0..=b1).enumerate() {
+        // Rows in the order of the spectrum slices they read (fractional offset q, residue r):
+        // the rows of one slice set (every Q D-th bin: 10 of 201 with 10 ms blocks) follow
+        // each other while its blocks' slices (1.6 MB at 4 MHz x 50 blocks) are in cache,
+        // instead of every row streaming them from memory (the spectra of a 10 ms x 50 search
+        // take 32 MB at 4 MHz).
+        s.rows.clear();
+        s.rows.extend((b0..=b1).enumerate().map(|(row, bin)| {
+            let q = bin.rem_euclid(q_total as i64) as usize;
+            let (r, _) = l.residue_rotation((bin - q as i64) / q_total as i64);
+            (q * l.decimation + r, row, bin)
+        }));
+        s.rows.sort_unstable();
+        for i in 0..s.rows.len() {
+            let (_, row, bin) = s.rows[i];
             let q = bin.rem_euclid(q_total as i64) as usize;
             let k = (bin - q as i64) / q_total as i64;
             let (r, a) = l.residue_rotation(k);

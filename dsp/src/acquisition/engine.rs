@@ -23,6 +23,8 @@ pub(super) struct Scratch {
     pub(super) buf: Vec<Complex32>,
     pub(super) fft: Vec<Complex32>,
     pub(super) grid: Vec<f32>,
+    /// Grid rows in the order they are filled: (slice set, row, Doppler bin).
+    pub(super) rows: Vec<(usize, usize, i64)>,
     epl: [Vec<Complex64>; 3],
     fine: Vec<Complex32>,
     floors: Vec<f64>,

@@ -272,8 +272,10 @@ fn grid_is_the_band_limited_correlation() {
 #[test]
 fn search_lengths() {
     for &(fs, ms, spec, inv) in &[
-        (4.0e6, 1u32, 4000usize, 4000usize),
-        (4.0e6, 10, 4000, 4000),
+        (4.0e6, 1u32, 4000usize, 4096usize),
+        (4.0e6, 10, 4000, 4096),
+        (4.092e6, 1, 4092, 4096),
+        (3.2e6, 1, 3200, 3200),
         (2.048e6, 1, 2048, 2048),
         (2.6e6, 1, 2600, 2688),
         (1.023e6, 1, 1023, 1024),
@@ -563,7 +565,7 @@ fn finds_signals_at_front_end_rates() {
     }
 }
 
-/// False alarms on pure noise at 4 MHz (the spectrum kept as it is), 12 MHz (truncated to the
+/// False alarms on pure noise at 4 MHz (4000 bins padded to 4096), 12 MHz (truncated to the
 /// 4096 lowest bins per ms) and 2.6 MHz (zero-padded from 2600 to 2688 bins): the rate per PRN
 /// search must match the configured pfa, since the threshold is set by the union bound over the
 /// search's cells (Doppler bins x search lags) and the search lags are about 4 per chip at any
