@@ -148,6 +148,12 @@ impl AcquisitionEngine {
         self.layout.samples_needed.max(refine as usize)
     }
 
+    /// Search lags per code period: the length of the inverse FFTs, one per block, Doppler bin
+    /// and PRN (nearly all the work of a search).
+    pub fn search_lags(&self) -> usize {
+        self.layout.n_lags
+    }
+
     /// Coherent block duration T, s.
     pub fn coherent_s(&self) -> f64 {
         self.layout.t_block_s(self.fs_hz)

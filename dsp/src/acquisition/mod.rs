@@ -126,7 +126,9 @@ mod refine;
 mod replica;
 pub mod stats;
 
-pub use config::{AcqConfig, AcqError, MAX_COHERENT_MS, MAX_DOPPLER_SUBDIVISION};
+pub use config::{
+    AcqConfig, AcqError, MAX_COHERENT_MS, MAX_DOPPLER_SUBDIVISION, SEARCH_SAMPLES_PER_MS,
+};
 pub use engine::AcquisitionEngine;
 
 use crate::Prn;

@@ -271,34 +271,87 @@ fn grid_is_the_band_limited_correlation() {
 /// next fast length below that, 4096 per ms above.
 #[test]
 fn search_lengths() {
-    for &(fs, ms, spec, inv) in &[
-        (4.0e6, 1u32, 4000usize, 4096usize),
-        (4.0e6, 10, 4000, 4096),
-        (4.092e6, 1, 4092, 4096),
-        (3.2e6, 1, 3200, 3200),
-        (2.048e6, 1, 2048, 2048),
-        (2.6e6, 1, 2600, 2688),
-        (1.023e6, 1, 1023, 1024),
-        (5.0e6, 1, 5000, 4096),
-        (12.0e6, 4, 12000, 4096),
-        (16.368e6, 1, 16368, 4096),
-        (25.0e6, 1, 25000, 4096),
-        (12.000_1e6, 2, 12000, 4096),
-        (16.3676e6, 10, 16368, 4096),
-        (2.047_9e6, 10, 2048, 2048),
+    let full = SEARCH_SAMPLES_PER_MS;
+    for &(fs, ms, cap, spec, inv) in &[
+        (4.0e6, 1u32, full, 4000usize, 4096usize),
+        (4.0e6, 10, full, 4000, 4096),
+        (4.092e6, 1, full, 4092, 4096),
+        (3.2e6, 1, full, 3200, 3200),
+        (2.048e6, 1, full, 2048, 2048),
+        (2.6e6, 1, full, 2600, 2688),
+        (1.023e6, 1, full, 1023, 1024),
+        (5.0e6, 1, full, 5000, 4096),
+        (12.0e6, 4, full, 12000, 4096),
+        (16.368e6, 1, full, 16368, 4096),
+        (25.0e6, 1, full, 25000, 4096),
+        (12.000_1e6, 2, full, 12000, 4096),
+        (16.3676e6, 10, full, 16368, 4096),
+        (2.047_9e6, 10, full, 2048, 2048),
+        // Half the lags: everything from 2.048 MHz up searched at 2048 lags.
+        (4.0e6, 10, 2048, 4000, 2048),
+        (2.6e6, 10, 2048, 2600, 2048),
+        (2.048e6, 10, 2048, 2048, 2048),
+        (1.5e6, 1, 2048, 1500, 1536),
     ] {
         let e = engine(
             fs,
             AcqConfig {
                 coherent_ms: ms,
+                search_lags_per_ms: cap,
                 ..AcqConfig::default()
             },
         );
         let l = &e.layout;
         assert_eq!((l.spec_len, l.inv_len), (spec, inv), "fs {fs} ms {ms}");
+        assert_eq!(e.search_lags(), inv);
         assert_eq!(l.keep_pos + l.keep_neg, spec.min(inv));
         let per_lag = l.block_len as f64 / (f64::from(ms) * inv as f64);
         assert!((l.lag_samples - per_lag).abs() < 1e-12, "fs {fs} ms {ms}");
+    }
+}
+
+/// With half the lags (2048 per ms: +-1.024 MHz, two lags per chip) 10 ms x 6 blocks still find
+/// a 35 dB-Hz signal at 4, 12 and 16.3676 MHz, the grid's code phase within a quarter chip
+/// (half a lag) and the refined one within 0.1 chip (3.5 sigma of early-late half a chip apart
+/// over 100 ms at 35 dB-Hz), the Doppler within 10 Hz.
+#[test]
+fn half_the_lags_finds_signals_at_any_rate() {
+    for &(fs, seed) in &[(4.0e6, 41u64), (12.0e6, 42), (16.3676e6, 43)] {
+        let sig = Sig {
+            prn: 19,
+            tau: 0.3141 * fs * 1e-3,
+            doppler_hz: -2_345.0,
+            cn0_dbhz: 35.0,
+        };
+        for refine_ms in [0, 100] {
+            let e = engine(
+                fs,
+                AcqConfig {
+                    coherent_ms: 10,
+                    noncoherent: 6,
+                    bit_edge_offsets: Some(false),
+                    search_lags_per_ms: 2048,
+                    refine_ms,
+                    ..AcqConfig::default()
+                },
+            );
+            let x = synth(fs, e.samples_wanted(), std::slice::from_ref(&sig), seed);
+            let r = &e
+                .search(&x, &[SearchTarget::full(prn(19))])
+                .unwrap_or_else(|err| panic!("{err}"))[0];
+            assert!(r.detected, "fs {fs}: {r:?}");
+            let chips = (r.code_phase_samples - sig.tau).abs() * CA_CHIP_RATE_HZ / fs;
+            let want = if refine_ms == 0 { 0.25 } else { 0.1 };
+            assert!(
+                chips < want,
+                "fs {fs} refine {refine_ms}: {chips} chip, {r:?}"
+            );
+            let dop = if refine_ms == 0 { 25.0 } else { 10.0 };
+            assert!(
+                (r.doppler_hz - sig.doppler_hz).abs() < dop,
+                "fs {fs}: {r:?}"
+            );
+        }
     }
 }
 
@@ -437,6 +490,18 @@ fn bad_settings_and_short_input_are_errors() {
         },
         AcqConfig {
             doppler_max_hz: f64::INFINITY,
+            ..AcqConfig::default()
+        },
+        AcqConfig {
+            search_lags_per_ms: 5000,
+            ..AcqConfig::default()
+        },
+        AcqConfig {
+            search_lags_per_ms: 1000,
+            ..AcqConfig::default()
+        },
+        AcqConfig {
+            search_lags_per_ms: 4100,
             ..AcqConfig::default()
         },
     ];
