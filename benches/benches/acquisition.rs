@@ -8,9 +8,14 @@
 //! input samples read (10 ms): the grid runs at a fast FFT length of at most 4096 lags per ms
 //! whatever the rate, so 12 to 25 MHz must cost about what 4 MHz does (target: under 300 ms).
 //! `cargo run -p gpsrx-dsp --example acq_rates --release` prints the same as a table.
+//! 16.3676 MHz (the GN3S sampler) has no whole number of samples per code period.
+//!
+//! The weak background level (`acquisition_weak`): 10 ms x 50 in one pass over +-5 kHz (201
+//! bins), 4 MHz, the 20 PRNs a 12-satellite sky leaves absent.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
+use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine, SearchTarget};
+use gpsrx_dsp::Prn;
 use num_complex::Complex32;
 
 /// 10 ms at 4 MHz: unit-variance noise (SplitMix64 + Box-Muller) and three satellites at
@@ -49,7 +54,7 @@ fn bench_cold_search(c: &mut Criterion) {
 fn bench_rates(c: &mut Criterion) {
     let mut group = c.benchmark_group("acquisition_rates");
     group.sample_size(10);
-    for mhz in [2.6, 4.0, 12.0, 16.368, 24.0] {
+    for mhz in [2.6, 4.0, 12.0, 16.368, 16.3676, 20.0, 24.0] {
         let fs = mhz * 1e6;
         let engine = match AcquisitionEngine::new(fs, AcqConfig::default()) {
             Ok(e) => e,
@@ -67,5 +72,35 @@ fn bench_rates(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_cold_search, bench_rates);
+fn bench_weak_level(c: &mut Criterion) {
+    let fs = 4.0e6;
+    let config = AcqConfig {
+        coherent_ms: 10,
+        noncoherent: 50,
+        bit_edge_offsets: Some(false),
+        refine_ms: 0,
+        ..AcqConfig::default()
+    };
+    let engine = match AcquisitionEngine::new(fs, config) {
+        Ok(e) => e,
+        Err(e) => panic!("{e}"),
+    };
+    let x = samples(engine.samples_wanted(), fs);
+    let targets: Vec<SearchTarget> = (13u8..=32)
+        .filter_map(|p| Prn::new(p).ok())
+        .map(SearchTarget::full)
+        .collect();
+    let mut group = c.benchmark_group("acquisition_weak");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(targets.len() as u64));
+    group.bench_function("20prn_10msx50_one_pass_pm5kHz_4MHz", |b| {
+        b.iter(|| match engine.search(&x, &targets) {
+            Ok(r) => r,
+            Err(e) => panic!("{e}"),
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_cold_search, bench_rates, bench_weak_level);
 criterion_main!(benches);

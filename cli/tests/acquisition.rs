@@ -240,10 +240,30 @@ fn real_cttc_large_lo_offset() {
 
 const FS: f64 = 4.0e6;
 
+/// The recording's sample format and rates.
+#[derive(Debug, Clone, Copy)]
+struct Output {
+    format: &'static str,
+    fs_hz: f64,
+    if_hz: f64,
+}
+
+/// ci8 complex baseband at 4 MHz (the default of these tests).
+const CI8_4MHZ: Output = Output {
+    format: "ci8",
+    fs_hz: FS,
+    if_hz: 0.0,
+};
+
 /// A static receiver in Seoul on 2022-01-01, ci8 at 4 MHz, perfect clock, every satellite above
 /// 5 deg at `cn0` dB-Hz. Different `k` start 15 min apart (other satellites, Dopplers and code
 /// phases) with another noise seed.
 fn scenario(k: u64, cn0: f64, duration_s: f64) -> Scenario {
+    scenario_as(k, cn0, duration_s, CI8_4MHZ)
+}
+
+/// [`scenario`] written as `out`.
+fn scenario_as(k: u64, cn0: f64, duration_s: f64, out: Output) -> Scenario {
     let text = format!(
         r#"
 duration_s = {duration_s}
@@ -253,8 +273,9 @@ nav = "builtin:brdc0010.22n"
 week = 2190
 tow_s = {tow}
 [output]
-format = "ci8"
-fs_hz = {FS}
+format = "{format}"
+fs_hz = {fs_hz}
+if_hz = {if_hz}
 [receiver]
 kind = "static"
 llh_deg = [37.5665, 126.9780, 40.0]
@@ -264,6 +285,9 @@ cn0_all_dbhz = {cn0}
 "#,
         seed = 1000 + k,
         tow = 538_194.0 + 900.0 * k as f64,
+        format = out.format,
+        fs_hz = out.fs_hz,
+        if_hz = out.if_hz,
     );
     Scenario::from_toml(&text).unwrap_or_else(|e| panic!("scenario: {e}"))
 }
@@ -276,9 +300,9 @@ struct Truth {
     doppler_hz: f64,
 }
 
-/// Reads the t = 0 rows of truth_sv.csv; the code phase in samples is where the next C/A period
-/// starts: (1023 - code_phase_chips) / code_rate * fs.
-fn truth_at_start(path: &Path) -> Vec<Truth> {
+/// Reads the t = 0 rows of truth_sv.csv of a recording at `fs` Hz; the code phase in samples is
+/// where the next C/A period starts: (1023 - code_phase_chips) / code_rate * fs.
+fn truth_at_start(path: &Path, fs: f64) -> Vec<Truth> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
@@ -302,7 +326,7 @@ fn truth_at_start(path: &Path) -> Vec<Truth> {
         .filter(|f| num(f[t]) == 0.0 && f[on] == "1")
         .map(|f| Truth {
             prn: num(f[prn]) as u8,
-            code_phase_samples: (1023.0 - num(f[chips])).rem_euclid(1023.0) / num(f[rate]) * FS,
+            code_phase_samples: (1023.0 - num(f[chips])).rem_euclid(1023.0) / num(f[rate]) * fs,
             doppler_hz: num(f[dop]),
         })
         .collect()
@@ -311,13 +335,23 @@ fn truth_at_start(path: &Path) -> Vec<Truth> {
 /// Simulates scenario `k` into a temporary folder; returns the folder, the recording and the
 /// truth at t = 0.
 fn simulate(k: u64, cn0: f64, duration_s: f64) -> (tempfile::TempDir, String, Vec<Truth>) {
+    simulate_as(k, cn0, duration_s, CI8_4MHZ)
+}
+
+/// [`simulate`] written as `out`.
+fn simulate_as(
+    k: u64,
+    cn0: f64,
+    duration_s: f64,
+    out: Output,
+) -> (tempfile::TempDir, String, Vec<Truth>) {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let sim = Simulator::new(&scenario(k, cn0, duration_s), Path::new("."))
+    let sim = Simulator::new(&scenario_as(k, cn0, duration_s, out), Path::new("."))
         .unwrap_or_else(|e| panic!("{e}"));
     let rep = sim
         .run(dir.path(), &|_| {})
         .unwrap_or_else(|e| panic!("{e}"));
-    let truth = truth_at_start(&rep.truth_sv_path);
+    let truth = truth_at_start(&rep.truth_sv_path, out.fs_hz);
     (dir, rep.data_path.to_string_lossy().to_string(), truth)
 }
 
@@ -435,6 +469,62 @@ fn simulated_32dbhz_weak_signal_setting() {
     assert!(tally.hits * 100 >= tally.trials * 90, "{tally:?}");
     assert!(max_err < 25.0, "refined Doppler error up to {max_err} Hz");
     assert!((cn0 - 32.0).abs() < 1.5, "mean C/N0 {cn0}");
+}
+
+/// Front-end rates other than 4 MHz, against the simulator's truth: 16.368 MHz real IF (ri8,
+/// IF 4.092 MHz, the MAX2769/SiGe configuration: mixed down, 16368 samples per period searched
+/// in its 4096 lowest bins) and 24 MHz complex (ci8). Every satellite simulated (40 dB-Hz) is
+/// found by the default 1 ms x 10 search, its code phase within half a sample at 4.092 MHz
+/// (1/8 chip, half a 4 MHz search lag), its Doppler within 25 Hz after refinement (a tenth of
+/// the 250 Hz half bin), and no PRN is reported that was not simulated.
+#[test]
+fn simulated_front_end_rates_real_if_and_complex() {
+    let cases = [
+        Output {
+            format: "ri8",
+            fs_hz: 16.368e6,
+            if_hz: 4.092e6,
+        },
+        Output {
+            format: "ci8",
+            fs_hz: 24.0e6,
+            if_hz: 0.0,
+        },
+    ];
+    for (k, out) in [(4u64, cases[0]), (5, cases[1])] {
+        let (_dir, file, truth) = simulate_as(k, 40.0, 0.12, out);
+        let (fs, if_hz) = (out.fs_hz.to_string(), out.if_hz.to_string());
+        let report = run(&[&file, "--format", out.format, "--fs", &fs, "--if", &if_hz]);
+        let period = out.fs_hz * 1e-3;
+        for t in &truth {
+            let r = report
+                .rows
+                .iter()
+                .find(|r| r.prn.get() == t.prn)
+                .unwrap_or_else(|| panic!("{out:?}: G{:02} simulated, not found", t.prn));
+            let chips =
+                code_err(r.code_phase_samples, t.code_phase_samples, period) * 1.023e6 / out.fs_hz;
+            println!(
+                "{} {:.3} MHz G{:02}: code error {chips:.4} chip, Doppler error {:.2} Hz, \
+                 C/N0 {:?}",
+                out.format,
+                out.fs_hz * 1e-6,
+                t.prn,
+                r.doppler_hz - t.doppler_hz,
+                r.cn0_dbhz
+            );
+            assert!(r.detected, "{out:?}: {r:?}");
+            assert!(chips <= 0.125, "{out:?}: {chips} chip {r:?}");
+            assert!((r.doppler_hz - t.doppler_hz).abs() < 25.0, "{out:?}: {r:?}");
+        }
+        for r in report.rows.iter().filter(|r| r.detected) {
+            assert!(
+                truth.iter().any(|t| t.prn == r.prn.get()),
+                "{out:?}: {} reported, not simulated",
+                r.prn
+            );
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -25,11 +25,16 @@ fn main() {
         .skip(1)
         .filter_map(|a| a.parse::<f64>().ok())
         .collect();
-    // ACQ_REFINE_MS=0 times the grid search alone.
-    let refine_ms = std::env::var("ACQ_REFINE_MS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(AcqConfig::default().refine_ms);
+    // ACQ_REFINE_MS=0 times the grid search alone; ACQ_COHERENT_MS, ACQ_NONCOHERENT and
+    // ACQ_BIT_EDGES=0 time another search (e.g. the background levels: 10, 50, 0);
+    // ACQ_RUNS the number of timed searches (7).
+    let env = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<u32>().ok());
+    let base = AcqConfig::default();
+    let refine_ms = env("ACQ_REFINE_MS").unwrap_or(base.refine_ms);
+    let coherent_ms = env("ACQ_COHERENT_MS").unwrap_or(base.coherent_ms);
+    let noncoherent = env("ACQ_NONCOHERENT").unwrap_or(base.noncoherent);
+    let bit_edge_offsets = env("ACQ_BIT_EDGES").map(|b| b != 0);
+    let runs = env("ACQ_RUNS").unwrap_or(7).max(1) as usize;
     let rates = if args.is_empty() {
         vec![2.048, 2.6, 4.0, 5.0, 12.0, 16.368, 20.0, 24.0, 25.0]
     } else {
@@ -52,6 +57,9 @@ fn main() {
             fs,
             AcqConfig {
                 refine_ms,
+                coherent_ms,
+                noncoherent,
+                bit_edge_offsets,
                 ..AcqConfig::default()
             },
         ) {
@@ -67,7 +75,7 @@ fn main() {
         run();
         let mut times = Vec::new();
         let mut found = 0;
-        for _ in 0..7 {
+        for _ in 0..runs {
             let t = Instant::now();
             let r = run();
             times.push(t.elapsed().as_secs_f64() * 1e3);

@@ -61,8 +61,9 @@ pub struct RunSettings {
     /// whole run (the background search spends it over its searches of that PRN).
     pub acq_pfa: f64,
     /// CPU time the background search may spend per second of signal, s (modelled:
-    /// [`crate::pipeline::search_schedule`]); a first round of searches may spend 2 s at
-    /// once. 0: no background search, only the re-acquisition of lost satellites.
+    /// [`crate::pipeline::search_schedule`]); a first round of searches may spend
+    /// [`crate::pipeline::search_schedule::BURST_S`] at once. 0: no background search, only
+    /// the re-acquisition of lost satellites.
     pub search_budget_s: f64,
     /// Use satellites whose ephemeris says they are unhealthy.
     pub allow_unhealthy: bool,
@@ -98,7 +99,7 @@ impl Default for RunSettings {
             acq_coherent_ms: 1,
             acq_noncoherent: 10,
             acq_pfa: 1e-5,
-            search_budget_s: 0.03,
+            search_budget_s: crate::pipeline::search_schedule::DEFAULT_PER_SIGNAL_S,
             allow_unhealthy: false,
             week: None,
             prns: Vec::new(),

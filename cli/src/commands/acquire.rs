@@ -170,6 +170,7 @@ pub fn search_plan(
         bit_edge_offsets: Some(!args.no_bit_offsets),
         refine_ms: args.refine_ms,
         xcorr_margin_db: (args.xcorr_margin != 0.0).then_some(args.xcorr_margin),
+        ..AcqConfig::default()
     };
     if let Some((lo, hi)) = window_span(&targets) {
         config.doppler_center_hz = 0.5 * (lo + hi);

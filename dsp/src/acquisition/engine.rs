@@ -23,6 +23,8 @@ pub(super) struct Scratch {
     pub(super) buf: Vec<Complex32>,
     pub(super) fft: Vec<Complex32>,
     pub(super) grid: Vec<f32>,
+    /// Grid rows in the order they are filled: (slice set, row, Doppler bin).
+    pub(super) rows: Vec<(usize, usize, i64)>,
     epl: [Vec<Complex64>; 3],
     fine: Vec<Complex32>,
     floors: Vec<f64>,
@@ -87,7 +89,7 @@ impl AcquisitionEngine {
         let inv = planner.plan_fft_inverse(layout.inv_len);
         let fine_len = (8 * config.refine_ms as usize).next_power_of_two().max(256);
         let fine = planner.plan_fft_forward(fine_len);
-        let fwd_replica = planner.plan_fft_forward(layout.spec_len);
+        let fwd_replica = planner.plan_fft_forward(layout.replica_len);
         let (replicas, replica_power) = replica_spectra(&layout, fs_hz, &fwd_replica);
         let wipeoffs = fractional_wipeoffs(&layout);
         Ok(Self {
@@ -144,6 +146,12 @@ impl AcquisitionEngine {
     pub fn samples_wanted(&self) -> usize {
         let refine = ((f64::from(self.config.refine_ms) + 1.0) * self.layout.period_samples).ceil();
         self.layout.samples_needed.max(refine as usize)
+    }
+
+    /// Search lags per code period: the length of the inverse FFTs, one per block, Doppler bin
+    /// and PRN (nearly all the work of a search).
+    pub fn search_lags(&self) -> usize {
+        self.layout.n_lags
     }
 
     /// Coherent block duration T, s.

@@ -14,17 +14,23 @@
 //!   1 ms; the bin width never exceeds 2/(3T)). A bin `f = (k + q/Q)/T` is the spectrum of the
 //!   block wiped off by the fractional part `q/(Q T)`, rotated by k bins; so each block needs only
 //!   Q forward FFTs, shared by every PRN and every bin.
-//! - **Decimated inverse FFTs.** When a code period is a whole number L of samples (fs a multiple
-//!   of 1 kHz, e.g. 2.048, 2.6, 4, 5, 16.368 MHz) the replica of one period is L-periodic in an
-//!   M-period block, so only every M-th bin of its spectrum is non-zero and the correlation of an
-//!   M-ms block is an L-point inverse FFT: a 10 ms block costs the same per bin as a 1 ms one.
-//!   At any other rate the replica is resampled over the whole block (N = round(M fs/1 kHz)
-//!   samples) and the correlation is taken from the N-point block spectrum.
+//! - **Decimated inverse FFTs.** The replica is periodic with the code period, so its spectrum
+//!   lies on the 1 kHz lines: in an M-ms block of N samples, only every M-th bin counted from
+//!   0 Hz (signed) is non-zero, and the correlation of an M-ms block is a one-period inverse FFT
+//!   of S = N/M (rounded) bins: a 10 ms block costs the same per bin as a 1 ms one. When a code
+//!   period is a whole number L = S of samples (fs a multiple of 1 kHz, e.g. 2.048, 2.6, 4, 5,
+//!   16.368 MHz) the replica is one period and `C_N[M j] = M C_L[j]` exactly; at any other rate
+//!   (16.3676 MHz, or a rate corrected by a few ppm) the replica is sampled over the whole block
+//!   and its N-point spectrum decimated the same way (its lines fall on the bins to within
+//!   `M |N - M fs 1 ms| j / N` bins, 0.06 at +-2 MHz in the worst case). Until issue 17 such
+//!   rates correlated the whole N-point spectrum: a 10 ms search cost 9 times more.
 //! - **A fast search length at any rate.** The inverse FFTs (32 PRNs x bins x blocks: nearly all
-//!   the work) do not run at the length of that spectrum, S = L or N, but at a search length
+//!   the work) do not run at the length of that spectrum, S, but at a search length
 //!   S' (`config::search_len`): S itself when it is a multiple of 16 with no prime factor above
-//!   7 and at most 4096 per ms (4, 2.048, 8.184... MHz); otherwise the next such length up to
-//!   4096 per ms (2.6 MHz: 2600 -> 2688; the spectrum zero-padded), and 4096 per ms for anything
+//!   7 and at most 4096 per ms (2.048, 3.2 MHz); otherwise the next such length up to
+//!   4096 per ms (2.6 MHz: 2600 -> 2688; the spectrum zero-padded), or the power of two above
+//!   S when it is at most 5 % longer (4 MHz: 4000 -> 4096, 20 % faster per point than the
+//!   radix-5 4000), and 4096 per ms for anything
 //!   faster (5, 12, 16.368, 24 MHz: the 4096 lowest frequencies kept, +-2.048 MHz, 95 % of the
 //!   C/A power). In both cases the S'-point inverse FFT of the kept bins
 //!   `Y[k] = X[k] conj(C[k]) / S`, k signed, is the *band-limited circular correlation*
@@ -120,7 +126,9 @@ mod refine;
 mod replica;
 pub mod stats;
 
-pub use config::{AcqConfig, AcqError, MAX_COHERENT_MS, MAX_DOPPLER_SUBDIVISION};
+pub use config::{
+    AcqConfig, AcqError, MAX_COHERENT_MS, MAX_DOPPLER_SUBDIVISION, SEARCH_SAMPLES_PER_MS,
+};
 pub use engine::AcquisitionEngine;
 
 use crate::Prn;

@@ -15,8 +15,14 @@ use std::sync::Arc;
 /// With a whole number L of samples per code period the replica is one period (L samples): a block
 /// of M periods correlated with an L-periodic replica has a spectrum that is non-zero only on
 /// every M-th bin, `C_N[M j] = M C_L[j]`, so `corr[tau] = (1/L) IDFT_L(X_N[M j] conj(C_L[j]))`.
-/// Otherwise the replica covers the whole block (N samples, the last chip cut where the block
-/// ends) and `corr = (1/N) IDFT_N(X_N conj(C_N))`.
+/// Otherwise the replica covers the whole block (N = M P samples, P = fs x 1 ms not whole): the
+/// samples of the 1 ms-periodic code are a sum of tones at whole kHz, which fall on the signed
+/// bins `M j` of the N-point spectrum (exactly when M P is a whole number, to within
+/// `M |N - M P| j / N` bins otherwise: 0.06 bin at 2 MHz with 10 ms at 16.3676 MHz), so
+/// `corr(tau) = (1/N) sum_j X_N[M j] conj(C_N[M j]) exp(j 2 pi j tau M / N)` is again a one-period
+/// inverse FFT (j signed, the same decimated bins as the blocks', see
+/// [`Layout::decimated_bin`]). (Before: the correlation of the whole N-point spectrum, an
+/// inverse FFT M times longer for the same lags.)
 ///
 /// The search layout has `inv_len` bins: the `keep_pos` lowest non-negative frequencies at the
 /// start, the `keep_neg` lowest negative ones at the end, zeros between (when `inv_len` exceeds
@@ -28,13 +34,15 @@ pub(crate) fn replica_spectra(
     fft: &Arc<dyn Fft<f32>>,
 ) -> (Vec<Vec<Complex32>>, Vec<f32>) {
     let n = layout.spec_len;
+    let len = layout.replica_len;
+    let d = if len == n { 1 } else { layout.decimation };
     let m = layout.inv_len;
     let (kp, kn) = (layout.keep_pos, layout.keep_neg);
-    let mut chips = vec![0i8; n];
-    let mut spec = vec![Complex32::new(0.0, 0.0); n];
+    let mut chips = vec![0i8; len];
+    let mut spec = vec![Complex32::new(0.0, 0.0); len];
     let mut scratch = vec![Complex32::new(0.0, 0.0); fft.get_inplace_scratch_len()];
     let mut mean_power = vec![0.0f32; n];
-    let scale = 1.0 / n as f32;
+    let scale = 1.0 / len as f32;
     let replicas = Prn::all()
         .map(|prn| {
             CaCode::new(prn).sample(fs_hz, CA_CHIP_RATE_HZ, 0.0, &mut chips);
@@ -43,7 +51,8 @@ pub(crate) fn replica_spectra(
             }
             fft.process_with_scratch(&mut spec, &mut scratch);
             let mut out = vec![Complex32::new(0.0, 0.0); m];
-            for (k, v) in spec.iter().enumerate() {
+            for k in 0..n {
+                let v = spec[layout.decimated_bin(k, 0, d, len)];
                 let c = v.conj() * scale;
                 mean_power[k] += c.norm_sqr() / 32.0;
                 if k < kp {

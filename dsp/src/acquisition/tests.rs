@@ -73,7 +73,9 @@ fn engine(fs: f64, cfg: AcqConfig) -> AcquisitionEngine {
 
 /// The FFT grid equals the correlation computed sample by sample (f64), for a whole and a
 /// fractional number of samples per code period, where the search keeps the block spectrum as
-/// it is (its length is already a fast one, at most 4096 per ms).
+/// it is (its length is already a fast one, at most 4096 per ms). With a fractional period the
+/// replica is the block's (M periods, sampled at fs) averaged over its M sub-blocks of N/M
+/// samples (N/M whole here): its spectrum is the block replica's on the 1 kHz lines alone.
 #[test]
 fn grid_matches_direct_correlation() {
     for &(fs, ms) in &[(1.2e6, 2u32), (2.048e6, 3u32), (2.048_000_5e6, 2u32)] {
@@ -104,15 +106,23 @@ fn grid_matches_direct_correlation() {
             let row = row.min(g.doppler_hz.len() - 1);
             let f = g.doppler_hz[row];
             let mut acc = Complex64::new(0.0, 0.0);
+            let sub = n / ms as usize;
             for (k, v) in x[..n].iter().enumerate() {
-                // The replica as the engine samples it: one period (L-periodic) or the block.
-                let idx = if whole {
-                    (k + n - lag) % period.round() as usize
+                // The replica as the engine samples it: one period (L-periodic), or the block
+                // averaged over its sub-blocks.
+                let c = if whole {
+                    let idx = (k + n - lag) % period.round() as usize;
+                    f64::from(code.chip((idx as f64 * CA_CHIP_RATE_HZ / fs) as usize % 1023))
                 } else {
-                    (k + n - lag) % n
+                    let idx = (k + n - lag) % sub;
+                    (0..ms as usize)
+                        .map(|p| {
+                            let chip = ((idx + p * sub) as f64 * CA_CHIP_RATE_HZ / fs) as usize;
+                            f64::from(code.chip(chip % 1023))
+                        })
+                        .sum::<f64>()
+                        / f64::from(ms)
                 };
-                let chip = (idx as f64 * CA_CHIP_RATE_HZ / fs) as usize;
-                let c = f64::from(code.chip(chip % 1023));
                 let ph = -2.0 * std::f64::consts::PI * f * k as f64 / fs;
                 acc +=
                     Complex64::new(f64::from(v.re), f64::from(v.im)) * Complex64::from_polar(c, ph);
@@ -128,14 +138,14 @@ fn grid_matches_direct_correlation() {
     }
 }
 
-/// Naive DFT (f64), `sign` -1 forward.
-fn dft(x: &[Complex64]) -> Vec<Complex64> {
+/// Naive forward DFT (f64) of `x` at the bins `bins` only.
+fn dft_bins(x: &[Complex64], bins: &[usize]) -> Vec<Complex64> {
     let n = x.len();
     let tw: Vec<Complex64> = (0..n)
         .map(|k| Complex64::from_polar(1.0, -2.0 * std::f64::consts::PI * k as f64 / n as f64))
         .collect();
-    (0..n)
-        .map(|k| {
+    bins.iter()
+        .map(|&k| {
             let mut acc = Complex64::new(0.0, 0.0);
             let mut idx = 0usize;
             for v in x {
@@ -152,9 +162,11 @@ fn dft(x: &[Complex64]) -> Vec<Complex64> {
 
 /// Where the block spectrum is resampled (zero-padded to a fast length, or truncated to the
 /// 4096 lowest frequencies per ms), the grid is the band-limited correlation
-/// `corr(tau) = (1/S) sum_{k kept} X[k] conj(C[k]) exp(j 2 pi k tau / S)` (S bins of the
-/// wiped-off block, folded to one period when a period is a whole number of samples; k signed)
-/// at `tau = lag * S / inv_len` input samples, computed here with naive f64 DFTs.
+/// `corr(tau) = (1/N) sum_{j kept} X[M j] conj(C[M j]) exp(j 2 pi M j tau / N)` (the 1 kHz
+/// lines, signed bins M j of the N-point spectra of the wiped-off block and of the replica
+/// over the block) at `tau = lag * N / (M inv_len)` input samples, computed here with naive
+/// f64 DFTs; for whole and fractional samples per code period (1.5345 MHz x 3 ms, 4.3001 MHz
+/// x 1 ms, 12.0001 MHz x 2 ms, 16.3676 MHz x 3 ms: decimated although M does not divide N).
 #[test]
 fn grid_is_the_band_limited_correlation() {
     // Padded: 1.1 MHz (1100 -> 1120), 2.6 MHz x 2 ms (2600 -> 2688 per period), 1.5345 MHz
@@ -167,6 +179,8 @@ fn grid_is_the_band_limited_correlation() {
         (5.0e6, 1),
         (6.0e6, 2),
         (4.3001e6, 1),
+        (12.0001e6, 2),
+        (16.3676e6, 3),
     ] {
         let cfg = AcqConfig {
             coherent_ms: ms,
@@ -189,33 +203,59 @@ fn grid_is_the_band_limited_correlation() {
             .grid(&x, &SearchTarget::full(prn(9)))
             .unwrap_or_else(|err| panic!("{err}"));
         let code = CaCode::new(prn(9));
-        let (n, sl) = (l.block_len, l.spec_len);
-        let c: Vec<Complex64> = (0..sl)
+        let (n, d) = (l.block_len, ms as i64);
+        // The replica over the whole block (M periods of the code) and the signed bins
+        // `M j` (the 1 kHz lines) of the N-point spectra, j in the kept band.
+        let c: Vec<Complex64> = (0..n)
             .map(|k| {
                 let chip = (k as f64 * CA_CHIP_RATE_HZ / fs) as usize;
                 Complex64::new(f64::from(code.chip(chip % 1023)), 0.0)
             })
             .collect();
-        let cs = dft(&c);
-        for row in [0, g.doppler_hz.len() - 1] {
+        let kept: Vec<i64> = (0..l.keep_pos as i64)
+            .chain(-(l.keep_neg as i64)..0)
+            .collect();
+        let bins: Vec<usize> = kept
+            .iter()
+            .map(|&j| (d * j).rem_euclid(n as i64) as usize)
+            .collect();
+        let cs = dft_bins(&c, &bins);
+        // The Doppler rotates the decimated spectrum circularly; when M does not divide N the
+        // lines that wrap past +-fs/2 land one bin off (D spec_len - N) from the true line:
+        // only where the whole spectrum is kept (fractional periods below 4.1 MHz), and only
+        // for the few edge lines the rotation moves across fs/2. There the rows are compared
+        // at the Doppler bins that do not rotate (0 Hz).
+        let wraps = l.decimation * l.spec_len != n && l.inv_len >= l.spec_len;
+        let mid = g
+            .doppler_hz
+            .iter()
+            .position(|f| f.abs() < 1e-9)
+            .unwrap_or(0);
+        let rows = if wraps {
+            vec![mid]
+        } else {
+            vec![0, mid, g.doppler_hz.len() - 1]
+        };
+        for row in rows {
             let f = g.doppler_hz[row];
-            let mut folded = vec![Complex64::new(0.0, 0.0); sl];
-            for (k, v) in x[..n].iter().enumerate() {
-                let ph = -2.0 * std::f64::consts::PI * f * k as f64 / fs;
-                folded[k % sl] += Complex64::new(f64::from(v.re), f64::from(v.im))
-                    * Complex64::from_polar(1.0, ph);
-            }
-            let xs = dft(&folded);
+            let wiped: Vec<Complex64> = x[..n]
+                .iter()
+                .enumerate()
+                .map(|(k, v)| {
+                    let ph = -2.0 * std::f64::consts::PI * f * k as f64 / fs;
+                    Complex64::new(f64::from(v.re), f64::from(v.im))
+                        * Complex64::from_polar(1.0, ph)
+                })
+                .collect();
+            let xs = dft_bins(&wiped, &bins);
             for &lag in &[0usize, 1, 333, g.n_lags / 2 + 1, g.n_lags - 1] {
                 let tau = lag as f64 * l.lag_samples;
                 let mut acc = Complex64::new(0.0, 0.0);
-                let kept = (0..l.keep_pos as i64).chain(-(l.keep_neg as i64)..0);
-                for k in kept {
-                    let i = k.rem_euclid(sl as i64) as usize;
-                    let ph = 2.0 * std::f64::consts::PI * k as f64 * tau / sl as f64;
+                for (i, &j) in kept.iter().enumerate() {
+                    let ph = 2.0 * std::f64::consts::PI * (d * j) as f64 * tau / n as f64;
                     acc += xs[i] * cs[i].conj() * Complex64::from_polar(1.0, ph);
                 }
-                let want = (acc / sl as f64).norm_sqr();
+                let want = (acc / n as f64).norm_sqr();
                 let got = f64::from(g.power[row * g.n_lags + lag]);
                 let scale = n as f64;
                 assert!(
@@ -231,29 +271,87 @@ fn grid_is_the_band_limited_correlation() {
 /// next fast length below that, 4096 per ms above.
 #[test]
 fn search_lengths() {
-    for &(fs, ms, spec, inv) in &[
-        (4.0e6, 1u32, 4000usize, 4000usize),
-        (4.0e6, 10, 4000, 4000),
-        (2.048e6, 1, 2048, 2048),
-        (2.6e6, 1, 2600, 2688),
-        (1.023e6, 1, 1023, 1024),
-        (5.0e6, 1, 5000, 4096),
-        (12.0e6, 4, 12000, 4096),
-        (16.368e6, 1, 16368, 4096),
-        (25.0e6, 1, 25000, 4096),
-        (12.000_1e6, 2, 24000, 8192),
+    let full = SEARCH_SAMPLES_PER_MS;
+    for &(fs, ms, cap, spec, inv) in &[
+        (4.0e6, 1u32, full, 4000usize, 4096usize),
+        (4.0e6, 10, full, 4000, 4096),
+        (4.092e6, 1, full, 4092, 4096),
+        (3.2e6, 1, full, 3200, 3200),
+        (2.048e6, 1, full, 2048, 2048),
+        (2.6e6, 1, full, 2600, 2688),
+        (1.023e6, 1, full, 1023, 1024),
+        (5.0e6, 1, full, 5000, 4096),
+        (12.0e6, 4, full, 12000, 4096),
+        (16.368e6, 1, full, 16368, 4096),
+        (25.0e6, 1, full, 25000, 4096),
+        (12.000_1e6, 2, full, 12000, 4096),
+        (16.3676e6, 10, full, 16368, 4096),
+        (2.047_9e6, 10, full, 2048, 2048),
+        // Half the lags: everything from 2.048 MHz up searched at 2048 lags.
+        (4.0e6, 10, 2048, 4000, 2048),
+        (2.6e6, 10, 2048, 2600, 2048),
+        (2.048e6, 10, 2048, 2048, 2048),
+        (1.5e6, 1, 2048, 1500, 1536),
     ] {
         let e = engine(
             fs,
             AcqConfig {
                 coherent_ms: ms,
+                search_lags_per_ms: cap,
                 ..AcqConfig::default()
             },
         );
         let l = &e.layout;
         assert_eq!((l.spec_len, l.inv_len), (spec, inv), "fs {fs} ms {ms}");
+        assert_eq!(e.search_lags(), inv);
         assert_eq!(l.keep_pos + l.keep_neg, spec.min(inv));
-        assert!((l.lag_samples - spec as f64 / inv as f64).abs() < 1e-12);
+        let per_lag = l.block_len as f64 / (f64::from(ms) * inv as f64);
+        assert!((l.lag_samples - per_lag).abs() < 1e-12, "fs {fs} ms {ms}");
+    }
+}
+
+/// With half the lags (2048 per ms: +-1.024 MHz, two lags per chip) 10 ms x 6 blocks still find
+/// a 35 dB-Hz signal at 4, 12 and 16.3676 MHz, the grid's code phase within a quarter chip
+/// (half a lag) and the refined one within 0.1 chip (3.5 sigma of early-late half a chip apart
+/// over 100 ms at 35 dB-Hz), the Doppler within 10 Hz.
+#[test]
+fn half_the_lags_finds_signals_at_any_rate() {
+    for &(fs, seed) in &[(4.0e6, 41u64), (12.0e6, 42), (16.3676e6, 43)] {
+        let sig = Sig {
+            prn: 19,
+            tau: 0.3141 * fs * 1e-3,
+            doppler_hz: -2_345.0,
+            cn0_dbhz: 35.0,
+        };
+        for refine_ms in [0, 100] {
+            let e = engine(
+                fs,
+                AcqConfig {
+                    coherent_ms: 10,
+                    noncoherent: 6,
+                    bit_edge_offsets: Some(false),
+                    search_lags_per_ms: 2048,
+                    refine_ms,
+                    ..AcqConfig::default()
+                },
+            );
+            let x = synth(fs, e.samples_wanted(), std::slice::from_ref(&sig), seed);
+            let r = &e
+                .search(&x, &[SearchTarget::full(prn(19))])
+                .unwrap_or_else(|err| panic!("{err}"))[0];
+            assert!(r.detected, "fs {fs}: {r:?}");
+            let chips = (r.code_phase_samples - sig.tau).abs() * CA_CHIP_RATE_HZ / fs;
+            let want = if refine_ms == 0 { 0.25 } else { 0.1 };
+            assert!(
+                chips < want,
+                "fs {fs} refine {refine_ms}: {chips} chip, {r:?}"
+            );
+            let dop = if refine_ms == 0 { 25.0 } else { 10.0 };
+            assert!(
+                (r.doppler_hz - sig.doppler_hz).abs() < dop,
+                "fs {fs}: {r:?}"
+            );
+        }
     }
 }
 
@@ -309,29 +407,38 @@ fn finds_signals_at_awkward_rates() {
 #[test]
 fn long_coherent_with_bit_edges_and_code_doppler() {
     // 10 ms x 10 at 32 dB-Hz with a Doppler of 9 kHz: the 100 ms sum spans 0.6 chip of code
-    // Doppler, and bits flip inside blocks.
-    let fs = 4.0e6;
-    let cfg = AcqConfig {
-        coherent_ms: 10,
-        noncoherent: 10,
-        doppler_max_hz: 10_000.0,
-        ..AcqConfig::default()
-    };
-    let e = engine(fs, cfg);
-    assert!((e.doppler_step_hz() - 50.0).abs() < 1e-9);
-    let sig = Sig {
-        prn: 11,
-        tau: 2222.3,
-        doppler_hz: 9_013.0,
-        cn0_dbhz: 32.0,
-    };
-    let x = synth(fs, e.samples_wanted(), std::slice::from_ref(&sig), 5);
-    let r = &e
-        .search(&x, &[SearchTarget::around(prn(11), 9_000.0, 500.0)])
-        .unwrap_or_else(|err| panic!("{err}"))[0];
-    assert!(r.detected, "{r:?}");
-    assert!((r.code_phase_samples - sig.tau).abs() < 1.0, "{r:?}");
-    assert!((r.doppler_hz - sig.doppler_hz).abs() < 10.0, "{r:?}");
+    // Doppler, and bits flip inside blocks. At 4 MHz, and at rates whose code period is not a
+    // whole number of samples (16.3676 MHz, the GN3S sampler; 4 MHz 25 ppm off; 2.0471 MHz,
+    // where the whole spectrum is kept and the Doppler rotation wraps), where the 10 ms blocks
+    // are decimated all the same.
+    for &(fs, seed) in &[(4.0e6, 5u64), (16.3676e6, 6), (4.0001e6, 7), (2.0471e6, 8)] {
+        let cfg = AcqConfig {
+            coherent_ms: 10,
+            noncoherent: 10,
+            doppler_max_hz: 10_000.0,
+            ..AcqConfig::default()
+        };
+        let e = engine(fs, cfg);
+        assert!((e.doppler_step_hz() - 50.0).abs() < 1e-3, "fs {fs}");
+        let sig = Sig {
+            prn: 11,
+            tau: 0.555_575 * fs * 1e-3,
+            doppler_hz: 9_013.0,
+            cn0_dbhz: 32.0,
+        };
+        let x = synth(fs, e.samples_wanted(), std::slice::from_ref(&sig), seed);
+        let r = &e
+            .search(&x, &[SearchTarget::around(prn(11), 9_000.0, 500.0)])
+            .unwrap_or_else(|err| panic!("{err}"))[0];
+        assert!(r.detected, "fs {fs}: {r:?}");
+        // A quarter chip (one sample at 4 MHz), and the Doppler to 10 Hz.
+        let chips = (r.code_phase_samples - sig.tau).abs() * CA_CHIP_RATE_HZ / fs;
+        assert!(chips < 0.25, "fs {fs}: {chips} chip, {r:?}");
+        assert!(
+            (r.doppler_hz - sig.doppler_hz).abs() < 10.0,
+            "fs {fs}: {r:?}"
+        );
+    }
 }
 
 #[test]
@@ -383,6 +490,18 @@ fn bad_settings_and_short_input_are_errors() {
         },
         AcqConfig {
             doppler_max_hz: f64::INFINITY,
+            ..AcqConfig::default()
+        },
+        AcqConfig {
+            search_lags_per_ms: 5000,
+            ..AcqConfig::default()
+        },
+        AcqConfig {
+            search_lags_per_ms: 1000,
+            ..AcqConfig::default()
+        },
+        AcqConfig {
+            search_lags_per_ms: 4100,
             ..AcqConfig::default()
         },
     ];
@@ -511,7 +630,7 @@ fn finds_signals_at_front_end_rates() {
     }
 }
 
-/// False alarms on pure noise at 4 MHz (the spectrum kept as it is), 12 MHz (truncated to the
+/// False alarms on pure noise at 4 MHz (4000 bins padded to 4096), 12 MHz (truncated to the
 /// 4096 lowest bins per ms) and 2.6 MHz (zero-padded from 2600 to 2688 bins): the rate per PRN
 /// search must match the configured pfa, since the threshold is set by the union bound over the
 /// search's cells (Doppler bins x search lags) and the search lags are about 4 per chip at any

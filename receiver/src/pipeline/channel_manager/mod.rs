@@ -21,7 +21,7 @@ pub use realign::{Realigned, REALIGN_DOPPLER_HZ};
 
 use crate::pipeline::ring::SampleView;
 use crate::pipeline::search_schedule::{
-    search_pfa, Batch, Liveness, Scheduler, SearchBudget, Visibility, LEVELS,
+    level_config, search_pfa, Batch, Liveness, Scheduler, SearchBudget, Visibility, LEVELS,
 };
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::Prn;
@@ -147,12 +147,8 @@ impl ChannelManager {
     ) -> Result<Self, gpsrx_dsp::acquisition::AcqError> {
         let mut engines = vec![AcquisitionEngine::new(fs_hz, settings.acq.clone())?];
         if settings.weak_fallback {
-            for &(coherent_ms, noncoherent) in &LEVELS {
-                let cfg = AcqConfig {
-                    coherent_ms,
-                    noncoherent,
-                    ..settings.acq.clone()
-                };
+            for level in 1..=LEVELS.len() {
+                let cfg = level_config(&settings.acq, level);
                 engines.push(AcquisitionEngine::new(fs_hz, cfg)?);
             }
         }
