@@ -702,30 +702,37 @@ impl SampleSource for Ci8Source<'_> {
 
 #[test]
 fn ci8_samples_held_as_stored_give_the_fixes_of_the_same_samples_in_f32() {
+    use gpsrx_tracking::CorrelatorArithmetic;
     let sim = simulator(8.0);
     let fs = 2.048e6;
-    let mut as_f32 = MemorySink::new();
-    let a = receiver(fs)
-        .run(&mut Ci8Source::new(&sim, false), &mut as_f32)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let mut as_stored = MemorySink::new();
-    let b = receiver(fs)
-        .run(&mut Ci8Source::new(&sim, true), &mut as_stored)
-        .unwrap_or_else(|e| panic!("{e}"));
+    let run = |offer_integers: bool, arithmetic: CorrelatorArithmetic| {
+        let mut sink = MemorySink::new();
+        let summary = receiver_with(fs, |c| c.tracking.correlator_arithmetic = arithmetic)
+            .run(&mut Ci8Source::new(&sim, offer_integers), &mut sink)
+            .unwrap_or_else(|e| panic!("{e}"));
+        (summary, sink)
+    };
+    let (a, as_f32) = run(false, CorrelatorArithmetic::F32);
+    // The same f32 kernel on the ci8 held as stored: the same sums in another lane order.
+    let (b, as_stored) = run(true, CorrelatorArithmetic::F32);
+    // The default: the int16 kernel on ci8 (carrier rounded to 2^-7 sample).
+    let (c, as_i16) = run(true, CorrelatorArithmetic::Auto);
     assert!(a.fixes > 5, "{} fixes", a.fixes);
-    assert_eq!(a.fixes, b.fixes);
-    assert_eq!(a.tracked_prns, b.tracked_prns);
-    assert_eq!(as_f32.events, as_stored.events);
-    // The same sums in another order (the kernels' lanes): equal to far below a millimetre.
-    for (x, y) in as_f32.fixes.iter().zip(&as_stored.fixes) {
-        assert_eq!(x.fix.time, y.fix.time);
-        let d: f64 = (0..3)
-            .map(|i| (x.fix.ecef_m[i] - y.fix.ecef_m[i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        assert!(d < 1e-3, "fixes {d} m apart at {:.1} s", x.t_stream_s);
+    for (other, summary, tol_m) in [(&as_stored, &b, 1e-3), (&as_i16, &c, 0.05)] {
+        assert_eq!(a.fixes, summary.fixes);
+        assert_eq!(a.tracked_prns, summary.tracked_prns);
+        assert_eq!(as_f32.events, other.events);
+        for (x, y) in as_f32.fixes.iter().zip(&other.fixes) {
+            assert_eq!(x.t_stream_s, y.t_stream_s);
+            assert!((x.fix.time.tow_s - y.fix.time.tow_s).abs() < 1e-9);
+            let d: f64 = (0..3)
+                .map(|i| (x.fix.ecef_m[i] - y.fix.ecef_m[i]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            assert!(d < tol_m, "fixes {d} m apart at {:.1} s", x.t_stream_s);
+        }
     }
-    for (f, (h, v)) in as_stored.fixes.iter().zip(fix_errors(&sim, &as_stored)) {
+    for (f, (h, v)) in as_i16.fixes.iter().zip(fix_errors(&sim, &as_i16)) {
         let (h_max, v_max) = fix_bounds();
         assert!(
             h < h_max && v < v_max,
