@@ -715,10 +715,11 @@ fn ci8_samples_held_as_stored_give_the_fixes_of_the_same_samples_in_f32() {
     let (a, as_f32) = run(false, CorrelatorArithmetic::F32);
     // The same f32 kernel on the ci8 held as stored: the same sums in another lane order.
     let (b, as_stored) = run(true, CorrelatorArithmetic::F32);
-    // The default: the int16 kernel on ci8 (carrier rounded to 2^-7 sample).
+    // The default: the int16 kernel on ci8 (products rounded to 2^-7 sample, carrier within
+    // 4.1e-4): the same fixes to a few centimetres, far below their metre-level noise.
     let (c, as_i16) = run(true, CorrelatorArithmetic::Auto);
     assert!(a.fixes > 5, "{} fixes", a.fixes);
-    for (other, summary, tol_m) in [(&as_stored, &b, 1e-3), (&as_i16, &c, 0.05)] {
+    for (other, summary, tol_m) in [(&as_stored, &b, 1e-3), (&as_i16, &c, 0.25)] {
         assert_eq!(a.fixes, summary.fixes);
         assert_eq!(a.tracked_prns, summary.tracked_prns);
         assert_eq!(as_f32.events, other.events);

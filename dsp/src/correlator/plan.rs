@@ -112,6 +112,10 @@ pub(crate) struct Seed<const L: usize> {
 
 /// `exp(-j 2 pi x)`, argument reduced first so large phases keep their precision.
 fn cis_neg(cycles: f64) -> Complex64 {
+    if cycles == 0.0 {
+        // No rate (a constant frequency, what tracking asks for): no sin/cos to pay.
+        return Complex64::new(1.0, 0.0);
+    }
     let x = cycles - cycles.round();
     let (s, c) = (2.0 * std::f64::consts::PI * x).sin_cos();
     Complex64::new(c, -s)

@@ -1,10 +1,10 @@
 //! [`Receiver`]: the whole pipeline, driven by a source or by pushed sample blocks.
 //!
 //! Samples go into a [`SampleWindow`]; the first ones feed the cold-start search of the
-//! [`ChannelManager`]; from then on, block by block (10 ms of signal), every channel processes
+//! [`ChannelManager`]; from then on, block by block (40 ms of signal), every channel processes
 //! the code periods the window holds while a due re-acquisition search runs beside them, and
 //! each report goes to the [`NavigationProcessor`], which hands observables, fixes and events to
-//! the [`Sink`]. The processing is cut into the same 10 ms blocks whatever the caller's block
+//! the [`Sink`]. The processing is cut into the same 40 ms blocks whatever the caller's block
 //! size, so [`Receiver::push`] in any chunking gives what [`Receiver::run`] gives.
 
 use crate::config::ReceiverConfig;
@@ -443,7 +443,7 @@ impl Receiver {
         self.finish(sink)
     }
 
-    /// Takes the next samples of the stream (any number: the processing is cut into 10 ms
+    /// Takes the next samples of the stream (any number: the processing is cut into 40 ms
     /// blocks of the stream, whatever the chunking). The first sample pushed has index 0.
     ///
     /// Non-finite values (NaN, infinity) are read as 0, with a warning, as sources do.
