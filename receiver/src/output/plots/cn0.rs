@@ -1,10 +1,10 @@
 //! `cn0.png`: each satellite's C/N0 against time, the legend beside the data.
 
-use super::canvas::{titled, with_legend_strip, MARGIN_PX, X_AREA_PX, Y_AREA_PX};
+use super::canvas::{linear_chart, titled, with_legend_strip, MARGIN_PX};
 use super::decimate::Decimated;
 use super::legend::{draw_legend, LegendEntry, Swatch};
-use super::style::{color, plot_err, AXIS_DESC_PX, LABEL_PX};
-use super::ticks::{padded_range, tick_label};
+use super::style::{color, plot_err};
+use super::ticks::padded_range;
 use super::PlotError;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
@@ -59,23 +59,13 @@ pub fn draw_cn0(cn0: &BTreeMap<u8, Decimated<(f64, f64)>>, path: &Path) -> Resul
     // tracked levels stay readable (the plunge leaves through the bottom).
     let (y0, y1) = padded_range(all().map(|p| p.1), false);
     let y0 = y0.max(CN0_FLOOR_DBHZ.min(y1 - 1.0));
-    let mut chart = ChartBuilder::on(&chart_area)
-        .margin(MARGIN_PX)
-        .x_label_area_size(X_AREA_PX)
-        .y_label_area_size(Y_AREA_PX)
-        .build_cartesian_2d(t0.max(0.0)..t1, y0..y1)
-        .map_err(plot_err(path))?;
-    chart
-        .configure_mesh()
-        .light_line_style(TRANSPARENT)
-        .x_desc("time from the start of the recording (s)")
-        .y_desc("C/N0 (dB-Hz)")
-        .x_label_formatter(&|v| tick_label(*v))
-        .y_label_formatter(&|v| tick_label(*v))
-        .label_style(("sans-serif", LABEL_PX))
-        .axis_desc_style(("sans-serif", AXIS_DESC_PX))
-        .draw()
-        .map_err(plot_err(path))?;
+    let mut chart = linear_chart(
+        &chart_area,
+        t0.max(0.0)..t1,
+        y0..y1,
+        ("time from the start of the recording (s)", "C/N0 (dB-Hz)"),
+        path,
+    )?;
     for (i, series) in cn0.values().enumerate() {
         for run in split_at_gaps(series.values()) {
             chart

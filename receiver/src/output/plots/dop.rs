@@ -1,7 +1,7 @@
 //! `dop.png`: the number of satellites used (upper panel) and PDOP and HDOP (lower panel)
 //! against time.
 
-use super::canvas::{titled, with_legend_strip, MARGIN_PX, X_AREA_PX, Y_AREA_PX};
+use super::canvas::{linear_chart, titled, with_legend_strip, MARGIN_PX, X_AREA_PX, Y_AREA_PX};
 use super::data::FixPoint;
 use super::legend::{draw_legend, LegendEntry, Swatch};
 use super::style::{color, plot_err, AXIS_DESC_PX, LABEL_PX};
@@ -63,23 +63,16 @@ pub fn draw_dop(fixes: &[FixPoint], path: &Path) -> Result<(), PlotError> {
         .map_err(plot_err(path))?;
     let dops = || fixes.iter().flat_map(|f| [f.pdop, f.hdop]);
     let (_, d1) = padded_range(dops().map(|v| v.min(DOP_CEILING)), false);
-    let mut bottom = ChartBuilder::on(&lower)
-        .margin(MARGIN_PX)
-        .x_label_area_size(X_AREA_PX)
-        .y_label_area_size(Y_AREA_PX)
-        .build_cartesian_2d(t0..t1, 0.0..d1.max(1.0))
-        .map_err(plot_err(path))?;
-    bottom
-        .configure_mesh()
-        .light_line_style(TRANSPARENT)
-        .x_desc("time from the start of the recording (s)")
-        .y_desc("dilution of precision")
-        .x_label_formatter(&|v| tick_label(*v))
-        .y_label_formatter(&|v| tick_label(*v))
-        .label_style(("sans-serif", LABEL_PX))
-        .axis_desc_style(("sans-serif", AXIS_DESC_PX))
-        .draw()
-        .map_err(plot_err(path))?;
+    let mut bottom = linear_chart(
+        &lower,
+        t0..t1,
+        0.0..d1.max(1.0),
+        (
+            "time from the start of the recording (s)",
+            "dilution of precision",
+        ),
+        path,
+    )?;
     type Pick = fn(&FixPoint) -> f64;
     for (i, pick) in [(|f: &FixPoint| f.pdop) as Pick, |f: &FixPoint| f.hdop]
         .into_iter()

@@ -1,12 +1,11 @@
 //! `dr.png` (`gpsrx run --dr`): the GNSS/dead-reckoning fused track in local east/north
 //! metres, the stretches the receiver had no GNSS fix (dead reckoning alone) marked in red.
 
-use super::canvas::{plot_px, titled, with_legend_strip, MARGIN_PX, X_AREA_PX, Y_AREA_PX};
+use super::canvas::{linear_chart, plot_px, titled, with_legend_strip, MARGIN_PX};
 use super::data::MAX_POINTS;
 use super::geometry::{equal_scale_ranges, median_position, LocalFrame};
 use super::legend::{draw_legend, LegendEntry, Swatch};
-use super::style::{plot_err, AXIS_DESC_PX, LABEL_PX};
-use super::ticks::tick_label;
+use super::style::plot_err;
 use super::PlotError;
 use crate::fusion::fuse::FusedFix;
 use gpsrx_ins_aiding::FixSource;
@@ -88,23 +87,13 @@ pub fn draw_dr_track(fused: &[FusedFix], path: &Path) -> Result<(), PlotError> {
     let (chart_area, side) = with_legend_strip(&area, &entries);
     let all: Vec<(f64, f64)> = parts.iter().flat_map(|s| s.1.iter().copied()).collect();
     let (er, nr) = equal_scale_ranges(&all, plot_px(&chart_area), 2.0);
-    let mut chart = ChartBuilder::on(&chart_area)
-        .margin(MARGIN_PX)
-        .x_label_area_size(X_AREA_PX)
-        .y_label_area_size(Y_AREA_PX)
-        .build_cartesian_2d(er, nr)
-        .map_err(plot_err(path))?;
-    chart
-        .configure_mesh()
-        .light_line_style(TRANSPARENT)
-        .x_desc("east of the median position (m)")
-        .y_desc("north (m)")
-        .x_label_formatter(&|v| tick_label(*v))
-        .y_label_formatter(&|v| tick_label(*v))
-        .label_style(("sans-serif", LABEL_PX))
-        .axis_desc_style(("sans-serif", AXIS_DESC_PX))
-        .draw()
-        .map_err(plot_err(path))?;
+    let mut chart = linear_chart(
+        &chart_area,
+        er,
+        nr,
+        ("east of the median position (m)", "north (m)"),
+        path,
+    )?;
     for (outage, pts, _) in &parts {
         let style = if *outage {
             OUTAGE.stroke_width(4)

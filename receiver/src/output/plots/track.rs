@@ -1,13 +1,12 @@
 //! `track.png`: the ground track in local east/north metres, each fix coloured by the number
 //! of satellites it used.
 
-use super::canvas::{plot_px, titled, with_legend_strip, MARGIN_PX, X_AREA_PX, Y_AREA_PX};
+use super::canvas::{linear_chart, plot_px, titled, with_legend_strip, MARGIN_PX};
 use super::cn0::split_at_gaps;
 use super::data::FixPoint;
 use super::geometry::{equal_scale_ranges, median_position, LocalFrame};
 use super::legend::{draw_legend, LegendEntry, Swatch};
-use super::style::{plot_err, AXIS_DESC_PX, LABEL_PX};
-use super::ticks::tick_label;
+use super::style::plot_err;
 use super::PlotError;
 use plotters::prelude::*;
 use std::path::Path;
@@ -85,23 +84,7 @@ pub fn draw_track(
     let (chart_area, side) = with_legend_strip(&area, &entries);
     let pts: Vec<(f64, f64)> = en.iter().map(|p| (p.0, p.1)).collect();
     let (er, nr) = equal_scale_ranges(&pts, plot_px(&chart_area), 2.0);
-    let mut chart = ChartBuilder::on(&chart_area)
-        .margin(MARGIN_PX)
-        .x_label_area_size(X_AREA_PX)
-        .y_label_area_size(Y_AREA_PX)
-        .build_cartesian_2d(er, nr)
-        .map_err(plot_err(path))?;
-    chart
-        .configure_mesh()
-        .light_line_style(TRANSPARENT)
-        .x_desc("east (m)")
-        .y_desc("north (m)")
-        .x_label_formatter(&|v| tick_label(*v))
-        .y_label_formatter(&|v| tick_label(*v))
-        .label_style(("sans-serif", LABEL_PX))
-        .axis_desc_style(("sans-serif", AXIS_DESC_PX))
-        .draw()
-        .map_err(plot_err(path))?;
+    let mut chart = linear_chart(&chart_area, er, nr, ("east (m)", "north (m)"), path)?;
     // Fixes joined in time order, broken where fixes are missing (a GNSS outage).
     let times: Vec<(f64, f64)> = valid
         .iter()
