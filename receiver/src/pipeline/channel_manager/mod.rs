@@ -380,23 +380,33 @@ impl ChannelManager {
     }
 
     /// Hands the reports of the last [`ChannelManager::work`] to `f` as `(channel index,
-    /// report)`, channel by channel, each in time order.
+    /// report)` in stream order: by the first sample of their interval, then by channel (a
+    /// channel's own reports keep their order). A block holds 40 ms of every channel's reports;
+    /// handed over channel by channel, a fix and the clock step it makes, decided on the
+    /// reports of the channels before, came after the later reports of the channels after
+    /// (a satellite missing from the next fix). Every report is dropped afterwards, also
+    /// when `f` fails (its error is returned).
     pub fn drain_reports<E>(
         &mut self,
         mut f: impl FnMut(usize, &ChannelEpoch) -> Result<(), E>,
     ) -> Result<(), E> {
-        for (i, r) in self.reports.iter_mut().enumerate() {
-            let mut result = Ok(());
-            for e in r.iter() {
-                result = f(i, e);
-                if result.is_err() {
-                    break;
-                }
-            }
+        let mut order: Vec<(u64, usize, usize)> = self
+            .reports
+            .iter()
+            .enumerate()
+            .flat_map(|(i, r)| {
+                r.iter()
+                    .enumerate()
+                    .map(move |(j, e)| (e.sample_index, i, j))
+            })
+            .collect();
+        order.sort_unstable();
+        let reports = &self.reports;
+        let result = order.iter().try_for_each(|&(_, i, j)| f(i, &reports[i][j]));
+        for r in &mut self.reports {
             r.clear();
-            result?;
         }
-        Ok(())
+        result
     }
 
     /// Whether detection `d` sits at the Doppler of a much stronger live channel modulo 1 kHz
