@@ -11,7 +11,7 @@ use super::summary::Gathered;
 use crate::report::{register_font, LinePlot, Series};
 use anyhow::Context;
 use gpsrx_receiver::output::plots::legend::{
-    corner_origin, draw_legend, free_corner, legend_size_px, LegendEntry, Swatch,
+    draw_legend, draw_legend_in_corner, free_corner, legend_size_px, LegendEntry, Swatch,
 };
 use gpsrx_receiver::output::plots::ticks::tick_label;
 use plotters::prelude::*;
@@ -376,9 +376,7 @@ fn draw_shaded(
     }
     if let Some(corner) = corner {
         let area = chart.plotting_area().strip_coord_spec();
-        let (pw, ph) = area.dim_in_pixel();
-        let at = corner_origin(corner, 0..pw as i32, 0..ph as i32, (lw, lh));
-        draw_legend(&area, &entries, at).map_err(plot_err(path))?;
+        draw_legend_in_corner(&area, &entries, corner).map_err(plot_err(path))?;
     }
     if let Some(side) = side {
         draw_legend(&side, &entries, (0, 20)).map_err(plot_err(path))?;

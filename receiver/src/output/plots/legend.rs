@@ -110,6 +110,18 @@ pub fn corner_origin(
     }
 }
 
+/// Draws the legend of `entries` inside `area` (a chart's plotting area) at `corner`.
+pub fn draw_legend_in_corner<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[LegendEntry],
+    corner: Corner,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (pw, ph) = area.dim_in_pixel();
+    let size = legend_size_px(entries);
+    let at = corner_origin(corner, 0..pw as i32, 0..ph as i32, size);
+    draw_legend(area, entries, at)
+}
+
 /// Draws the legend with its top-left corner at `origin` (pixels of `area`).
 pub fn draw_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,

@@ -1,7 +1,9 @@
 //! [`LinePlot`]: named curves on linear or logarithmic axes (the studies' plots), with 1-2-5
 //! tick labels on log axes and the legend in a corner free of data (or beside the plot).
 
-use super::legend::{corner_origin, draw_legend, free_corner, legend_size_px, LegendEntry, Swatch};
+use super::legend::{
+    draw_legend, draw_legend_in_corner, free_corner, legend_size_px, LegendEntry, Swatch,
+};
 use super::style::{color, plot_err, register_font, AXIS_DESC_PX, LABEL_PX, TITLE_PX};
 use super::ticks::{log_ticks, padded_range, tick_label};
 use super::PlotError;
@@ -171,9 +173,7 @@ pub fn draw_line_plot(plot: &LinePlot, path: &Path) -> Result<(), PlotError> {
             }
             if let Some(corner) = corner {
                 let area = chart.plotting_area().strip_coord_spec();
-                let (pw, ph) = area.dim_in_pixel();
-                let at = corner_origin(corner, 0..pw as i32, 0..ph as i32, (lw, lh));
-                draw_legend(&area, &entries, at).map_err(plot_err(path))?;
+                draw_legend_in_corner(&area, &entries, corner).map_err(plot_err(path))?;
             }
         }};
     }
