@@ -9,10 +9,11 @@ use gpsrx_nav::{
 use std::collections::HashMap;
 use std::path::PathBuf;
 
-/// Path of a file in the shared, read-only test data (`../shared/data` from the project root).
-pub fn shared_data(name: &str) -> PathBuf {
+/// Path of a data file that the repository ships in `samples/data` (the broadcast file of
+/// 2022-01-01 is the IGS product that `../shared/data` also holds, byte for byte).
+pub fn shipped_data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/data")
+        .join("../samples/data")
         .join(name)
 }
 
@@ -25,7 +26,7 @@ pub fn fixture(name: &str) -> PathBuf {
 
 /// The broadcast file of 2022-01-01 used throughout.
 pub fn brdc() -> gpsrx_nav::NavData {
-    gpsrx_nav::read_rinex_nav(&shared_data("brdc0010.22n")).expect("brdc0010.22n parses")
+    gpsrx_nav::read_rinex_nav(&shipped_data("brdc0010.22n")).expect("brdc0010.22n parses")
 }
 
 /// A CSV fixture with named columns.

@@ -2,7 +2,7 @@
 //! cross-checked against RTKLIB's reader through the position fixture), a hand-written
 //! RINEX 3 mixed file, and malformed input that must report the right line.
 
-use crate::common::{brdc, shared_data};
+use crate::common::{brdc, shipped_data};
 use gpsrx_nav::rinex_nav::{parse_rinex_nav_report, RinexError};
 use gpsrx_nav::{parse_rinex_nav, read_rinex_nav, GpsTime};
 
@@ -152,7 +152,7 @@ fn rinex3_mixed_file() {
 
 /// Replaces the text of 1-based line `line_no` of the brdc file using `f`.
 fn brdc_with_line(line_no: usize, f: impl Fn(&str) -> String) -> String {
-    let text = std::fs::read_to_string(shared_data("brdc0010.22n")).expect("readable");
+    let text = std::fs::read_to_string(shipped_data("brdc0010.22n")).expect("readable");
     text.lines()
         .enumerate()
         .map(|(i, l)| {
@@ -199,7 +199,7 @@ fn bad_epoch_and_truncation_report_lines() {
     let err = parse_rinex_nav(&text).expect_err("month 13");
     assert_eq!(err.line(), Some(17), "{err}");
 
-    let full = std::fs::read_to_string(shared_data("brdc0010.22n")).expect("readable");
+    let full = std::fs::read_to_string(shipped_data("brdc0010.22n")).expect("readable");
     let lines: Vec<&str> = full.lines().collect();
     let truncated = lines[..lines.len() - 3].join("\n");
     let err = parse_rinex_nav(&truncated).expect_err("truncated");
