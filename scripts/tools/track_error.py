@@ -5,7 +5,7 @@ usage: track_error.py OUT_DIR TRUTH_CSV [--from S] [--to S]
 
 OUT_DIR is a `gpsrx run --out` directory (pvt.csv, channels.csv); TRUTH_CSV the simulator's
 truth.csv. --from/--to select a window in seconds from the truth file's first epoch. Prints the
-number of fixes, horizontal/vertical/3D RMS and maximum position error (truth interpolated
+number of valid fixes (and of those written flagged invalid, left out), horizontal/vertical/3D RMS and maximum position error (truth interpolated
 linearly at each fix's GPS time), the 3D velocity RMS error, and the fraction of channel
 reports in the window that were tracking with phase lock.
 """
@@ -50,9 +50,16 @@ def main():
     n = nv = 0
     worst = 0.0
     j = 1
+    flagged = 0
     for r in csv.DictReader(open(f"{a.out}/pvt.csv")):
+        if not r["tow_s"]:
+            continue
         t = float(r["tow_s"])
         if not (lo <= t <= hi) or t < truth[0][0] or t > truth[-1][0]:
+            continue
+        if r.get("quality", "gnss") == "none":
+            # Written but flagged invalid (RAIM, PDOP): not a fix a user would take.
+            flagged += 1
             continue
         while j < len(truth) - 1 and truth[j][0] < t:
             j += 1
@@ -75,15 +82,17 @@ def main():
             nv += 1
     rows = locked = 0
     for r in csv.DictReader(open(f"{a.out}/channels.csv")):
+        if not r["tow_s"] or not r["gps_week"]:
+            continue
         t = float(r["tow_s"])
         if lo <= t <= hi and int(r["gps_week"]) > 0:
             rows += 1
             locked += r["state"] == "track" and r["carrier_lock"] in ("1", "true")
     if n == 0:
-        print(f"fixes 0 in the window; phase-locked channel reports {locked}/{rows}")
+        print(f"fixes 0 in the window ({flagged} flagged invalid); phase-locked channel reports {locked}/{rows}")
         return
     print(
-        f"fixes {n}: RMS horizontal {math.sqrt(h2 / n):.2f} m, vertical {math.sqrt(v2 / n):.2f} m, "
+        f"fixes {n} ({flagged} more flagged invalid): RMS horizontal {math.sqrt(h2 / n):.2f} m, vertical {math.sqrt(v2 / n):.2f} m, "
         f"3D {math.sqrt(d2 / n):.2f} m (max {worst:.2f} m); velocity RMS "
         f"{math.sqrt(vel2 / max(nv, 1)):.3f} m/s; phase-locked channel reports "
         f"{locked}/{rows} ({100.0 * locked / max(rows, 1):.1f} %)"

@@ -1,0 +1,60 @@
+#!/usr/bin/env python3
+"""How a run came back from a fault, from its pvt.csv and a static truth position.
+
+usage: fault_recovery.py PVT_CSV LAT LON H --start-tow S --at S --len S --kind cut|zero
+
+The signal comes back at true GPS time start + at + len (for a cut the samples of that span
+are gone, for zeros they are empty). Prints the first valid fix after it ("back", seconds after
+the return), the number of valid fixes after the fault, the largest 3D error of any valid fix
+after the fault (a fix from the wrong time would show here), and how many were written flagged
+invalid.
+"""
+import argparse
+import csv
+import math
+
+A, F = 6378137.0, 1 / 298.257223563
+E2 = F * (2 - F)
+
+
+def ecef(lat, lon, h):
+    lat, lon = math.radians(lat), math.radians(lon)
+    n = A / math.sqrt(1 - E2 * math.sin(lat) ** 2)
+    return ((n + h) * math.cos(lat) * math.cos(lon), (n + h) * math.cos(lat) * math.sin(lon),
+            (n * (1 - E2) + h) * math.sin(lat))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("pvt")
+    ap.add_argument("lat", type=float)
+    ap.add_argument("lon", type=float)
+    ap.add_argument("h", type=float)
+    ap.add_argument("--start-tow", type=float, required=True)
+    ap.add_argument("--at", type=float, required=True)
+    ap.add_argument("--len", type=float, required=True)
+    ap.add_argument("--kind", choices=["cut", "zero"], required=True)
+    a = ap.parse_args()
+    x0 = ecef(a.lat, a.lon, a.h)
+    t_fault = a.start_tow + a.at
+    t_back = t_fault + a.len
+    first, worst, valid, flagged = None, 0.0, 0, 0
+    for r in csv.DictReader(open(a.pvt)):
+        if not r["tow_s"] or float(r["tow_s"]) <= t_fault:
+            continue
+        if r["quality"] == "none":
+            flagged += 1
+            continue
+        t = float(r["tow_s"])
+        err = math.dist(x0, [float(r[k]) for k in ("x_m", "y_m", "z_m")])
+        worst = max(worst, err)
+        valid += 1
+        if first is None:
+            first = t
+    back = f"{first - t_back:.1f} s" if first is not None else "never"
+    print(f"   back {back} after the signal returns; {valid} valid fixes after the fault, "
+          f"worst 3D error {worst:.1f} m; {flagged} written flagged invalid")
+
+
+if __name__ == "__main__":
+    main()
