@@ -93,8 +93,9 @@ if "$GPSRX" simulate samples/scenarios/static-seoul-4msps.toml -o "$SIM" --json 
   echo "simulate: $nsat satellites, real-time factor ${rtf}x"
   if [ "$nsat" -ge 10 ]; then ok "simulated 60 s 4 Msps ci8 with $nsat satellites (${rtf}x real time)"; else bad "only $nsat satellites simulated"; fi
   if [ -x scripts/gnss-sdr/run-gnss-sdr.sh ] || [ -f scripts/gnss-sdr/run-gnss-sdr.sh ]; then
-    # What the README says of it: GNSS-SDR tracks every simulated satellite, decodes telemetry
-    # from each, fixes by 40 s, and its fixes are within 3 m (mean 3D) of the scenario's truth.
+    # What the README says of it: GNSS-SDR tracks every simulated satellite and decodes
+    # telemetry from each, fixes by 40 s, and its fixes are within 3 m (mean 3D) of the
+    # scenario's truth. (It may also track a PRN that is not there: reported, not scored.)
     if MAX_ERR_M=3 bash scripts/gnss-sdr/run-gnss-sdr.sh "$SIM/signal.ci8" ci8 4000000 37.5665 126.9780 40.0 "$WORK/gnss-sdr" \
       && python3 - "$WORK/gnss-sdr/report.txt" "$WORK/sim.json" <<'PY'
 import json, re, sys
@@ -103,10 +104,14 @@ sim = {s[0] for s in json.load(open(sys.argv[2]))["satellites"]}  # [prn, elevat
 m = re.search(r"tracked PRNs : ([0-9 ]+)\(", report)
 tracked = {int(p) for p in m.group(1).split()} if m else set()
 assert sim <= tracked, f"GNSS-SDR tracked {sorted(tracked)}, simulated {sorted(sim)}"
-assert "no telemetry from" not in report, "a tracked satellite gave GNSS-SDR no telemetry"
+sf = re.search(r"subframes    : (.*)", report)
+with_tlm = {int(t.split(":")[0]) for t in sf.group(1).split()} if sf else set()
+assert sim <= with_tlm, f"no telemetry from simulated PRNs {sorted(sim - with_tlm)}"
+false_prns = sorted(tracked - sim)
 f = re.search(r"first fix    : ~([0-9.]+)-", report)
 assert f and float(f.group(1)) <= 40.0, f"first fix: {f.group(1) if f else 'none'}"
-print(f"GNSS-SDR: tracked all {len(sim)} simulated satellites, telemetry from each, first fix at ~{f.group(1)} s")
+print(f"GNSS-SDR: tracked all {len(sim)} simulated satellites, telemetry from each, first fix at ~{f.group(1)} s"
+      + (f"; also tracked PRNs not simulated: {false_prns}" if false_prns else ""))
 PY
     then
       ok "GNSS-SDR on the simulated recording: every satellite tracked, first fix by 40 s, mean 3D error < 3 m"
