@@ -66,3 +66,90 @@ pub fn conclusions_md(all: &[CellStats]) -> String {
     }
     md
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::landmarks::grid::Cell;
+
+    /// Every cell of the grid: availability `avail(n_sat, n_lm)`, HDOP `3 / (1 + n_lm)` times
+    /// `4 / n_sat`, PDOP twice that.
+    fn grid(avail: impl Fn(usize, usize) -> f64) -> Vec<CellStats> {
+        let mut v = Vec::new();
+        for n_sat in SATELLITES {
+            for n_lm in LANDMARKS {
+                let hdop = 3.0 / (1.0 + n_lm as f64) * 4.0 / n_sat as f64;
+                v.push(CellStats {
+                    cell: Cell { n_sat, n_lm },
+                    trials: 100,
+                    rank4: 1.0,
+                    allows: 1.0,
+                    available: avail(n_sat, n_lm),
+                    median_pdop: 2.0 * hdop,
+                    median_hdop: hdop,
+                    rms_error_m: 3.0,
+                });
+            }
+        }
+        v
+    }
+
+    fn base(n_sat: usize, n_lm: usize) -> f64 {
+        match (n_sat, n_lm) {
+            (3, 0) => 0.0,
+            (3, 1) => 0.72,
+            (3, _) => 0.925,
+            (4, 0) => 0.75,
+            _ => 1.0,
+        }
+    }
+
+    #[test]
+    fn the_conclusions_follow_the_cells() {
+        let mut all = grid(base);
+        let md = conclusions_md(&all);
+        assert!(
+            md.contains("0.0 % of the geometries without a landmark, 72.0 %"),
+            "{md}"
+        );
+        assert!(
+            md.contains("one street-level landmark raises the availability"),
+            "{md}"
+        );
+        assert!(md.contains("(falls with every landmark)"), "{md}");
+        assert!(
+            md.contains("- 0 landmark(s): at least 95 % availability from 5 satellites"),
+            "{md}"
+        );
+        assert!(
+            md.contains("- 2 landmark(s): at least 95 % availability from 4 satellites"),
+            "{md}"
+        );
+        // One landmark no longer helps with 3 satellites; the second landmark no longer lowers
+        // the HDOP with 4; nothing reaches 95 % without a landmark.
+        all = grid(|s, l| match (s, l) {
+            (3, 1) => 0.0,
+            (_, 0) => 0.5,
+            _ => base(s, l),
+        });
+        for c in all
+            .iter_mut()
+            .filter(|c| c.cell.n_sat == 4 && c.cell.n_lm == 2)
+        {
+            c.median_hdop = 5.0;
+        }
+        let md = conclusions_md(&all);
+        assert!(
+            md.contains("one street-level landmark does not raise"),
+            "{md}"
+        );
+        assert!(md.contains("(does not fall with every landmark)"), "{md}");
+        assert!(
+            md.contains("- 0 landmark(s): 95 % availability is not reached in the grid"),
+            "{md}"
+        );
+        // A cell missing from the grid: its sentence is left out, not guessed.
+        all.retain(|c| !(c.cell.n_sat == 3 && c.cell.n_lm == 1));
+        assert!(!conclusions_md(&all).contains("With 3 satellites"));
+    }
+}
