@@ -44,7 +44,7 @@ pub(super) const PAPER_RATIO: (f64, f64) = (1.65, 1.81);
 
 /// Where a measured range `lo..=hi` lies against the paper's range, in words.
 fn against_paper(lo: f64, hi: f64) -> &'static str {
-    if !(lo <= hi) {
+    if lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
         "not measured"
     } else if lo > PAPER_RATIO.1 {
         "above the paper's"
@@ -81,7 +81,7 @@ fn table_two_discussion(ratios: &[TableTwoRatio]) -> String {
     // The output whose ratio is closest to the middle of the paper's range.
     let mid = 0.5 * (PAPER_RATIO.0 + PAPER_RATIO.1);
     let dist = |lo: f64, hi: f64| {
-        if !(lo <= hi) {
+        if lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
             f64::INFINITY
         } else if (lo..=hi).contains(&mid) {
             0.0

@@ -66,7 +66,7 @@ fn bias_md(results: &[CaseResult]) -> String {
         return String::new();
     }
     let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
-    let shows = if (1.0 - BIAS_RATIO_TOL) * 2.0 <= mean && mean <= (1.0 + BIAS_RATIO_TOL) * 2.0 {
+    let shows = if ((1.0 - BIAS_RATIO_TOL) * 2.0..=(1.0 + BIAS_RATIO_TOL) * 2.0).contains(&mean) {
         "The bias shows in the mean error of the 2nd-order loop as theory says"
     } else if mean > 1.0 + SAME_MEAN {
         "The bias shows in the mean error of the 2nd-order loop, but not in the theory's \

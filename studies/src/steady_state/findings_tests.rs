@@ -87,7 +87,10 @@ fn the_bias_conclusion_needs_every_biased_cell_to_agree() {
         "{s}"
     );
     assert!(s.contains("error is negative here (every input)"), "{s}");
-    assert!(s.contains("order 2 settles at -0.0007380 cycle for every input"), "{s}");
+    assert!(
+        s.contains("order 2 settles at -0.0007380 cycle for every input"),
+        "{s}"
+    );
     // One 2nd-order biased cell measured with the opposite sign.
     let i = r
         .iter()
@@ -118,10 +121,7 @@ fn perfect_aiding_is_called_error_free_only_when_its_cells_agree() {
         s.contains("Perfect aiding (closed form 0 for every order): 12 of 12 cells agree, so"),
         "{s}"
     );
-    assert!(
-        s.contains("so it leaves no error for any order"),
-        "{s}"
-    );
+    assert!(s.contains("so it leaves no error for any order"), "{s}");
     measure(&mut r[0], 0.01);
     let s = md(&r);
     assert!(
