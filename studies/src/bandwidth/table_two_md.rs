@@ -47,11 +47,11 @@ fn against_paper(lo: f64, hi: f64) -> &'static str {
     if lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
         "not measured"
     } else if lo > PAPER_RATIO.1 {
-        "above the paper's"
+        "above the paper's range"
     } else if hi < PAPER_RATIO.0 {
-        "below the paper's"
+        "below the paper's range"
     } else {
-        "overlapping the paper's"
+        "overlapping the paper's range"
     }
 }
 
@@ -108,7 +108,8 @@ fn table_two_discussion(ratios: &[TableTwoRatio]) -> String {
         )
     } else {
         format!(
-            "Closest to the paper's {:.2}-{:.2}: {closest} ({} it without oscillator noise).",
+            "Closest to the paper's {:.2}-{:.2}: {closest}; without oscillator noise the 1 s \
+             ratio is {}.",
             PAPER_RATIO.0,
             PAPER_RATIO.1,
             against_paper(a, b)

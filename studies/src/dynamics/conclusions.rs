@@ -342,6 +342,8 @@ mod tests {
         assert!(md.contains("INS 2 / INS 1 discriminator std 1.120"), "{md}");
         assert!(md.contains("(1 of 1 within the paper's 1.09-1.17)"), "{md}");
         assert!(!md.contains("The bias does not change the std"), "{md}");
+        // One INS pair: no trend with the bias is claimed.
+        assert!(!md.contains("rise"), "{md}");
         // Equal phase std against the truth: the discriminator is the cause.
         assert!(
             md.contains("comes from the discriminator, not from the loop"),

@@ -88,7 +88,7 @@ fn the_bias_conclusion_needs_every_biased_cell_to_agree() {
     );
     assert!(s.contains("error is negative here (every input)"), "{s}");
     assert!(
-        s.contains("order 2 settles at -0.0007380 cycle for every input"),
+        s.contains("order 2 -0.0007380 cycles for every input"),
         "{s}"
     );
     // One 2nd-order biased cell measured with the opposite sign.
