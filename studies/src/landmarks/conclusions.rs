@@ -33,10 +33,19 @@ pub fn conclusions_md(all: &[CellStats]) -> String {
         let cells: Vec<Option<&CellStats>> = LANDMARKS.map(|l| find(all, n_sat, l)).collect();
         if let [Some(a), Some(b), Some(c)] = cells[..] {
             let falls = b.median_hdop < a.median_hdop && c.median_hdop < b.median_hdop;
+            // Relative fall from 0 to 2 landmarks: which DOP the landmarks help more.
+            let h_fall = 1.0 - c.median_hdop / a.median_hdop;
+            let p_fall = 1.0 - c.median_pdop / a.median_pdop;
+            let more = if h_fall > p_fall {
+                "the horizontal more than the whole position"
+            } else {
+                "the horizontal no more than the whole position"
+            };
             let _ = writeln!(
                 md,
                 "- With {n_sat} satellites the median HDOP is {} / {} / {} with 0 / 1 / 2 \
-                 landmarks ({}), the median PDOP {} / {} / {}.",
+                 landmarks ({}), the median PDOP {} / {} / {}: two landmarks lower the HDOP by \
+                 {} and the PDOP by {}, so they help {more}.",
                 fmt(a.median_hdop, 2),
                 fmt(b.median_hdop, 2),
                 fmt(c.median_hdop, 2),
@@ -47,7 +56,9 @@ pub fn conclusions_md(all: &[CellStats]) -> String {
                 },
                 fmt(a.median_pdop, 2),
                 fmt(b.median_pdop, 2),
-                fmt(c.median_pdop, 2)
+                fmt(c.median_pdop, 2),
+                pct(h_fall),
+                pct(p_fall)
             );
         }
     }
@@ -117,6 +128,21 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("(falls with every landmark)"), "{md}");
+        // HDOP 3 -> 1 (66.7 %), PDOP 6 -> 2 (66.7 %) with 4 satellites: not more.
+        assert!(
+            md.contains("lower the HDOP by 66.7 % and the PDOP by 66.7 %"),
+            "{md}"
+        );
+        assert!(md.contains("help the horizontal no more than"), "{md}");
+        let mut lifted = all.clone();
+        for c in lifted.iter_mut().filter(|c| c.cell.n_lm == 2) {
+            c.median_pdop *= 2.0;
+        }
+        let md2 = conclusions_md(&lifted);
+        assert!(
+            md2.contains("help the horizontal more than the whole position"),
+            "{md2}"
+        );
         assert!(
             md.contains("- 0 landmark(s): at least 95 % availability from 5 satellites"),
             "{md}"
