@@ -203,6 +203,13 @@ fn the_absolute_table_two_follows_the_rows() {
         "{md}"
     );
     assert!(md.contains("the paper's 1 Hz value is 2 x this"), "{md}");
+    // No channel held lock at 1 Hz (NaN): said so, no trend and no scale claimed.
+    let md = absolute_md(&[abs_row(f64::NAN, 0.0095)]);
+    assert!(
+        md.contains("no 1 s error at Bn 1 Hz (no channel held lock), so no trend"),
+        "{md}"
+    );
+    assert!(!md.contains("NaN x"), "{md}");
     let md = absolute_md(&[abs_row(0.035, 0.06)]);
     assert!(md.contains("the 1 s error grows"), "{md}");
     assert!(

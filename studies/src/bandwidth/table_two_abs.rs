@@ -163,6 +163,19 @@ fn absolute_discussion(rows: &[AbsoluteRow]) -> String {
         .iter()
         .map(|r| {
             let q = r.bn4_1s_mps / r.bn1_1s_mps;
+            if !q.is_finite() {
+                let missing: Vec<&str> = [(r.bn1_1s_mps, "1"), (r.bn4_1s_mps, "4")]
+                    .iter()
+                    .filter(|(v, _)| !v.is_finite())
+                    .map(|(_, bn)| *bn)
+                    .collect();
+                return format!(
+                    "{} at {} dB-Hz: no 1 s error at Bn {} Hz (no channel held lock), so no trend",
+                    r.oscillator,
+                    r.cn0_dbhz,
+                    missing.join(" and ")
+                );
+            }
             let trend = if q > 1.0 {
                 "grows"
             } else if q < 1.0 {
