@@ -113,7 +113,7 @@ fn the_outage_ratio_is_compared_with_the_paper_by_its_value() {
     // 10 m over 90 m: 0.111, below the paper's 0.40.
     assert!(md.contains("**case2_outage_error_ratio = 0.111**"), "{md}");
     assert!(
-        md.contains("(largest single ratio 0.125), below the paper's 0.40"),
+        md.contains("(single outages 0.100-0.125, median 0.113), below the paper's 0.40"),
         "{md}"
     );
     assert!(
