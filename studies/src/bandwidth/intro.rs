@@ -4,6 +4,7 @@ use super::{
     RunInfo, DLL_BN_HZ, EL_SPACING_CHIPS, FS_HZ, LONG_INTERVAL_S, MAX_SETTLE_S, OBS_INTERVAL_S,
     SETTLE_FRACTION,
 };
+use gpsrx_dsp::constants::F_L1_HZ;
 use std::fmt::Write as _;
 
 pub(super) fn intro(info: &RunInfo) -> String {
@@ -14,8 +15,10 @@ pub(super) fn intro(info: &RunInfo) -> String {
         "Simulated static receiver (Seoul, {}), clock without noise (Allan deviation 0): the \
          loops see thermal noise only. Real oscillators add the Allan term (oracles.md: about \
          `144 sigma_A f_L1 / Bn` deg for a 2nd-order loop, `160 sigma_A f_L1 / Bn` for a 3rd; \
-         7.6 deg at 3 Hz for sigma_A = 1e-10), which grows as Bn shrinks and is not in this table.\n",
-        if quick { "`--quick` grid" } else { "full grid" }
+         {:.1} deg at 3 Hz for sigma_A = 1e-10), which grows as Bn shrinks and is not in this \
+         table.\n",
+        if quick { "`--quick` grid" } else { "full grid" },
+        144.0 * 1e-10 * F_L1_HZ / 3.0
     );
     let _ = writeln!(
         s,
@@ -31,8 +34,8 @@ pub(super) fn intro(info: &RunInfo) -> String {
          settling time `settle_s` from the hand-over to \
          tracking (1 s plus the time the cell's linearised loop takes to bring a start-up \
          transient down to {SETTLE_FRACTION:e} of its size: about 8 time constants of its \
-         slowest mode; 6.3/Bn s for order 2 but 43/Bn s for the lightly damped 3rd-order loop; \
-         at most {MAX_SETTLE_S} s), per integration interval against the simulator's truth, \
+         slowest mode, longer for the lightly damped 3rd-order loop: the conclusions give the \
+         values; at most {MAX_SETTLE_S} s), per integration interval against the simulator's truth, \
          pooled over the three satellites: `phase_jitter_deg` = \
          std of the replica (NCO) carrier phase minus the true carrier phase (offset and Costas \
          half cycle removed){}; `doppler_std_hz` = NCO frequency held over each interval minus \

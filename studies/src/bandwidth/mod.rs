@@ -51,6 +51,8 @@
 
 mod channel;
 mod conclusions;
+#[cfg(test)]
+mod conclusions_tests;
 mod discriminator;
 mod doppler_code_md;
 mod formulas;

@@ -6,8 +6,7 @@ pub const FS_HZ: f64 = 2.5e6;
 /// The satellites of every recording (all at the recording's C/N0): Dopplers +3672, -3183 and
 /// +1975 Hz at the start, so that the code drifts across the sample grid at 1.3-2.4 chip/s (a
 /// satellite near zero Doppler, e.g. G31 at +201 Hz, drifts at 0.13 chip/s and its code error
-/// then carries the slowly varying sample-grid bias of the unfiltered correlation triangle,
-/// 0.0043 instead of 0.0024 chip at 50 dB-Hz: see the study's conclusions).
+/// then carries the slowly varying sample-grid bias of the unfiltered correlation triangle).
 pub const PRNS: [u8; 3] = [16, 25, 26];
 /// DLL: order 1 (carrier-aided), this noise bandwidth, Hz.
 pub const DLL_BN_HZ: f64 = 1.0;

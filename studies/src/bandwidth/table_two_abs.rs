@@ -107,8 +107,8 @@ pub(super) fn absolute_md(rows: &[AbsoluteRow]) -> String {
     let mut s = String::from(
         "\n### Seed 004 Table 2 in m/s, with a stated oscillator\n\n\
          Unaided 2nd-order PLL, T = 1 ms, static; the receiver clock of the simulation is the \
-         two-state oscillator model (white FM + random-walk FM). Seed 004: 0.031-0.040 m/s at \
-         Bn = 1 Hz and 0.052-0.070 m/s at 4 Hz.\n\n\
+         two-state oscillator model (white FM + random-walk FM). Paper (not measured here): \
+         seed 004 reports 0.031-0.040 m/s at Bn = 1 Hz and 0.052-0.070 m/s at 4 Hz.\n\n\
          | oscillator | sigma_y(1 s) | C/N0 | Bn 1 Hz, 1 s (m/s) | Bn 4 Hz, 1 s (m/s) | ratio | \
          Bn 1 Hz, 0.1 s (m/s) | Bn 4 Hz, 0.1 s (m/s) |\n|---|---|---|---|---|---|---|---|\n",
     );
@@ -126,8 +126,23 @@ pub(super) fn absolute_md(rows: &[AbsoluteRow]) -> String {
             r.bn4_0p1s_mps
         );
     }
+    s += &absolute_discussion(rows);
+    s
+}
+
+/// Seed 004's pseudorange-rate error std at Bn = 1 Hz and 4 Hz, m/s (paper, not measured here).
+const PAPER_1HZ_MPS: (f64, f64) = (0.031, 0.040);
+/// The same at 4 Hz.
+const PAPER_4HZ_MPS: (f64, f64) = (0.052, 0.070);
+
+/// What the rows show, each statement computed from them: which rows fall within seed 004's
+/// ranges, how far the paper's 1 Hz value is from each, and whether the 1 s error grows or falls
+/// from 1 Hz to 4 Hz with each oscillator.
+fn absolute_discussion(rows: &[AbsoluteRow]) -> String {
+    let mut s = String::new();
     let in_paper = |r: &&AbsoluteRow| {
-        (0.031..=0.040).contains(&r.bn1_1s_mps) || (0.052..=0.070).contains(&r.bn4_1s_mps)
+        (PAPER_1HZ_MPS.0..=PAPER_1HZ_MPS.1).contains(&r.bn1_1s_mps)
+            || (PAPER_4HZ_MPS.0..=PAPER_4HZ_MPS.1).contains(&r.bn4_1s_mps)
     };
     let matching: Vec<String> = rows
         .iter()
@@ -143,5 +158,45 @@ pub(super) fn absolute_md(rows: &[AbsoluteRow]) -> String {
             matching.join(", ")
         }
     );
+    let paper_mid = 0.5 * (PAPER_1HZ_MPS.0 + PAPER_1HZ_MPS.1);
+    let per_row: Vec<String> = rows
+        .iter()
+        .map(|r| {
+            let q = r.bn4_1s_mps / r.bn1_1s_mps;
+            if !q.is_finite() {
+                let missing: Vec<&str> = [(r.bn1_1s_mps, "1"), (r.bn4_1s_mps, "4")]
+                    .iter()
+                    .filter(|(v, _)| !v.is_finite())
+                    .map(|(_, bn)| *bn)
+                    .collect();
+                return format!(
+                    "{} at {} dB-Hz: no 1 s error at Bn {} Hz (no channel held lock), so no trend",
+                    r.oscillator,
+                    r.cn0_dbhz,
+                    missing.join(" and ")
+                );
+            }
+            let trend = if q > 1.0 {
+                "grows"
+            } else if q < 1.0 {
+                "falls"
+            } else {
+                "does not change"
+            };
+            let scale = paper_mid / r.bn1_1s_mps;
+            let level = if scale >= 1.0 {
+                format!("the paper's 1 Hz value is {scale:.0} x this")
+            } else {
+                format!("this is {:.1} x the paper's 1 Hz value", 1.0 / scale)
+            };
+            format!(
+                "{} at {} dB-Hz: the 1 s error {trend} from 1 Hz to 4 Hz ({q:.2}); {level}",
+                r.oscillator, r.cn0_dbhz
+            )
+        })
+        .collect();
+    if !per_row.is_empty() {
+        let _ = writeln!(s, "\n{}.", per_row.join("; "));
+    }
     s
 }

@@ -25,6 +25,9 @@
 //! hold, RMS pooled over all gaps and seeds).
 
 pub mod cases;
+mod conclusions;
+#[cfg(test)]
+mod conclusions_tests;
 pub mod drive;
 pub mod fusion;
 pub mod gnss;

@@ -1,12 +1,13 @@
 //! Gathers the job results into the study's headline numbers, `study.json` and the report.
 
 use super::cases::{JobResult, OutageStats, SectionStats};
+use super::conclusions::conclusions_md;
 use super::drive::Drive;
 use super::fusion::FusionRun;
 use super::params::{CASE3_TILT_DEG, SECTIONS};
 use super::plots::{draw_plots, plot_links, write_speed_trace};
 use super::speed::{GapResult, SpeedRun};
-use super::tables::{conclusions_md, intro_md, table};
+use super::tables::{intro_md, table};
 use super::DrArgs;
 use crate::report::StudyReport;
 use gpsrx_ins_aiding::SEED000_SF_G_DPS_PER_V;
@@ -70,7 +71,7 @@ fn pooled_rms(speed: &[(u64, &[GapResult])]) -> (f64, f64) {
     ((f2 / m).sqrt(), (h2 / m).sqrt())
 }
 
-fn headline(g: &Gathered) -> Headline {
+pub(super) fn headline(g: &Gathered) -> Headline {
     let (sp, sc) = g.outages.iter().fold((0.0, 0.0), |(a, b), o| {
         (a + o.proposed.0, b + o.conventional.0)
     });

@@ -342,6 +342,8 @@ mod tests {
         assert!(md.contains("INS 2 / INS 1 discriminator std 1.120"), "{md}");
         assert!(md.contains("(1 of 1 within the paper's 1.09-1.17)"), "{md}");
         assert!(!md.contains("The bias does not change the std"), "{md}");
+        // One INS pair: no trend with the bias is claimed.
+        assert!(!md.contains("rise"), "{md}");
         // Equal phase std against the truth: the discriminator is the cause.
         assert!(
             md.contains("comes from the discriminator, not from the loop"),
@@ -375,6 +377,57 @@ mod tests {
         let md = conclusions_md(&r);
         assert!(
             md.contains("leaving out G01 (never tracked into the turn)): through the turn 0.4 Hz"),
+            "{md}"
+        );
+    }
+
+    /// The aided 1st-order loops (INS 1 and INS 2) growing at `g1` and `g2` deg/s against the
+    /// theory's 0.1 and 0.2 deg/s, and a 2nd-order loop aided by INS 2 growing at `g_o2`.
+    fn order1_results(g1: f64, g2: f64, g_o2: f64) -> Vec<CaseResult> {
+        use crate::dynamics::params::ORDER1_BN_HZ;
+        let mut out = Vec::new();
+        for (order, aiding, g, p) in [
+            (1u8, Aiding::Ins1, g1, 0.1),
+            (1, Aiding::Ins2, g2, 0.2),
+            (2, Aiding::Ins2, g_o2, 0.0),
+        ] {
+            let case = Case {
+                order,
+                bn_hz: ORDER1_BN_HZ,
+                aiding,
+                ins1_bias_mps2: 0.05,
+            };
+            let mut r = test_result(spec(), case, N, 0.09);
+            r.growth_abs_deg_s = g;
+            r.predicted_growth_deg_s = p;
+            r.disc_mean_abs_deg = 1.0;
+            r.predicted_mean_abs_deg = 1.0;
+            out.push(r);
+        }
+        out
+    }
+
+    #[test]
+    fn the_order1_conclusions_follow_the_growth() {
+        let md = conclusions_md(&order1_results(0.1, 0.2, 0.001));
+        assert!(md.contains("(ratio 2.00; theory"), "{md}");
+        assert!(
+            md.contains("The growth follows the theory within 20 %"),
+            "{md}"
+        );
+        assert!(
+            md.contains("grows at only 0.001 deg/s: an aided loop needs order >= 2"),
+            "{md}"
+        );
+        // INS 2's growth no longer double INS 1's; the 2nd-order loop grows as fast.
+        let md = conclusions_md(&order1_results(0.1, 0.12, 0.1));
+        assert!(md.contains("(ratio 1.20;"), "{md}");
+        assert!(
+            md.contains("does not follow the theory within 20 %"),
+            "{md}"
+        );
+        assert!(
+            md.contains("not less than a tenth of the 1st-order loop's"),
             "{md}"
         );
     }

@@ -88,6 +88,9 @@ either INS (kept {}), so there is no ratio.\n",
         .all(|r| (r - 1.0).abs() < SAME);
     s += &if all_same {
         format!("The bias does not change the std (every ratio within {SAME} of 1). ")
+    } else if finite.len() < 2 {
+        // One INS pair: no trend with the bias to state.
+        String::new()
     } else if rising {
         "The ratio rises with the bias. ".to_string()
     } else {
@@ -105,8 +108,13 @@ atan(Q/I) folding more of its noise at +-90 deg about INS 2's larger static offs
         .collect();
     let lo = d1.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = d1.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let level = if format!("{lo:.3}") == format!("{hi:.3}") {
+        format!("{lo:.3}")
+    } else {
+        format!("{lo:.3}-{hi:.3}")
+    };
     s += &format!(
-        "INS 1's discriminator std is {lo:.3}-{hi:.3} cycle ({} the paper's {:.3}-{:.3}). ",
+        "INS 1's discriminator std is {level} cycle ({} the paper's {:.3}-{:.3}). ",
         if lo <= PAPER_STD.1 && hi >= PAPER_STD.0 {
             "overlapping"
         } else if hi < PAPER_STD.0 {

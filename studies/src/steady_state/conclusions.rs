@@ -1,13 +1,14 @@
-//! The introduction and conclusions text of the report.
+//! The introduction and conclusions text of the report (the findings, each decided by the
+//! measured cells, are in [`super::findings`]).
 
 use gpsrx_tracking::loop_filter::omega0;
 use gpsrx_tracking::phase_sim::LAMBDA_M;
 use std::fmt::Write as _;
 
+use super::findings::{aiding_md, dc_property_md, seed_differences_md};
 use super::text::{short, sig};
 use super::{
-    stability_limit_bn_t, Aiding, CellResult, SteadyStateArgs, MAIN_T_COH_S,
-    TARGET_END_ERROR_CYCLES, TARGET_ERROR_CYCLES,
+    CellResult, SteadyStateArgs, MAIN_T_COH_S, TARGET_END_ERROR_CYCLES, TARGET_ERROR_CYCLES,
 };
 use crate::report::Table;
 
@@ -112,7 +113,6 @@ pub(super) fn conclusions_md(
     }
     let others: Vec<&serde_json::Value> = per_cfg.iter().filter(|c| c["main"] == false).collect();
     let count = |k: &str| -> u64 { others.iter().map(|c| c[k].as_u64().unwrap_or(0)).sum() };
-    let limits: Vec<String> = (1..=3u8).map(|o| short(stability_limit_bn_t(o))).collect();
     if !others.is_empty() {
         s += "**Other loop configurations** (full run; their rows follow the main table):\n\n";
         s += &cfg_table.to_markdown();
@@ -131,56 +131,8 @@ were not run because the digital loop is unstable there.",
             count("cells_not_run")
         );
     }
-    let _ = writeln!(
-        s,
-        "- The steady-state error is a DC property of the digital loop: in steady state the \
-integrators must ramp the NCO exactly as the residual does, which fixes the error by the \
-integrator gains alone. So the closed forms, written with the implemented omega0, hold for any \
-*stable* Bn T, not only for Bn T << 1{}. What departs from the analog design as Bn T grows is \
-the loop's noise bandwidth (the digital loop's integral of |H|^2, last column: up to several \
-times the design Bn), its transients (the `max_abs_error_cycles` column) and its stability: \
-this implementation's loops are stable for Bn T below {} (orders 1, 2, 3; \
-`loop_analysis::is_stable`, independent of T), not the 0.18 quoted in `oracles.md` for a \
-3rd-order bilinear loop, and `LoopConfig` accepts Bn T <= {}. Stable loops beyond that limit \
-are simulated with the loop filter and Costas discriminator directly (the computation of \
-`CarrierLoop`).",
-        if others.is_empty() {
-            " (the full run checks this up to Bn T = 0.5)"
-        } else {
-            ""
-        },
-        limits.join(", "),
-        short(gpsrx_tracking::config::MAX_BN_T),
-    );
-    let max_perfect = results
-        .iter()
-        .filter(|r| r.cell.aiding == Aiding::Perfect)
-        .fold(0.0_f64, |m, r| m.max(r.measured.abs()));
-    let _ = writeln!(
-        s,
-        "- Perfect aiding leaves no error for any order (seed 004 eq. 7): largest steady error \
-{} cycle over all runs (not exactly 0 because the NCO holds one \
-frequency per interval, so a curved phase leaves -theta'' T^2/12 inside each interval, which \
-the loop sees and mostly removes).",
-        sig(max_perfect)
-    );
-    s += "- The band-limited aid \
-removes one order of dynamics (the residual is the input times s/(s + alpha)); an INS \
-accelerometer bias adds a Doppler ramp that a 1st-order loop cannot follow, a 2nd-order loop \
-follows with a constant error -B_V/(lambda omega0^2) and a 3rd-order loop removes: aided loops \
-need order >= 2, as seed 004 concludes (order 3 to remove the bias error entirely).\n";
-    s += "- Differences from seed 004 Table 1: (1) the bias columns. Seed eq. 16 writes the \
-Doppler error as `B_V/(s lambda)`, a frequency *step*, although the velocity error of a constant \
-bias is `B_V t` (eq. 13), whose transform is `B_V/s^2`: a frequency *ramp*. The seed's entries \
-B_V/(lambda omega_n) (order 1, step input) and 0 (order 2) are what a constant velocity error \
-gives; with the ramp, order 1 grows without bound and order 2 settles at -B_V/(lambda omega0^2), \
-for every input, as measured here (the seed's -1/omega_n^2 for order 2 under an acceleration \
-input is this value for a unit Doppler ramp, and its order-1 'infinity' matches). Its order-1 \
-velocity entry (1 + B_V/lambda)/omega_n adds an unaided unit-ramp error that perfect aiding \
-removes; not reproduced. (2) Band-limited jerk, order 2: the seed's text gives 6/(alpha omega_n) \
-for theta = t^3; the dimensions and this simulation give j/(alpha omega0^2) (j = 6). Its order-1 \
-acceleration entry 2/(alpha omega_n) for theta = t^2 (a = 2) agrees. (3) The biased-INS \
-2nd-order error is negative here: error = signal - NCO and an aid that is too high makes the NCO \
-run ahead (`oracles.md` quotes its magnitude, 360 B_V/(lambda omega0^2) deg).\n";
+    s += &dc_property_md(args, per_cfg, results);
+    s += &aiding_md(args, results);
+    s += &seed_differences_md(args, results);
     s
 }

@@ -72,6 +72,9 @@ mod aid;
 mod cell;
 mod closed_form;
 mod conclusions;
+mod findings;
+#[cfg(test)]
+mod findings_tests;
 mod fit;
 mod inputs;
 mod plan;
