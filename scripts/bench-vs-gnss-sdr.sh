@@ -10,7 +10,8 @@
 #    - ci16 (16-bit complex): GNSS-SDR's fixed-point path, 16i_resamplerxn (writes the three
 #      16-bit code replicas) then 16ic_16i_rotator_dotprodxn (wipe-off and dot products),
 #      complete per channel = 1/(1/resampler + 1/rotator); and its rotator alone (replicas
-#      given for free) for reference. Ours: `gpsrx bench` avx2+fma/i16 on ci16.
+#      given for free) for reference. Ours: the best AVX2 kernel of `gpsrx bench` on ci16 (the
+#      one `auto` takes), and our int16 kernel on ci16 for the issue-28 target.
 #    - cf32 (32-bit float complex): GNSS-SDR's float path, 32f_resamplerxn then
 #      32fc_32f_rotator_dotprodxn, complete as above. Ours: avx2+fma/f32 on cf32.
 #    - ci8 (8-bit complex): ours, avx2+fma/i16 on ci8 (16 samples per step). GNSS-SDR has no
@@ -126,7 +127,9 @@ res16, rot16, res32, rot32 = map(float, sys.argv[2:6])
 rows = [r for f in sys.argv[6:] for r in json.load(open(f))["correlators"] if r["taps"] == 3]
 
 def ours(kernel, fmt):
-    hits = [r for r in rows if r["kernel"] == kernel and r["format"] == fmt]
+    """Our best 3-tap figure on `fmt` of `kernel`, or of every AVX2 kernel when kernel is None."""
+    hits = [r for r in rows if r["format"] == fmt
+            and (r["kernel"] == kernel if kernel else r["kernel"].startswith("avx2"))]
     if not hits:
         sys.exit(f"gpsrx bench gave no 3-tap {kernel} figure on {fmt}: does this CPU have AVX2? ({machine})")
     best = max(hits, key=lambda r: r["msps_per_core"])
@@ -134,7 +137,8 @@ def ours(kernel, fmt):
 
 complete16 = 1.0 / (1.0 / res16 + 1.0 / rot16)
 complete32 = 1.0 / (1.0 / res32 + 1.0 / rot32)
-o16, k16 = ours("avx2+fma/i16", "ci16")
+o16, k16 = ours(None, "ci16")
+o16i, k16i = ours("avx2+fma/i16", "ci16")
 o32, k32 = ours("avx2+fma/f32", "cf32")
 o8, k8 = ours("avx2+fma/i16", "ci8")
 print()
@@ -146,8 +150,9 @@ print(f"  ci16   {k16:<30} {o16:7.0f}   {'16i_resampler + 16ic_16i_rotator':<40}
 print(f"  ci16   {'':<30} {'':>7}   {'16ic_16i_rotator alone (replicas given)':<40} {rot16:8.0f}   {o16 / rot16:.2f}x")
 print(f"  cf32   {k32:<30} {o32:7.0f}   {'32f_resampler + 32fc_32f_rotator':<40} {complete32:8.0f}   {o32 / complete32:.2f}x")
 print(f"  ci8    {k8:<30} {o8:7.0f}   {'none (8-bit input is widened first)':<40} {'-':>8}   -")
-print(f"  issue 28 target, ci16 AVX2 int16 >= 2x 16ic_16i (rotator alone): {o16 / rot16:.2f}x, "
-      + ("met" if o16 / rot16 >= 2.0 else "NOT met"))
+print(f"  (ours on ci16: the best AVX2 kernel, the one `auto` takes; our int16 kernel on ci16: {k16i} {o16i:.0f})")
+print(f"  issue 28 target, ci16 AVX2 int16 >= 2x 16ic_16i (rotator alone): {o16i / rot16:.2f}x, "
+      + ("met" if o16i / rot16 >= 2.0 else "NOT met"))
 EOF
 
 # ------------------------------------------------------------------ end to end
