@@ -15,6 +15,12 @@ pub struct Measured {
     /// The first run that failed (one step below the threshold), with its C/N0; `None` when the
     /// scan reached its bottom without a failure.
     pub first_failure: Option<(f64, RunOutcome)>,
+    /// The same for the loop itself, by the truth ([`RunOutcome::slip_free_fraction`]): the
+    /// lowest C/N0 of the scan at which the loop ran slip-free for the hold fraction of the
+    /// window.
+    pub loop_threshold_dbhz: Option<f64>,
+    /// The first run whose loop slipped too early, with its C/N0.
+    pub loop_first_failure: Option<(f64, RunOutcome)>,
     /// Runs made.
     pub runs: usize,
 }
@@ -32,9 +38,10 @@ pub fn run_seed(seed: u64, cell: &Cell, step: usize) -> u64 {
 }
 
 /// Scans `cell` from [`SCAN_TOP_DBHZ`] down in steps of [`SCAN_STEP_DB`], one 30 s run per
-/// step ([`run`]), until a run holds lock less than [`HOLD_FRACTION`] of its window: the
-/// threshold is the last C/N0 that held (the scan stops at the first failure, so a lucky run
-/// below it cannot lower the threshold).
+/// step ([`run`]): the threshold is the last C/N0 before the first run that holds lock less
+/// than [`HOLD_FRACTION`] of its window (a lucky run below the first failure cannot lower
+/// it). The loop's own threshold (slip-free for that share of the window) is found in the
+/// same runs; the scan goes on until both have failed.
 ///
 /// Errors: the receiver refuses the cell's loop.
 pub fn measure_cell(cell: &Cell, seed: u64) -> anyhow::Result<Measured> {
@@ -43,18 +50,31 @@ pub fn measure_cell(cell: &Cell, seed: u64) -> anyhow::Result<Measured> {
         threshold_dbhz: None,
         at_threshold: None,
         first_failure: None,
+        loop_threshold_dbhz: None,
+        loop_first_failure: None,
         runs: 0,
     };
     for step in 0..=steps {
+        if m.first_failure.is_some() && m.loop_first_failure.is_some() {
+            break;
+        }
         let cn0 = SCAN_TOP_DBHZ - step as f64 * SCAN_STEP_DB;
         let out = run(cell, cn0, run_seed(seed, cell, step))?;
         m.runs += 1;
-        if out.held_fraction >= HOLD_FRACTION {
-            m.threshold_dbhz = Some(cn0);
-            m.at_threshold = Some(out);
-        } else {
-            m.first_failure = Some((cn0, out));
-            break;
+        if m.first_failure.is_none() {
+            if out.held_fraction >= HOLD_FRACTION {
+                m.threshold_dbhz = Some(cn0);
+                m.at_threshold = Some(out);
+            } else {
+                m.first_failure = Some((cn0, out));
+            }
+        }
+        if m.loop_first_failure.is_none() {
+            if out.slip_free_fraction >= HOLD_FRACTION {
+                m.loop_threshold_dbhz = Some(cn0);
+            } else {
+                m.loop_first_failure = Some((cn0, out));
+            }
         }
     }
     Ok(m)

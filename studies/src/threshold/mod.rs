@@ -82,7 +82,11 @@ pub fn run(args: &ThresholdArgs, progress: bool) -> anyhow::Result<StudyReport> 
     let quick = args.common.quick;
     let cells = if quick { quick_grid() } else { full_grid() };
     let results = measure_cells(&cells, args.common.seed, progress)?;
-    let runs: usize = results.iter().filter_map(|r| r.measured).map(|m| m.runs).sum();
+    let runs: usize = results
+        .iter()
+        .filter_map(|r| r.measured)
+        .map(|m| m.runs)
+        .sum();
     let wall_s = t0.elapsed().as_secs_f64();
     let n_run = results.iter().filter(|r| r.rejected.is_none()).count();
     let agree = results
@@ -143,8 +147,13 @@ fn intro_md(quick: bool, seed: u64, runs: usize, wall_s: f64) -> String {
          held (`none`: not even at the top). {runs} runs in {wall_s:.0} s.\n\n\
          **Other columns**: `stress_deg` theta_e; `detector_dbhz` the lock detector's floor \
          (where `exp(-2 sigma^2) g rho/(g rho + 1)` reaches 0.7, `rho` = 20 ms of C/N0, `g` = \
-         {g:.3} the block power a bit transition leaves); `expected_dbhz` the higher of the \
-         two; `bn_real_hz` the digital loop's realised noise bandwidth and `theory_real_dbhz` \
+         {g:.3} the block power a bit transition leaves); `theory_slope_dbhz` the rule with the \
+         stress divided by the Costas atan slope `1 - exp(-C/N0 T)` (a lower loop gain leaves a \
+         larger steady-state error); `stable_dbhz` the C/N0 below which that slope leaves a \
+         3rd-order loop (only conditionally stable) linearly unstable; `expected_dbhz` the \
+         highest of `theory_slope_dbhz`, `stable_dbhz` and `detector_dbhz`; `loop_dbhz` the \
+         loop's own threshold by the truth (no half-cycle slip, a 3/8-cycle excursion, in the \
+         first 95 % of the window), whatever the lock detector reports; `bn_real_hz` the digital loop's realised noise bandwidth and `theory_real_dbhz` \
          the rule with it; `below_threshold` the first failing run.\n",
         hold = 100.0 * HOLD_FRACTION,
         window = WINDOW_S,

@@ -45,7 +45,13 @@ pub fn plots(results: &[CellResult]) -> Vec<LinePlot> {
                     } else {
                         format!("order {order}, {}", dynamics.name())
                     };
-                    let m = points(results, order, t_coh_ms, dynamics, CellResult::measured_dbhz);
+                    let m = points(
+                        results,
+                        order,
+                        t_coh_ms,
+                        dynamics,
+                        CellResult::measured_dbhz,
+                    );
                     let t = points(results, order, t_coh_ms, dynamics, |r| r.theory.rule_dbhz);
                     if m.is_empty() && t.is_empty() {
                         continue;
@@ -61,7 +67,9 @@ pub fn plots(results: &[CellResult]) -> Vec<LinePlot> {
                         reference: true,
                     });
                     if static_only && !floor_done {
-                        let f = points(results, order, t_coh_ms, dynamics, |r| r.theory.detector_dbhz);
+                        let f = points(results, order, t_coh_ms, dynamics, |r| {
+                            r.theory.detector_dbhz
+                        });
                         if !f.is_empty() {
                             series.push(Series {
                                 name: "lock detector floor".into(),

@@ -3,7 +3,8 @@
 use super::measure::Measured;
 use super::params::{AGREE_DB, F_L1_HZ};
 use super::theory::{
-    allan_jitter_deg, detector_floor_dbhz, dynamic_stress_deg, rule_threshold_dbhz, RuleInputs,
+    allan_jitter_deg, detector_floor_dbhz, dynamic_stress_deg, rule_threshold_dbhz,
+    rule_with_slope_dbhz, stability_floor_dbhz, RuleInputs,
 };
 use super::Cell;
 use crate::bandwidth::LoopNoiseGains;
@@ -16,19 +17,33 @@ pub struct CellTheory {
     pub stress_deg: f64,
     /// The rule of thumb `3 sigma + theta_e <= 45` deg with the design Bn, dB-Hz.
     pub rule_dbhz: Option<f64>,
+    /// The rule with the stress divided by the Costas discriminator's slope, dB-Hz.
+    pub rule_slope_dbhz: Option<f64>,
     /// The digital loop's realised noise bandwidth (linearised, discriminator slope 1), Hz.
     pub realised_bn_hz: f64,
     /// The rule of thumb with the realised Bn, dB-Hz.
     pub rule_realised_dbhz: Option<f64>,
     /// The receiver's lock-detector floor with the rule's jitter, dB-Hz.
     pub detector_dbhz: Option<f64>,
+    /// The C/N0 below which the linearised loop with the Costas slope is unstable, dB-Hz
+    /// (`None`: stable at every C/N0).
+    pub stable_dbhz: Option<f64>,
 }
 
 impl CellTheory {
-    /// What the receiver can at best report: the higher of the rule and the detector floor
-    /// (`None` if either has no threshold).
+    /// What the receiver can at best report: the highest of the rule, the detector floor and
+    /// the stability floor (`None` if the rule or the detector has no threshold).
     pub fn expected_dbhz(&self) -> Option<f64> {
-        Some(self.rule_dbhz?.max(self.detector_dbhz?))
+        Some(self.loop_expected_dbhz()?.max(self.detector_dbhz?))
+    }
+
+    /// What the loop itself can at best hold: the higher of the rule (with the stress over the
+    /// discriminator's slope) and the stability floor.
+    pub fn loop_expected_dbhz(&self) -> Option<f64> {
+        Some(
+            self.rule_slope_dbhz?
+                .max(self.stable_dbhz.unwrap_or(f64::NEG_INFINITY)),
+        )
     }
 }
 
@@ -48,12 +63,14 @@ pub fn cell_theory(cell: &Cell) -> CellTheory {
     CellTheory {
         stress_deg,
         rule_dbhz: rule_threshold_dbhz(&inputs),
+        rule_slope_dbhz: rule_with_slope_dbhz(&inputs),
         realised_bn_hz,
         rule_realised_dbhz: rule_threshold_dbhz(&RuleInputs {
             bn_hz: realised_bn_hz,
             ..inputs
         }),
         detector_dbhz: detector_floor_dbhz(&inputs),
+        stable_dbhz: stability_floor_dbhz(cell.order, cell.bn_hz, cell.t_coh_s()),
     }
 }
 
@@ -114,6 +131,17 @@ impl CellResult {
     pub fn vs_rule(&self) -> Option<Agreement> {
         self.measured
             .map(|m| Agreement::of(m.threshold_dbhz, self.theory.rule_dbhz))
+    }
+
+    /// The loop's own (slip-free) threshold, dB-Hz.
+    pub fn loop_dbhz(&self) -> Option<f64> {
+        self.measured.and_then(|m| m.loop_threshold_dbhz)
+    }
+
+    /// The loop's own threshold against the rule of thumb.
+    pub fn loop_vs_rule(&self) -> Option<Agreement> {
+        self.measured
+            .map(|m| Agreement::of(m.loop_threshold_dbhz, self.theory.rule_dbhz))
     }
 
     /// Measured against the expected threshold (rule and detector floor).

@@ -44,9 +44,13 @@ use std::f64::consts::PI;
 pub struct RunOutcome {
     /// Share of the window's 1 ms periods with carrier lock reported.
     pub held_fraction: f64,
-    /// Half-cycle slips of the loop against the truth in the window (changes of the nearest
-    /// half cycle of the interval's true phase error).
+    /// Half-cycle slips of the loop against the truth in the window: the interval's true phase
+    /// error moving more than 3/8 cycle from the half cycle the loop held (past the Costas
+    /// discriminator's +-1/4 cycle by 1/8, so that noise at the boundary is not counted twice).
     pub half_cycle_slips: u32,
+    /// Share of the window before the loop's first slip (1 without a slip): the loop itself
+    /// holding the phase, whatever the lock detector reports.
+    pub slip_free_fraction: f64,
     /// RMS true phase error over the window (modulo half cycles, so a slip does not count),
     /// deg.
     pub rms_error_deg: f64,
@@ -99,7 +103,8 @@ pub fn run(cell: &Cell, cn0_dbhz: f64, seed: u64) -> anyhow::Result<RunOutcome> 
     let mut acc = Complex64::new(0.0, 0.0);
     let mut bit = 1.0;
     let (mut held, mut counted) = (0usize, 0usize);
-    let (mut slips, mut last_half, mut sum_e2, mut n_e) = (0u32, None::<f64>, 0.0, 0usize);
+    let (mut slips, mut half, mut sum_e2, mut n_e) = (0u32, None::<f64>, 0.0, 0usize);
+    let mut first_slip_ms = None;
     for k in 0..n_ms {
         let t0 = k as f64 * 1e-3;
         let t1 = t0 + 1e-3;
@@ -115,7 +120,8 @@ pub fn run(cell: &Cell, cn0_dbhz: f64, seed: u64) -> anyhow::Result<RunOutcome> 
             (PI * de).sin() / (PI * de)
         };
         let re = rng.gauss();
-        let p = Complex64::from_polar(amp * bit * sinc, 2.0 * PI * e) + Complex64::new(re, rng.gauss());
+        let p =
+            Complex64::from_polar(amp * bit * sinc, 2.0 * PI * e) + Complex64::new(re, rng.gauss());
         phi += f * 1e-3;
         acc += p;
         if k >= detector_start {
@@ -130,12 +136,16 @@ pub fn run(cell: &Cell, cn0_dbhz: f64, seed: u64) -> anyhow::Result<RunOutcome> 
             f = carrier.update(acc, 0.0).nco_freq_hz;
             acc = Complex64::new(0.0, 0.0);
             if k >= window_start {
-                let half = (2.0 * e).round();
-                if last_half.is_some_and(|h| h != half) {
+                let h = *half.get_or_insert((2.0 * e).round());
+                let h = if (e - 0.5 * h).abs() > 0.375 {
                     slips += 1;
-                }
-                last_half = Some(half);
-                let r = e - 0.5 * half;
+                    first_slip_ms.get_or_insert(k + 1);
+                    (2.0 * e).round()
+                } else {
+                    h
+                };
+                half = Some(h);
+                let r = e - 0.5 * h;
                 sum_e2 += r * r;
                 n_e += 1;
             }
@@ -144,6 +154,9 @@ pub fn run(cell: &Cell, cn0_dbhz: f64, seed: u64) -> anyhow::Result<RunOutcome> 
     Ok(RunOutcome {
         held_fraction: held as f64 / counted.max(1) as f64,
         half_cycle_slips: slips,
+        slip_free_fraction: first_slip_ms.map_or(1.0, |k| {
+            (k - window_start) as f64 / (n_ms - window_start) as f64
+        }),
         rms_error_deg: 360.0 * (sum_e2 / n_e.max(1) as f64).sqrt(),
     })
 }
@@ -182,7 +195,11 @@ mod tests {
         assert!((steady_state_error_cycles(&c) * 360.0 - 16.08).abs() < 0.05);
         let out = run(&c, 45.0, 3)?;
         assert_eq!(out.held_fraction, 1.0);
-        assert!((out.rms_error_deg - 16.08).abs() < 1.0, "{}", out.rms_error_deg);
+        assert!(
+            (out.rms_error_deg - 16.08).abs() < 1.0,
+            "{}",
+            out.rms_error_deg
+        );
         Ok(())
     }
 
@@ -194,7 +211,10 @@ mod tests {
         assert!(out.held_fraction < 0.5, "{out:?}");
         let c = cell(2, 18.0, 1, Dynamics::JerkUnaided { g_per_s: 10.0 });
         let out = run(&c, 50.0, 3)?;
-        assert!(out.held_fraction < 0.5 && out.half_cycle_slips > 0, "{out:?}");
+        assert!(
+            out.held_fraction < 0.5 && out.half_cycle_slips > 0,
+            "{out:?}"
+        );
         Ok(())
     }
 }

@@ -5,7 +5,7 @@ use crate::report::{fmt, Table};
 
 /// The columns: the issue's `order`, `bn_hz`, `t_coh_ms`, `dynamics`, `measured_dbhz`,
 /// `theory_dbhz` (the rule of thumb), then the comparison and the other theories.
-pub const COLUMNS: [&str; 16] = [
+pub const COLUMNS: [&str; 21] = [
     "order",
     "bn_hz",
     "t_coh_ms",
@@ -17,11 +17,16 @@ pub const COLUMNS: [&str; 16] = [
     "delta_db",
     "within_3db",
     "detector_dbhz",
+    "theory_slope_dbhz",
+    "stable_dbhz",
     "expected_dbhz",
     "within_3db_expected",
     "bn_real_hz",
     "theory_real_dbhz",
     "below_threshold",
+    "loop_dbhz",
+    "loop_delta_db",
+    "loop_within_3db",
 ];
 
 /// A threshold or `none` (no C/N0 up to the scan's top, or no root of the rule).
@@ -69,6 +74,7 @@ pub fn build_table(results: &[CellResult]) -> Table {
         let c = &r.cell;
         let (delta, within) = agreement(r.vs_rule());
         let (_, within_exp) = agreement(r.vs_expected());
+        let (loop_delta, loop_within) = agreement(r.loop_vs_rule());
         let run = r.rejected.is_none();
         t.push(vec![
             c.order.to_string(),
@@ -77,16 +83,31 @@ pub fn build_table(results: &[CellResult]) -> Table {
             c.dynamics.name(),
             c.dynamics.aided().to_string(),
             fmt(r.theory.stress_deg, 1),
-            if run { level(r.measured_dbhz()) } else { "-".into() },
+            if run {
+                level(r.measured_dbhz())
+            } else {
+                "-".into()
+            },
             level(r.theory.rule_dbhz),
             delta,
             within,
             level(r.theory.detector_dbhz),
+            level(r.theory.rule_slope_dbhz),
+            r.theory
+                .stable_dbhz
+                .map_or_else(|| "-".to_string(), |x| fmt(x, 1)),
             level(r.theory.expected_dbhz()),
             within_exp,
             fmt(r.theory.realised_bn_hz, 2),
             level(r.theory.rule_realised_dbhz),
             below(r),
+            if run {
+                level(r.loop_dbhz())
+            } else {
+                "-".into()
+            },
+            loop_delta,
+            loop_within,
         ]);
     }
     t

@@ -31,18 +31,35 @@
 //! transition leaves ([`super::params::BIT_EDGE_IN_LOCK_BLOCK_MS`]). Below the C/N0 where this
 //! reaches the threshold ([`detector_floor_dbhz`]) the detector reports no lock even for a loop
 //! that holds the phase: a threshold of the receiver, not of the loop.
+//!
+//! # The stability floor
+//!
+//! The Costas `atan(Q/I)` discriminator's slope falls with the prompt SNR `rho = CN0 T` as
+//! `1 - exp(-rho)` (`crate::bandwidth::costas_atan_stats`), which scales the loop gain. Orders 1
+//! and 2 stay stable at any gain; a 3rd-order loop is only conditionally stable (the analog
+//! loop `s^3 + k b3 w s^2 + k a3 w^2 s + k w^3` needs `k > 1/(a3 b3) = 0.38` by Routh), so below
+//! the C/N0 where the slope falls under the digital loop's critical gain
+//! ([`stability_floor_dbhz`]) the linearised loop is unstable and its phase error grows until it
+//! slips, whatever the jitter.
 
 use super::params::{BIT_EDGE_IN_LOCK_BLOCK_MS, RULE_LIMIT_DEG};
 use super::Dynamics;
+use crate::bandwidth::stable_with_slope;
 use gpsrx_tracking::loop_filter::omega0;
 use gpsrx_tracking::phase_sim::pll_jitter_deg;
+use gpsrx_tracking::LoopFilter;
 use gpsrx_tracking::PllLockConfig;
 
 /// Oscillator (Allan) phase jitter of a PLL, degrees: `144 sigma_y f_L / Bn` (order 2) or
 /// `160 sigma_y f_L / Bn` (order 3), Kaplan & Hegarty eqs. 5.10-5.11; `sigma_y` the Allan
 /// deviation at the loop's time constant. `None` for order 1 with a noisy clock (Kaplan gives
 /// no 1st-order value); 0 for a perfect clock.
-pub fn allan_jitter_deg(order: u8, bn_hz: f64, allan_deviation: f64, f_carrier_hz: f64) -> Option<f64> {
+pub fn allan_jitter_deg(
+    order: u8,
+    bn_hz: f64,
+    allan_deviation: f64,
+    f_carrier_hz: f64,
+) -> Option<f64> {
     if allan_deviation == 0.0 {
         return Some(0.0);
     }
@@ -119,6 +136,20 @@ pub fn rule_threshold_dbhz(r: &RuleInputs) -> Option<f64> {
     lowest_root(|c| 3.0 * r.sigma_deg(c) + r.stress_deg - RULE_LIMIT_DEG)
 }
 
+/// The rule with the stress error a loop of reduced gain leaves: the Costas atan slope
+/// `k = 1 - exp(-CN0 T)` (module docs "The stability floor") scales the loop gain, and a
+/// steady-state error is inversely proportional to it, so `3 sigma_PLL + theta_e / k <= 45` deg.
+/// The same as [`rule_threshold_dbhz`] without stress.
+pub fn rule_with_slope_dbhz(r: &RuleInputs) -> Option<f64> {
+    if !r.stress_deg.is_finite() {
+        return None;
+    }
+    lowest_root(|c| {
+        let k = 1.0 - (-(10f64.powf(c / 10.0)) * r.t_coh_s).exp();
+        3.0 * r.sigma_deg(c) + r.stress_deg / k - RULE_LIMIT_DEG
+    })
+}
+
 /// Share of a lock-detector block's signal power left by a data-bit transition `m` ms into the
 /// 20 ms block, averaged over blocks with and without a transition: `1/2 + (1/2)(1 - m/10)^2`.
 pub fn bit_edge_power_share(edge_ms: u32) -> f64 {
@@ -142,6 +173,19 @@ pub fn detector_floor_dbhz(r: &RuleInputs) -> Option<f64> {
         let rho = g * m_t1 * 10f64.powf(c / 10.0);
         cfg.threshold - (-2.0 * sigma_rad * sigma_rad).exp() * rho / (rho + 1.0)
     })
+}
+
+/// The lowest C/N0 (dB-Hz) at which the linearised digital loop (`order`, `bn_hz`, `t_coh_s`)
+/// with the Costas atan slope `1 - exp(-CN0 T)` is stable (module docs); `None` when it is
+/// stable down to -20 dB-Hz (orders 1 and 2) or not even at 100 dB-Hz.
+pub fn stability_floor_dbhz(order: u8, bn_hz: f64, t_coh_s: f64) -> Option<f64> {
+    let filter = LoopFilter::pll(order, bn_hz).ok()?;
+    let stable = |c: f64| {
+        let slope = 1.0 - (-(10f64.powf(c / 10.0)) * t_coh_s).exp();
+        stable_with_slope(&filter, t_coh_s, slope)
+    };
+    let floor = lowest_root(|c| if stable(c) { -1.0 } else { 1.0 })?;
+    (floor > -20.0).then_some(floor)
 }
 
 #[cfg(test)]
@@ -188,7 +232,10 @@ mod tests {
         assert!(allan_jitter_deg(1, 3.0, 1e-10, F_L1_HZ).is_none());
         assert_eq!(allan_jitter_deg(1, 3.0, 0.0, F_L1_HZ), Some(0.0));
         let jerk = dynamic_stress_deg(3, 18.0, &Dynamics::JerkUnaided { g_per_s: 10.0 });
-        assert!((jerk - 0.4828 * 185_520.0 / 18f64.powi(3)).abs() < 0.02, "{jerk}");
+        assert!(
+            (jerk - 0.4828 * 185_520.0 / 18f64.powi(3)).abs() < 0.02,
+            "{jerk}"
+        );
         let acc = dynamic_stress_deg(2, 18.0, &Dynamics::AccelUnaided { g: 1.0 });
         assert!((acc - 0.2809 * 18_552.0 / 324.0).abs() < 0.01, "{acc}");
         assert_eq!(
@@ -209,6 +256,36 @@ mod tests {
         let s2 = 5f64.to_radians().powi(2);
         let c = (18.0 + (324.0 + 2.0 * s2 * 18.0 / 1e-3).sqrt()) / (2.0 * s2);
         assert!((got - 10.0 * c.log10()).abs() < 1e-4, "{got}");
+    }
+
+    /// Without stress the slope changes nothing; with 16 deg (1 g into a 2nd-order 18 Hz loop)
+    /// at T = 1 ms the threshold rises: at the plain rule's 29.8 dB-Hz the slope is 0.62.
+    #[test]
+    fn the_slope_raises_a_stressed_threshold() {
+        let mut r = static_inputs(18.0, 1e-3);
+        assert_eq!(rule_with_slope_dbhz(&r), rule_threshold_dbhz(&r));
+        r.stress_deg = 16.08;
+        let plain = rule_threshold_dbhz(&r).unwrap_or(f64::NAN);
+        let sloped = rule_with_slope_dbhz(&r).unwrap_or(f64::NAN);
+        assert!(
+            (plain - 29.8).abs() < 0.1 && sloped > plain + 0.5,
+            "{plain} {sloped}"
+        );
+        let k = 1.0 - (-(10f64.powf(sloped / 10.0)) * 1e-3).exp();
+        let sigma = pll_jitter_deg(18.0, sloped, 1e-3);
+        assert!((3.0 * sigma + 16.08 / k - 45.0).abs() < 1e-3);
+    }
+
+    /// A 3rd-order loop at Bn T = 0.003 is nearly analog: unstable below the Routh gain
+    /// `1/(a3 b3) = 0.379`, i.e. `1 - exp(-c T) = 0.379`, `c = -ln(0.621)/T` = 476 Hz at T = 1 ms,
+    /// 26.8 dB-Hz; a 2nd-order loop has no floor.
+    #[test]
+    fn third_order_loops_have_a_stability_floor() {
+        let want = 10.0 * (-(1.0 - 1.0 / (1.1 * 2.4f64)).ln() / 1e-3).log10();
+        let got = stability_floor_dbhz(3, 3.0, 1e-3).unwrap_or(f64::NAN);
+        assert!((got - want).abs() < 0.3, "{got} vs {want}");
+        assert_eq!(stability_floor_dbhz(2, 3.0, 1e-3), None);
+        assert_eq!(stability_floor_dbhz(1, 18.0, 1e-3), None);
     }
 
     /// The detector floor: with no jitter it is where `g rho/(g rho + 1) = 0.7`, i.e.
