@@ -58,7 +58,7 @@ fn below(r: &CellResult) -> String {
     }
     match r.measured.and_then(|m| m.first_failure) {
         Some((cn0, out)) => format!(
-            "{}: {:.0} % held, {} half-cycle slips",
+            "{}: {:.0} % held; {} half-cycle slips",
             fmt(cn0, 1),
             100.0 * out.held_fraction,
             out.half_cycle_slips
