@@ -179,6 +179,11 @@ pub fn detector_floor_dbhz(r: &RuleInputs) -> Option<f64> {
 /// with the Costas atan slope `1 - exp(-CN0 T)` is stable (module docs); `None` when it is
 /// stable down to -20 dB-Hz (orders 1 and 2) or not even at 100 dB-Hz.
 pub fn stability_floor_dbhz(order: u8, bn_hz: f64, t_coh_s: f64) -> Option<f64> {
+    if order < 3 {
+        // Unconditionally stable at every gain below 1 (module docs); the numerical test is
+        // marginal at vanishing gains, where the poles sit on z = 1.
+        return None;
+    }
     let filter = LoopFilter::pll(order, bn_hz).ok()?;
     let stable = |c: f64| {
         let slope = 1.0 - (-(10f64.powf(c / 10.0)) * t_coh_s).exp();
