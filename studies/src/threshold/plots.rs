@@ -26,61 +26,19 @@ fn points(
     p
 }
 
-/// One plot per integration time: every (dynamics, order) with at least one measured or
-/// theoretical threshold, measured (dots) and rule of thumb (dashed), and the lock detector's
-/// floor for static cells of the lowest order present.
+/// One plot per integration time for the static cells (the receiver's lock and the loop's own
+/// slip-free threshold per order, the rule once: it is the same for every order without
+/// stress, the lock detector's floor and the 3rd-order stability floor) and one for the other
+/// dynamics (measured and rule per dynamics and order).
 pub fn plots(results: &[CellResult]) -> Vec<LinePlot> {
     let mut out = Vec::new();
     for t_coh_ms in super::grid::T_COH_MS {
         for static_only in [true, false] {
-            let mut series = Vec::new();
-            let mut floor_done = false;
-            for dynamics in super::grid::DYNAMICS {
-                if (dynamics == Dynamics::Static) != static_only {
-                    continue;
-                }
-                for &order in dynamics.orders() {
-                    let label = if static_only {
-                        format!("order {order}")
-                    } else {
-                        format!("order {order}, {}", dynamics.name())
-                    };
-                    let m = points(
-                        results,
-                        order,
-                        t_coh_ms,
-                        dynamics,
-                        CellResult::measured_dbhz,
-                    );
-                    let t = points(results, order, t_coh_ms, dynamics, |r| r.theory.rule_dbhz);
-                    if m.is_empty() && t.is_empty() {
-                        continue;
-                    }
-                    series.push(Series {
-                        name: format!("{label} measured"),
-                        points: m,
-                        reference: false,
-                    });
-                    series.push(Series {
-                        name: format!("{label} rule 3 sigma + theta_e = 45 deg"),
-                        points: t,
-                        reference: true,
-                    });
-                    if static_only && !floor_done {
-                        let f = points(results, order, t_coh_ms, dynamics, |r| {
-                            r.theory.detector_dbhz
-                        });
-                        if !f.is_empty() {
-                            series.push(Series {
-                                name: "lock detector floor".into(),
-                                points: f,
-                                reference: true,
-                            });
-                            floor_done = true;
-                        }
-                    }
-                }
-            }
+            let series = if static_only {
+                static_series(results, t_coh_ms)
+            } else {
+                dynamics_series(results, t_coh_ms)
+            };
             if series.iter().all(|s| s.points.is_empty()) {
                 continue;
             }
@@ -99,4 +57,77 @@ pub fn plots(results: &[CellResult]) -> Vec<LinePlot> {
         }
     }
     out
+}
+
+fn static_series(results: &[CellResult], t_coh_ms: u32) -> Vec<Series> {
+    let d = Dynamics::Static;
+    let mut series = Vec::new();
+    for order in 1..=3u8 {
+        series.push(Series {
+            name: format!("order {order}, receiver lock"),
+            points: points(results, order, t_coh_ms, d, CellResult::measured_dbhz),
+            reference: false,
+        });
+    }
+    for order in 1..=3u8 {
+        series.push(Series {
+            name: format!("order {order}, loop slip-free"),
+            points: points(results, order, t_coh_ms, d, CellResult::loop_dbhz),
+            reference: false,
+        });
+    }
+    let lowest = (1..=3u8)
+        .find(|&o| !points(results, o, t_coh_ms, d, |r| r.theory.rule_dbhz).is_empty())
+        .unwrap_or(1);
+    series.push(Series {
+        name: "rule 3 sigma = 45 deg".into(),
+        points: points(results, lowest, t_coh_ms, d, |r| r.theory.rule_dbhz),
+        reference: true,
+    });
+    series.push(Series {
+        name: "lock detector floor".into(),
+        points: points(results, lowest, t_coh_ms, d, |r| r.theory.detector_dbhz),
+        reference: true,
+    });
+    series.push(Series {
+        name: "order 3 stability floor".into(),
+        points: points(results, 3, t_coh_ms, d, |r| r.theory.stable_dbhz),
+        reference: true,
+    });
+    series.retain(|s| !s.points.is_empty());
+    series
+}
+
+fn dynamics_series(results: &[CellResult], t_coh_ms: u32) -> Vec<Series> {
+    let mut series = Vec::new();
+    for dynamics in super::grid::DYNAMICS {
+        if dynamics == Dynamics::Static {
+            continue;
+        }
+        for &order in dynamics.orders() {
+            let label = format!("order {order}, {}", dynamics.name());
+            let m = points(
+                results,
+                order,
+                t_coh_ms,
+                dynamics,
+                CellResult::measured_dbhz,
+            );
+            let t = points(results, order, t_coh_ms, dynamics, |r| r.theory.rule_dbhz);
+            if m.is_empty() && t.is_empty() {
+                continue;
+            }
+            series.push(Series {
+                name: format!("{label} measured"),
+                points: m,
+                reference: false,
+            });
+            series.push(Series {
+                name: format!("{label} rule"),
+                points: t,
+                reference: true,
+            });
+        }
+    }
+    series
 }
