@@ -4,11 +4,15 @@
 //! (unaided and INS-aided), against the theoretical threshold (the rule of thumb
 //! `3 sigma + theta_e <= 45` deg for a Costas PLL, Kaplan & Hegarty 2nd ed. sec. 5.6).
 //!
-//! - [`theory`]: the rule of thumb and the lock detector's floor, solved for C/N0.
-//! - [`sim`]: one 30 s run at the level of 1 ms correlator outputs with the receiver's carrier
-//!   loop, lock detector and fade detector; "lock held" is the channel's `pll_lock`.
-//! - [`measure`]: the scan down in C/N0 (0.5 dB steps, one run per step, fixed seeds).
-//! - [`grid`], [`dynamics`]: the cells; [`result`], [`table`], [`plots`], [`conclusions`]: the
+//! - theory ([`rule_threshold_dbhz`], [`detector_floor_dbhz`], [`stability_floor_dbhz`],
+//!   [`rule_with_slope_dbhz`]): the rule of thumb and the floors, solved for C/N0.
+//! - sim ([`run_once`]): one 30 s run at the level of 1 ms correlator outputs with the
+//!   receiver's carrier loop, lock detector and fade detector; "lock held" is the channel's
+//!   `pll_lock`.
+//! - measure ([`measure_cell`]): the scan down in C/N0 (0.5 dB steps, one run per step, fixed
+//!   seeds).
+//! - grid ([`full_grid`], [`quick_grid`]) and [`Dynamics`]: the cells; [`CellResult`],
+//!   [`build_table`], the plots and [`conclusions_md`]: the
 //!   report. Besides `study.csv` the study writes the same table as `threshold.csv`.
 
 mod conclusions;
@@ -35,7 +39,7 @@ pub use self::sim::{run as run_once, steady_state_error_cycles, RunOutcome};
 pub use self::table::{build_table, COLUMNS};
 pub use self::theory::{
     allan_jitter_deg, bit_edge_power_share, detector_floor_dbhz, dynamic_stress_deg,
-    rule_threshold_dbhz, RuleInputs,
+    rule_threshold_dbhz, rule_with_slope_dbhz, stability_floor_dbhz, RuleInputs,
 };
 
 use super::report::StudyReport;
