@@ -71,17 +71,23 @@ pub struct CommonStudyArgs {
 
 /// Runs `gpsrx study ...`.
 pub fn run(args: &StudyArgs) -> anyhow::Result<()> {
+    let mut extra_csv = None;
     let (report, out) = match &args.study {
         StudyKind::SteadyState(a) => (steady_state::run(a, true)?, &a.common.out),
         StudyKind::Bandwidth(a) => (bandwidth::run(a, true)?, &a.common.out),
         StudyKind::Dynamics(a) => (dynamics::run(a, true)?, &a.common.out),
         StudyKind::Dr(a) => (dr::run(a, true)?, &a.common.out),
         StudyKind::Landmarks(a) => (landmarks::run(a, true)?, &a.common.out),
-        StudyKind::Threshold(a) => (threshold::run(a, true)?, &a.common.out),
+        StudyKind::Threshold(a) => {
+            let (report, dll) = threshold::run_with_dll(a, true)?;
+            extra_csv = Some(dll);
+            (report, &a.common.out)
+        }
     };
     let written = report.write(out)?;
-    if matches!(args.study, StudyKind::Threshold(_)) {
+    if let Some(dll) = extra_csv {
         report.table.write_csv(&out.join(threshold::CSV_NAME))?;
+        dll.write_csv(&out.join(threshold::DLL_CSV_NAME))?;
     }
     let plots = std::fs::read_dir(out)
         .map(|d| {

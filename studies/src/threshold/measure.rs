@@ -28,10 +28,12 @@ pub struct Measured {
 /// The noise seed of the run of `cell` at scan step `step` (SplitMix64 of the study seed, the
 /// cell's key and the step: every run has its own noise, the same in every grid).
 pub fn run_seed(seed: u64, cell: &Cell, step: usize) -> u64 {
-    let mut z = seed
-        .wrapping_mul(0x9e37_79b9_7f4a_7c15)
-        .wrapping_add(cell.key().rotate_left(17))
-        .wrapping_add(step as u64);
+    run_seed_raw(seed, cell.key().rotate_left(17).wrapping_add(step as u64))
+}
+
+/// SplitMix64 of the study seed and a run's key.
+pub fn run_seed_raw(seed: u64, key: u64) -> u64 {
+    let mut z = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15).wrapping_add(key);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)

@@ -16,6 +16,7 @@
 //!   report. Besides `study.csv` the study writes the same table as `threshold.csv`.
 
 mod conclusions;
+mod dll;
 mod dynamics;
 mod grid;
 mod measure;
@@ -27,9 +28,13 @@ mod table;
 mod theory;
 
 pub use self::conclusions::conclusions_md;
+pub use self::dll::{
+    dll_md, dll_points, dll_table, dll_theory, run_dll, DllPoint, DllResult, DLL_SETTLE_S,
+    DLL_SPACING_CHIPS, DLL_TOLERANCE,
+};
 pub use self::dynamics::Dynamics;
 pub use self::grid::{full_grid, quick_grid, Cell, BN_HZ, DYNAMICS, T_COH_MS};
-pub use self::measure::{measure_cell, run_seed, Measured};
+pub use self::measure::{measure_cell, run_seed, run_seed_raw, Measured};
 pub use self::params::{
     AGREE_DB, BIT_EDGE_IN_LOCK_BLOCK_MS, HOLD_FRACTION, PRE_ROLL_S, RULE_LIMIT_DEG,
     SCAN_BOTTOM_DBHZ, SCAN_STEP_DB, SCAN_TOP_DBHZ, WINDOW_S,
@@ -42,12 +47,14 @@ pub use self::theory::{
     rule_threshold_dbhz, rule_with_slope_dbhz, stability_floor_dbhz, RuleInputs,
 };
 
-use super::report::StudyReport;
+use super::report::{StudyReport, Table};
 use super::{run_cases, CommonStudyArgs};
 use std::time::Instant;
 
 /// The CSV the issue asks for (the study's table), besides `study.csv`.
 pub const CSV_NAME: &str = "threshold.csv";
+/// The DLL sweep's CSV.
+pub const DLL_CSV_NAME: &str = "dll.csv";
 
 /// `gpsrx study` options of this study.
 #[derive(Debug, Clone, clap::Args)]
@@ -78,6 +85,48 @@ pub fn measure_cells(cells: &[Cell], seed: u64, progress: bool) -> anyhow::Resul
             })
         })
         .collect()
+}
+
+/// Runs the DLL sweep ([`dll_points`]) in parallel.
+pub fn run_dll_sweep(quick: bool, seed: u64, progress: bool) -> anyhow::Result<Vec<DllResult>> {
+    let points = dll_points(quick);
+    let out = run_cases(&points, "dll", progress, |p| {
+        let key = (u64::from(p.order) << 32)
+            ^ (((p.bn_hz * 10.0).round() as u64) << 16)
+            ^ (u64::from(p.t_coh_ms) << 8)
+            ^ (p.cn0_dbhz.round() as u64);
+        run_dll(p, run_seed_raw(seed, key))
+    });
+    points
+        .iter()
+        .zip(out)
+        .map(|(p, m)| {
+            let (formula_chips, loop_chips, slope) = dll_theory(p);
+            Ok(DllResult {
+                point: *p,
+                measured_chips: m?,
+                formula_chips,
+                loop_chips,
+                slope,
+            })
+        })
+        .collect()
+}
+
+/// Runs the study and the DLL sweep: the report (the DLL section appended to its
+/// conclusions) and the DLL table (`dll.csv`).
+pub fn run_with_dll(args: &ThresholdArgs, progress: bool) -> anyhow::Result<(StudyReport, Table)> {
+    let mut report = run(args, progress)?;
+    let dll = run_dll_sweep(args.common.quick, args.common.seed, progress)?;
+    report.conclusions_md += &dll_md(&dll);
+    if let Some(obj) = report.summary.as_object_mut() {
+        obj.insert(
+            "dll_points_within_20pct".into(),
+            serde_json::json!(dll.iter().filter(|r| r.agrees()).count()),
+        );
+        obj.insert("dll_points".into(), serde_json::json!(dll.len()));
+    }
+    Ok((report, dll_table(&dll)))
 }
 
 /// Runs the study.
