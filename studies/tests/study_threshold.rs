@@ -69,6 +69,7 @@ fn quick_threshold_study_writes_the_table_the_csv_and_the_plots() {
     let md = std::fs::read_to_string(dir.path().join("study.md")).unwrap_or_default();
     assert!(md.contains("## Conclusions") && md.contains("threshold_static_t1ms.png"));
     assert!(md.contains("## DLL: code jitter against theory"));
+    assert!(md.contains("## Cross-check on IF samples"));
     for p in ["threshold_static_t1ms.png", "threshold_static_t20ms.png"] {
         let png = std::fs::read(dir.path().join(p)).unwrap_or_default();
         assert!(png.len() > 5000, "{p}");

@@ -19,6 +19,7 @@ mod conclusions;
 mod dll;
 mod dynamics;
 mod grid;
+mod if_check;
 mod measure;
 mod params;
 mod plots;
@@ -34,13 +35,17 @@ pub use self::dll::{
 };
 pub use self::dynamics::Dynamics;
 pub use self::grid::{full_grid, quick_grid, Cell, BN_HZ, DYNAMICS, T_COH_MS};
+pub use self::if_check::{
+    if_check_md, if_cross_check, if_lock_shares, IfCheckRow, IF_CHECK_CELLS, IF_CHECK_OFFSET_DB,
+    IF_LEAD_S,
+};
 pub use self::measure::{measure_cell, run_seed, run_seed_raw, Measured};
 pub use self::params::{
     AGREE_DB, BIT_EDGE_IN_LOCK_BLOCK_MS, HOLD_FRACTION, PRE_ROLL_S, RULE_LIMIT_DEG,
     SCAN_BOTTOM_DBHZ, SCAN_STEP_DB, SCAN_TOP_DBHZ, WINDOW_S,
 };
 pub use self::result::{cell_theory, Agreement, CellResult, CellTheory};
-pub use self::sim::{run as run_once, steady_state_error_cycles, RunOutcome};
+pub use self::sim::{run as run_once, run_with_edge, steady_state_error_cycles, RunOutcome};
 pub use self::table::{build_table, COLUMNS};
 pub use self::theory::{
     allan_jitter_deg, bit_edge_power_share, detector_floor_dbhz, dynamic_stress_deg,
@@ -116,7 +121,9 @@ pub fn run_dll_sweep(quick: bool, seed: u64, progress: bool) -> anyhow::Result<V
 /// Runs the study and the DLL sweep: the report (the DLL section appended to its
 /// conclusions) and the DLL table (`dll.csv`).
 pub fn run_with_dll(args: &ThresholdArgs, progress: bool) -> anyhow::Result<(StudyReport, Table)> {
-    let mut report = run(args, progress)?;
+    let (mut report, results) = run_cells(args, progress)?;
+    let check = if_cross_check(&results, args.common.seed, progress)?;
+    report.conclusions_md += &if_check_md(&check);
     let dll = run_dll_sweep(args.common.quick, args.common.seed, progress)?;
     report.conclusions_md += &dll_md(&dll);
     if let Some(obj) = report.summary.as_object_mut() {
@@ -129,8 +136,16 @@ pub fn run_with_dll(args: &ThresholdArgs, progress: bool) -> anyhow::Result<(Stu
     Ok((report, dll_table(&dll)))
 }
 
-/// Runs the study.
+/// Runs the study's grid (no IF cross-check, no DLL sweep).
 pub fn run(args: &ThresholdArgs, progress: bool) -> anyhow::Result<StudyReport> {
+    Ok(run_cells(args, progress)?.0)
+}
+
+/// The grid's report and results.
+fn run_cells(
+    args: &ThresholdArgs,
+    progress: bool,
+) -> anyhow::Result<(StudyReport, Vec<CellResult>)> {
     let t0 = Instant::now();
     let quick = args.common.quick;
     let cells = if quick { quick_grid() } else { full_grid() };
@@ -158,14 +173,15 @@ pub fn run(args: &ThresholdArgs, progress: bool) -> anyhow::Result<StudyReport> 
         "simulated_s": runs as f64 * (WINDOW_S + PRE_ROLL_S),
         "wall_s": wall_s,
     });
-    Ok(StudyReport {
+    let report = StudyReport {
         title: "Tracking threshold: measured against the rule of thumb".into(),
         intro_md: intro_md(quick, args.common.seed, runs, wall_s),
         table: build_table(&results),
         conclusions_md: conclusions_md(&results),
         summary,
         plots: plots::plots(&results),
-    })
+    };
+    Ok((report, results))
 }
 
 fn intro_md(quick: bool, seed: u64, runs: usize, wall_s: f64) -> String {

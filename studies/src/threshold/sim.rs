@@ -71,6 +71,18 @@ pub fn steady_state_error_cycles(cell: &Cell) -> f64 {
 ///
 /// Errors: the receiver refuses the cell's loop configuration.
 pub fn run(cell: &Cell, cn0_dbhz: f64, seed: u64) -> anyhow::Result<RunOutcome> {
+    run_with_edge(cell, cn0_dbhz, seed, BIT_EDGE_IN_LOCK_BLOCK_MS)
+}
+
+/// [`run`] with the bit edges `bit_edge_ms` ms into the lock detector's blocks (0-19).
+///
+/// Errors: the receiver refuses the cell's loop configuration.
+pub fn run_with_edge(
+    cell: &Cell,
+    cn0_dbhz: f64,
+    seed: u64,
+    bit_edge_ms: u32,
+) -> anyhow::Result<RunOutcome> {
     let cfg = cell.loop_config();
     let t_ms = cell.t_coh_ms.max(1) as usize;
     let [v, a, j] = cell.dynamics.phase_derivatives();
@@ -102,7 +114,7 @@ pub fn run(cell: &Cell, cn0_dbhz: f64, seed: u64) -> anyhow::Result<RunOutcome> 
     let block = LOCK_BLOCK_PROMPTS as usize;
     // The detectors see their first prompt this many periods in, so that each of their blocks
     // has a bit edge BIT_EDGE_IN_LOCK_BLOCK_MS ms into it.
-    let detector_start = (block - BIT_EDGE_IN_LOCK_BLOCK_MS as usize % block) % block;
+    let detector_start = (block - bit_edge_ms as usize % block) % block;
     let window_start = detector_start + (PRE_ROLL_S * 1e3).round() as usize;
     let n_ms = window_start + (WINDOW_S * 1e3).round() as usize;
     let (mut phi, mut f) = (-theta_ss, f0);
