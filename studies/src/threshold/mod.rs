@@ -12,8 +12,12 @@
 //! - measure ([`measure_cell`]): the scan down in C/N0 (0.5 dB steps, one run per step, fixed
 //!   seeds).
 //! - grid ([`full_grid`], [`quick_grid`]) and [`Dynamics`]: the cells; [`CellResult`],
-//!   [`build_table`], the plots and [`conclusions_md`]: the
-//!   report. Besides `study.csv` the study writes the same table as `threshold.csv`.
+//!   [`build_table`], the plots and [`conclusions_md`]: the report. Besides `study.csv` the
+//!   study writes the same table as `threshold.csv`.
+//! - IF cross-check ([`if_cross_check`]): the receiver's whole channel on simulated IF samples
+//!   2 dB above and below two cells' measured thresholds.
+//! - DLL sweep ([`run_dll_sweep`]): code jitter of the carrier-aided DLL against theory,
+//!   written to `dll.csv` and appended to the report.
 
 mod conclusions;
 mod dll;
