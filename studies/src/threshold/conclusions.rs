@@ -303,7 +303,7 @@ pub fn conclusions_md(results: &[CellResult]) -> String {
         if loop_off.is_empty() {
             String::new()
         } else {
-            format!("; the others: {}", loop_off.join("; "))
+            format!("; more than 3 dB from the plain rule: {}", loop_off.join("; "))
         }
     );
     let rejected: Vec<&CellResult> = results.iter().filter(|r| r.rejected.is_some()).collect();
