@@ -28,3 +28,4 @@ mod study_dr;
 mod study_dynamics;
 mod study_landmarks;
 mod study_steady_state;
+mod study_threshold;

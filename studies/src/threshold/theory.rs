@@ -1,0 +1,311 @@
+//! The theoretical tracking threshold of a cell: the rule of thumb `3 sigma + theta_e <= 45` deg
+//! for a Costas PLL (Kaplan & Hegarty, *Understanding GPS*, 2nd ed., sec. 5.6; oracles.md
+//! "Noise"), solved for C/N0 by bisection, and the floor the receiver's own lock detector sets.
+//!
+//! # The rule of thumb
+//!
+//! `sigma_PLL = sqrt(sigma_t^2 + sigma_v^2 + sigma_A^2)`, and lock holds while
+//! `3 sigma_PLL + theta_e <= 45` deg, with
+//!
+//! - thermal jitter `sigma_t = (360/2 pi) sqrt((Bn/CN0)(1 + 1/(2 T CN0)))` deg
+//!   ([`pll_jitter_deg`], Kaplan eq. 5.6);
+//! - oscillator (Allan) jitter `sigma_A = 144 sigma_y(tau) f_L / Bn` deg (2nd order) or
+//!   `160 sigma_y(tau) f_L / Bn` (3rd order), `tau` the loop's time constant (Kaplan
+//!   eqs. 5.10-5.11); Kaplan gives no 1st-order value ([`allan_jitter_deg`]);
+//! - vibration jitter `sigma_v`: 0 (the study's receiver does not vibrate);
+//! - dynamic stress `theta_e = 360 (d^n theta/dt^n) / omega0^n` deg for a loop of order `n`
+//!   under a residual whose `n`-th phase derivative (cycles/s^n) is constant, `omega0` =
+//!   Bn/0.25, Bn/0.53, Bn/0.7845 (Kaplan Table 5.6; [`dynamic_stress_deg`]); unbounded when a
+//!   higher derivative is non-zero.
+//!
+//! `sigma_t` falls with C/N0, so the threshold is the one root of
+//! `sigma_PLL(CN0) + theta_e/3 = 15` deg ([`rule_threshold_dbhz`]).
+//!
+//! # The lock detector's floor
+//!
+//! "Lock held" is what the receiver's carrier lock detector reports
+//! ([`gpsrx_tracking::PllLockDetector`]): the steadiness `|LPF(NBD, NBS)| / LPF(NBP)` of
+//! 20-prompt coherent sums at or above 0.7. With the phase error Gaussian of standard deviation
+//! `sigma` (rad) its expected value is `exp(-2 sigma^2) g rho / (g rho + 1)`, `rho = M CN0 T1`
+//! (`M` = 20 prompts of `T1` = 1 ms) and `g` the share of the block's signal power a data-bit
+//! transition leaves ([`super::params::BIT_EDGE_IN_LOCK_BLOCK_MS`]). Below the C/N0 where this
+//! reaches the threshold ([`detector_floor_dbhz`]) the detector reports no lock even for a loop
+//! that holds the phase: a threshold of the receiver, not of the loop.
+//!
+//! # The stability floor
+//!
+//! The Costas `atan(Q/I)` discriminator's slope falls with the prompt SNR `rho = CN0 T` as
+//! `1 - exp(-rho)` (`crate::bandwidth::costas_atan_stats`), which scales the loop gain. Orders 1
+//! and 2 stay stable at any gain; a 3rd-order loop is only conditionally stable (the analog
+//! loop `s^3 + k b3 w s^2 + k a3 w^2 s + k w^3` needs `k > 1/(a3 b3) = 0.38` by Routh), so below
+//! the C/N0 where the slope falls under the digital loop's critical gain
+//! ([`stability_floor_dbhz`]) the linearised loop is unstable and its phase error grows until it
+//! slips, whatever the jitter.
+
+use super::params::{BIT_EDGE_IN_LOCK_BLOCK_MS, RULE_LIMIT_DEG};
+use super::Dynamics;
+use crate::bandwidth::stable_with_slope;
+use gpsrx_tracking::loop_filter::omega0;
+use gpsrx_tracking::phase_sim::pll_jitter_deg;
+use gpsrx_tracking::LoopFilter;
+use gpsrx_tracking::PllLockConfig;
+
+/// Oscillator (Allan) phase jitter of a PLL, degrees: `144 sigma_y f_L / Bn` (order 2) or
+/// `160 sigma_y f_L / Bn` (order 3), Kaplan & Hegarty eqs. 5.10-5.11; `sigma_y` the Allan
+/// deviation at the loop's time constant. `None` for order 1 with a noisy clock (Kaplan gives
+/// no 1st-order value); 0 for a perfect clock.
+pub fn allan_jitter_deg(
+    order: u8,
+    bn_hz: f64,
+    allan_deviation: f64,
+    f_carrier_hz: f64,
+) -> Option<f64> {
+    if allan_deviation == 0.0 {
+        return Some(0.0);
+    }
+    let k = match order {
+        2 => 144.0,
+        3 => 160.0,
+        _ => return None,
+    };
+    Some(k * allan_deviation * f_carrier_hz / bn_hz)
+}
+
+/// Dynamic stress error of a loop of `order` with noise bandwidth `bn_hz` under the residual
+/// `dynamics`, degrees: `360 (d^n theta/dt^n)/omega0^n` (Kaplan sec. 5.6, oracles.md "Loop
+/// filters"); infinite when the residual has a non-zero derivative above the loop's order.
+pub fn dynamic_stress_deg(order: u8, bn_hz: f64, dynamics: &Dynamics) -> f64 {
+    if dynamics.degree() > order {
+        return f64::INFINITY;
+    }
+    let n = usize::from(order.clamp(1, 3));
+    let d = dynamics.phase_derivatives()[n - 1];
+    360.0 * d.abs() / omega0(order, bn_hz).powi(n as i32)
+}
+
+/// The inputs of a theoretical threshold.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RuleInputs {
+    /// Noise bandwidth Bn, Hz.
+    pub bn_hz: f64,
+    /// Predetection integration time T, s.
+    pub t_coh_s: f64,
+    /// Oscillator jitter, deg.
+    pub allan_deg: f64,
+    /// Vibration jitter, deg.
+    pub vibration_deg: f64,
+    /// Dynamic stress error, deg.
+    pub stress_deg: f64,
+}
+
+impl RuleInputs {
+    /// `sigma_PLL` at `cn0_dbhz`, deg.
+    pub fn sigma_deg(&self, cn0_dbhz: f64) -> f64 {
+        let t = pll_jitter_deg(self.bn_hz, cn0_dbhz, self.t_coh_s);
+        (t * t + self.allan_deg.powi(2) + self.vibration_deg.powi(2)).sqrt()
+    }
+}
+
+/// Lowest C/N0 (dB-Hz) at which `f` (decreasing in C/N0) is `<= 0`, by bisection on
+/// [-20, 100] dB-Hz to 1e-6 dB; `None` when `f` is positive even at 100 dB-Hz.
+fn lowest_root(f: impl Fn(f64) -> f64) -> Option<f64> {
+    let (mut lo, mut hi) = (-20.0_f64, 100.0_f64);
+    if f(hi) > 0.0 {
+        return None;
+    }
+    if f(lo) <= 0.0 {
+        return Some(lo);
+    }
+    while hi - lo > 1e-6 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(hi)
+}
+
+/// The rule-of-thumb threshold, dB-Hz: the C/N0 at which `3 sigma_PLL + theta_e = 45` deg;
+/// `None` when the jitter that does not fall with C/N0 and the stress already break the rule.
+pub fn rule_threshold_dbhz(r: &RuleInputs) -> Option<f64> {
+    if !r.stress_deg.is_finite() {
+        return None;
+    }
+    lowest_root(|c| 3.0 * r.sigma_deg(c) + r.stress_deg - RULE_LIMIT_DEG)
+}
+
+/// The rule with the stress error a loop of reduced gain leaves: the Costas atan slope
+/// `k = 1 - exp(-CN0 T)` (module docs "The stability floor") scales the loop gain, and a
+/// steady-state error is inversely proportional to it, so `3 sigma_PLL + theta_e / k <= 45` deg.
+/// The same as [`rule_threshold_dbhz`] without stress.
+pub fn rule_with_slope_dbhz(r: &RuleInputs) -> Option<f64> {
+    if !r.stress_deg.is_finite() {
+        return None;
+    }
+    lowest_root(|c| {
+        let k = 1.0 - (-(10f64.powf(c / 10.0)) * r.t_coh_s).exp();
+        3.0 * r.sigma_deg(c) + r.stress_deg / k - RULE_LIMIT_DEG
+    })
+}
+
+/// Share of a lock-detector block's signal power left by a data-bit transition `m` ms into the
+/// 20 ms block, averaged over blocks with and without a transition: `1/2 + (1/2)(1 - m/10)^2`.
+pub fn bit_edge_power_share(edge_ms: u32) -> f64 {
+    let r = 1.0 - f64::from(edge_ms) / 10.0;
+    0.5 + 0.5 * r * r
+}
+
+/// The C/N0 (dB-Hz) below which the receiver's lock detector (default settings) reads below
+/// its threshold on average: `exp(-2 sigma^2) g rho/(g rho + 1) = threshold` (module docs),
+/// `sigma` the rule's `sigma_PLL` in radians; `None` when a steady stress error beyond the
+/// detector's offset limit already fails it.
+pub fn detector_floor_dbhz(r: &RuleInputs) -> Option<f64> {
+    let cfg = PllLockConfig::default();
+    if r.stress_deg / 360.0 > cfg.max_offset_cycles {
+        return None;
+    }
+    let g = bit_edge_power_share(BIT_EDGE_IN_LOCK_BLOCK_MS);
+    let m_t1 = f64::from(cfg.coherent_sum) * 1e-3;
+    lowest_root(|c| {
+        let sigma_rad = r.sigma_deg(c).to_radians();
+        let rho = g * m_t1 * 10f64.powf(c / 10.0);
+        cfg.threshold - (-2.0 * sigma_rad * sigma_rad).exp() * rho / (rho + 1.0)
+    })
+}
+
+/// The lowest C/N0 (dB-Hz) at which the linearised digital loop (`order`, `bn_hz`, `t_coh_s`)
+/// with the Costas atan slope `1 - exp(-CN0 T)` is stable (module docs); `None` when it is
+/// stable down to -20 dB-Hz (orders 1 and 2) or not even at 100 dB-Hz.
+pub fn stability_floor_dbhz(order: u8, bn_hz: f64, t_coh_s: f64) -> Option<f64> {
+    if order < 3 {
+        // Unconditionally stable at every gain below 1 (module docs); the numerical test is
+        // marginal at vanishing gains, where the poles sit on z = 1.
+        return None;
+    }
+    let filter = LoopFilter::pll(order, bn_hz).ok()?;
+    let stable = |c: f64| {
+        let slope = 1.0 - (-(10f64.powf(c / 10.0)) * t_coh_s).exp();
+        stable_with_slope(&filter, t_coh_s, slope)
+    };
+    let floor = lowest_root(|c| if stable(c) { -1.0 } else { 1.0 })?;
+    (floor > -20.0).then_some(floor)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::params::F_L1_HZ;
+    use super::*;
+
+    fn static_inputs(bn_hz: f64, t_coh_s: f64) -> RuleInputs {
+        RuleInputs {
+            bn_hz,
+            t_coh_s,
+            allan_deg: 0.0,
+            vibration_deg: 0.0,
+            stress_deg: 0.0,
+        }
+    }
+
+    /// Static, thermal only: `sigma^2 = Bn/c + Bn/(2 T c^2)` (rad^2) at the limit `s = 15` deg
+    /// is a quadratic in `1/c`, so `c = (Bn + sqrt(Bn^2 + 2 s^2 Bn/T)) / (2 s^2)`. By hand for
+    /// Bn = 18 Hz, T = 1 ms: s^2 = 0.068539, c = (18 + sqrt(324 + 2467.4))/0.137078 = 516.8,
+    /// 27.13 dB-Hz; Bn = 10 Hz, T = 20 ms: c = (10 + sqrt(100 + 68.54))/0.137078 = 167.7,
+    /// 22.25 dB-Hz.
+    #[test]
+    fn static_threshold_matches_the_hand_computed_quadratic() {
+        for (bn, t, want) in [(18.0, 1e-3, 27.13), (10.0, 20e-3, 22.25)] {
+            let got = rule_threshold_dbhz(&static_inputs(bn, t)).unwrap_or(f64::NAN);
+            assert!((got - want).abs() < 0.01, "Bn {bn} T {t}: {got}");
+            let s2 = 15f64.to_radians().powi(2);
+            let c = (bn + (bn * bn + 2.0 * s2 * bn / t).sqrt()) / (2.0 * s2);
+            assert!((got - 10.0 * c.log10()).abs() < 1e-4);
+        }
+    }
+
+    /// oracles.md: thermal jitter 9.41 deg at Bn 18 Hz, 30 dB-Hz, T = 1 ms; oscillator jitter
+    /// 7.6 deg at 3 Hz for sigma_A = 1e-10 (2nd order, 144 sigma_A f_L / Bn); the 3rd-order
+    /// stress `0.4828 (d3R/dt3)/Bn^3` (the equivalent form of `1/omega0^3`): 10 g/s of jerk
+    /// (185,520 deg/s^3) at 18 Hz is 15.36 deg; 2nd order `0.2809 (d2R/dt2)/Bn^2`: 1 g at 18 Hz
+    /// is 16.08 deg.
+    #[test]
+    fn jitter_and_stress_match_kaplans_numbers() {
+        assert!((pll_jitter_deg(18.0, 30.0, 1e-3) - 9.41).abs() < 0.01);
+        let a = allan_jitter_deg(2, 3.0, 1e-10, F_L1_HZ).unwrap_or(f64::NAN);
+        assert!((a - 7.56).abs() < 0.01, "{a}");
+        assert!(allan_jitter_deg(1, 3.0, 1e-10, F_L1_HZ).is_none());
+        assert_eq!(allan_jitter_deg(1, 3.0, 0.0, F_L1_HZ), Some(0.0));
+        let jerk = dynamic_stress_deg(3, 18.0, &Dynamics::JerkUnaided { g_per_s: 10.0 });
+        assert!(
+            (jerk - 0.4828 * 185_520.0 / 18f64.powi(3)).abs() < 0.02,
+            "{jerk}"
+        );
+        let acc = dynamic_stress_deg(2, 18.0, &Dynamics::AccelUnaided { g: 1.0 });
+        assert!((acc - 0.2809 * 18_552.0 / 324.0).abs() < 0.01, "{acc}");
+        assert_eq!(
+            dynamic_stress_deg(2, 18.0, &Dynamics::JerkUnaided { g_per_s: 1.0 }),
+            f64::INFINITY
+        );
+    }
+
+    /// A stress of 45 deg leaves nothing for the jitter: no threshold; 30 deg leaves
+    /// `sigma <= 5` deg, which at 18 Hz, T = 1 ms needs c with `Bn/c (1 + 1/(2Tc)) = (5 deg)^2`.
+    #[test]
+    fn stress_raises_the_threshold_until_there_is_none() {
+        let mut r = static_inputs(18.0, 1e-3);
+        r.stress_deg = 45.0;
+        assert_eq!(rule_threshold_dbhz(&r), None);
+        r.stress_deg = 30.0;
+        let got = rule_threshold_dbhz(&r).unwrap_or(f64::NAN);
+        let s2 = 5f64.to_radians().powi(2);
+        let c = (18.0 + (324.0 + 2.0 * s2 * 18.0 / 1e-3).sqrt()) / (2.0 * s2);
+        assert!((got - 10.0 * c.log10()).abs() < 1e-4, "{got}");
+    }
+
+    /// Without stress the slope changes nothing; with 16 deg (1 g into a 2nd-order 18 Hz loop)
+    /// at T = 1 ms the threshold rises: at the plain rule's 29.8 dB-Hz the slope is 0.62.
+    #[test]
+    fn the_slope_raises_a_stressed_threshold() {
+        let mut r = static_inputs(18.0, 1e-3);
+        assert_eq!(rule_with_slope_dbhz(&r), rule_threshold_dbhz(&r));
+        r.stress_deg = 16.08;
+        let plain = rule_threshold_dbhz(&r).unwrap_or(f64::NAN);
+        let sloped = rule_with_slope_dbhz(&r).unwrap_or(f64::NAN);
+        assert!(
+            (plain - 29.8).abs() < 0.1 && sloped > plain + 0.5,
+            "{plain} {sloped}"
+        );
+        let k = 1.0 - (-(10f64.powf(sloped / 10.0)) * 1e-3).exp();
+        let sigma = pll_jitter_deg(18.0, sloped, 1e-3);
+        assert!((3.0 * sigma + 16.08 / k - 45.0).abs() < 1e-3);
+    }
+
+    /// A 3rd-order loop at Bn T = 0.003 is nearly analog: unstable below the Routh gain
+    /// `1/(a3 b3) = 0.379`, i.e. `1 - exp(-c T) = 0.379`, `c = -ln(0.621)/T` = 476 Hz at T = 1 ms,
+    /// 26.8 dB-Hz; a 2nd-order loop has no floor.
+    #[test]
+    fn third_order_loops_have_a_stability_floor() {
+        let want = 10.0 * (-(1.0 - 1.0 / (1.1 * 2.4f64)).ln() / 1e-3).log10();
+        let got = stability_floor_dbhz(3, 3.0, 1e-3).unwrap_or(f64::NAN);
+        assert!((got - want).abs() < 0.3, "{got} vs {want}");
+        assert_eq!(stability_floor_dbhz(2, 3.0, 1e-3), None);
+        assert_eq!(stability_floor_dbhz(1, 18.0, 1e-3), None);
+    }
+
+    /// The detector floor: with no jitter it is where `g rho/(g rho + 1) = 0.7`, i.e.
+    /// `g rho = 7/3`, `c = 7/(3 g 0.02)`; g = 0.625 for an edge 5 ms into the block: 186.7,
+    /// 22.71 dB-Hz. Jitter raises it.
+    #[test]
+    fn detector_floor_is_where_the_block_snr_fails_the_threshold() {
+        assert!((bit_edge_power_share(0) - 1.0).abs() < 1e-12);
+        assert!((bit_edge_power_share(10) - 0.5).abs() < 1e-12);
+        let g = bit_edge_power_share(BIT_EDGE_IN_LOCK_BLOCK_MS);
+        let want = 10.0 * (7.0 / (3.0 * g * 0.02)).log10();
+        // A loop so narrow that its jitter is negligible at the floor.
+        let floor = detector_floor_dbhz(&static_inputs(1e-6, 20e-3)).unwrap_or(f64::NAN);
+        assert!((floor - want).abs() < 0.01, "{floor} vs {want}");
+        let wide = detector_floor_dbhz(&static_inputs(18.0, 1e-3)).unwrap_or(f64::NAN);
+        assert!(wide > floor + 1.0, "{wide}");
+    }
+}
