@@ -3,11 +3,13 @@
 mod acquire;
 mod bench;
 mod run;
+mod snapshot;
 mod track;
 
 pub use acquire::AcquireArgs;
 pub use bench::BenchArgs;
 pub use run::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
+pub use snapshot::SnapshotArgs;
 pub use track::TrackArgs;
 
 use clap::{Args, Parser, Subcommand};
@@ -53,6 +55,9 @@ pub enum Command {
     /// table.
     #[command(after_help = BATCH_EXIT_STATUS)]
     Batch(BatchArgs),
+    /// Position snapshots of a few milliseconds each (coarse-time navigation): SnapperGPS
+    /// JSON files or one raw snapshot; writes snapshots.csv and track.geojson.
+    Snapshot(SnapshotArgs),
     /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
     Config(ConfigArgs),
     /// Loop studies: steady-state errors, bandwidth vs noise, high dynamics (seed 004).
