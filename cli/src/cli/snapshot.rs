@@ -33,6 +33,10 @@ pub struct SnapshotArgs {
     /// 2-bit value map of the codes 00,01,10,11 (e.g. 0,1,-2,-1 for two's complement).
     #[arg(long, value_name = "V0,V1,V2,V3", allow_hyphen_values = true)]
     pub map: Option<String>,
+    /// Constrain the height to that of --approx-llh with this sigma, m (0: no constraint;
+    /// use 0 for an aircraft or when the height is not known to tens of metres).
+    #[arg(long, value_name = "M", default_value_t = 30.0)]
+    pub height_sigma: f64,
     /// Coherent integration, ms (default: 1 ms below 40 ms of samples, else 10 ms).
     #[arg(long, value_name = "MS")]
     pub coherent_ms: Option<u32>,

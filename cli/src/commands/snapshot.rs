@@ -3,6 +3,7 @@
 
 use crate::commands::acquire::assist::{parse_llh, parse_time};
 use anyhow::{bail, Context};
+use gpsrx_nav::pvt::HeightConstraint;
 use gpsrx_nav::{Llh, Vector3};
 use gpsrx_receiver::snapshot::driver::Seed;
 use gpsrx_receiver::snapshot::output::{self, Truth};
@@ -38,6 +39,13 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
     };
     let mut opts = SnapshotOptions::default();
     opts.measure.coherent_ms = args.coherent_ms;
+    if !(args.height_sigma.is_finite() && args.height_sigma >= 0.0) {
+        bail!("--height-sigma {}: give a non-negative number of metres", args.height_sigma);
+    }
+    opts.solve.height = (args.height_sigma > 0.0).then_some(HeightConstraint {
+        h_m: llh.h_m,
+        sigma_m: args.height_sigma,
+    });
     let mut processor = SnapshotProcessor::new(&nav, opts);
     let started = std::time::Instant::now();
     let n = snapshots.len();

@@ -27,7 +27,7 @@ pub mod wls;
 
 pub use coarse_time::{
     solve_coarse_time, CoarseApriori, CoarseIntegrity, CoarseMeasurement, CoarseSatellite,
-    CoarseTimeError, CoarseTimeSolution,
+    CoarseTimeError, CoarseTimeSolution, HeightConstraint,
 };
 pub use dop::Dop;
 pub use landmark::Landmark;

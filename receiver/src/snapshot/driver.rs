@@ -10,6 +10,7 @@
 //! `unverified`, or refused by a check) leaves the seed as it was, so a bad snapshot never
 //! moves the a-priori of the others.
 
+use super::clock::SequenceClock;
 use super::input::Snapshot;
 use super::measure::{
     acquire_snapshot, predict_visible, search_layout, MeasureOptions, SnapshotAcquisition,
@@ -52,6 +53,7 @@ impl Default for SnapshotOptions {
                 },
                 pos_uncertainty_m: gpsrx_nav::pvt::coarse_time::DEFAULT_POS_UNCERTAINTY_M,
                 time_uncertainty_s: gpsrx_nav::pvt::coarse_time::DEFAULT_TIME_UNCERTAINTY_S,
+                height: None,
             },
             fe_offset_max_hz: 5_000.0,
         }
@@ -166,7 +168,10 @@ impl<'a> SnapshotProcessor<'a> {
         }
     }
 
-    /// Processes `snapshots` in order from `seed`; `progress` is called after each one.
+    /// Processes `snapshots` in order from `seed` (module docs: seeding), then, when the
+    /// snapshots carry time tags and enough of them gave fixes, solves each again with the
+    /// sequence's clock ([`super::clock`]); `progress` is called after each snapshot of the
+    /// first pass.
     pub fn run(
         &mut self,
         snapshots: &[Snapshot],
@@ -174,39 +179,89 @@ impl<'a> SnapshotProcessor<'a> {
         mut progress: impl FnMut(&SnapshotOutcome),
     ) -> Vec<SnapshotOutcome> {
         let mut out = Vec::with_capacity(snapshots.len());
+        let mut kept = Vec::with_capacity(snapshots.len());
+        let mut clock = SequenceClock::default();
+        let t0 = snapshots.iter().find_map(|s| s.approx_time);
         for s in snapshots {
-            let o = self.process(s, &seed);
+            let (o, acq) = self.process(s, &seed);
             if o.quality == SnapshotQuality::Fix {
                 if let (Some(x), Some(dt)) = (o.ecef_m, o.time_correction_s) {
                     seed.pos_ecef_m = x;
-                    if s.approx_time.is_some() {
+                    if let (Some(tag), Some(t0)) = (s.approx_time, t0) {
                         seed.time_correction_s = dt;
+                        clock.push(tag.diff_s(t0), dt);
                     }
                 }
             }
             progress(&o);
+            kept.push(acq.map(|a| (a, o.ecef_m.unwrap_or(seed.pos_ecef_m))));
             out.push(o);
+        }
+        let Some(t0) = t0 else {
+            return out;
+        };
+        for ((s, o), k) in snapshots.iter().zip(out.iter_mut()).zip(&kept) {
+            let (Some(tag), Some((acq, pos))) = (s.approx_time, k) else {
+                continue;
+            };
+            let Some((corr, sigma)) = clock.at(tag.diff_s(t0)) else {
+                continue;
+            };
+            let again = self.solve_one(s, acq, tag.add_seconds(corr), pos, corr, Some(sigma));
+            if again.quality == SnapshotQuality::Fix || o.quality != SnapshotQuality::Fix {
+                *o = again;
+            } else {
+                o.reason = format!(
+                    "solved alone: with the sequence's clock ({corr:+.3} s) {}",
+                    again.reason
+                );
+            }
         }
         out
     }
 
-    /// One snapshot from `seed`.
-    pub fn process(&mut self, s: &Snapshot, seed: &Seed) -> SnapshotOutcome {
+    /// One snapshot from `seed`, with its acquisition when there was one.
+    pub fn process(
+        &mut self,
+        s: &Snapshot,
+        seed: &Seed,
+    ) -> (SnapshotOutcome, Option<SnapshotAcquisition>) {
+        let tagged = if s.approx_time.is_some() {
+            seed.time_correction_s
+        } else {
+            0.0
+        };
         let apriori_time = s
             .approx_time
             .map(|t| t.add_seconds(seed.time_correction_s))
             .or(seed.time);
         let Some(t_a) = apriori_time else {
-            return SnapshotOutcome::none(s, None, "no time: give --time WEEK:TOW".into());
+            let reason = "no time: give --time WEEK:TOW".into();
+            return (SnapshotOutcome::none(s, None, reason), None);
         };
         if let Some(reason) = unusable(s) {
-            return SnapshotOutcome::none(s, apriori_time, reason);
+            return (SnapshotOutcome::none(s, apriori_time, reason), None);
         }
         let acq = match self.acquire(s, t_a, &seed.pos_ecef_m) {
             Ok(a) => a,
-            Err(reason) => return SnapshotOutcome::none(s, apriori_time, reason),
+            Err(reason) => return (SnapshotOutcome::none(s, apriori_time, reason), None),
         };
-        let mut o = SnapshotOutcome::none(s, apriori_time, String::new());
+        let o = self.solve_one(s, &acq, t_a, &seed.pos_ecef_m, tagged, None);
+        (o, Some(acq))
+    }
+
+    /// Solves an acquired snapshot at a-priori time `t_a` (the tag plus `tagged_s`) and
+    /// position `pos`, with the time as an observation of sigma `time_sigma_s` if given.
+    fn solve_one(
+        &self,
+        s: &Snapshot,
+        acq: &SnapshotAcquisition,
+        t_a: GpsTime,
+        pos: &Vector3<f64>,
+        tagged_s: f64,
+        time_sigma_s: Option<f64>,
+    ) -> SnapshotOutcome {
+        let mut o = SnapshotOutcome::none(s, Some(t_a), String::new());
         o.searched = acq.searched;
         o.detected = acq.sats.len();
         o.rejected_prns.clone_from(&acq.rejected_prns);
@@ -218,24 +273,21 @@ impl<'a> SnapshotProcessor<'a> {
             );
             return o;
         }
-        match solve_snapshot(
+        let solved = solve_snapshot(
             &acq.sats,
             s.fs_hz,
             self.nav,
             t_a,
-            &seed.pos_ecef_m,
+            pos,
+            time_sigma_s,
             &self.opts.solve,
-        ) {
+        );
+        match solved {
             Ok((sol, quality)) => {
                 o.quality = quality;
                 o.time = Some(sol.time);
-                // Against the snapshot's own tag: the seed's correction plus the solver's.
-                let tagged = if s.approx_time.is_some() {
-                    seed.time_correction_s
-                } else {
-                    0.0
-                };
-                o.time_correction_s = Some(sol.time_correction_s + tagged);
+                // Against the snapshot's own tag.
+                o.time_correction_s = Some(sol.time_correction_s + tagged_s);
                 o.llh = Some(sol.llh);
                 o.ecef_m = Some(sol.pos_ecef_m);
                 o.used_prns = sol.satellites.iter().map(|x| x.prn).collect();

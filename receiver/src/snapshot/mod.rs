@@ -8,6 +8,7 @@
 //!   front-end offset, narrow second search, false-peak rejection);
 //! - [`solve`]: the coarse-time fix ([`gpsrx_nav::pvt::coarse_time`]) and its checks;
 //! - [`driver`]: a sequence of snapshots, each good fix seeding the next;
+//! - [`clock`]: the device clock's error from the sequence's fixes (a second pass);
 //! - [`output`]: `snapshots.csv`, the GeoJSON track, errors against a truth.
 //!
 //! # A-priori limits
@@ -17,6 +18,7 @@
 //! together (the defaults of [`solve::SolveOptions`]); beyond them the result is an error
 //! (a row with quality `none`), not a wrong fix.
 
+pub mod clock;
 pub mod driver;
 pub mod input;
 pub mod measure;

@@ -27,7 +27,7 @@ use super::measure::SatCodePhase;
 use gpsrx_dsp::constants::F_L1_HZ;
 use gpsrx_nav::pvt::{
     solve_coarse_time, CoarseApriori, CoarseIntegrity, CoarseMeasurement, CoarseTimeSolution,
-    PvtOptions,
+    HeightConstraint, PvtOptions,
 };
 use gpsrx_nav::{GpsTime, HealthPolicy, NavData, Vector3};
 
@@ -47,6 +47,8 @@ pub struct SolveOptions {
     pub pos_uncertainty_m: f64,
     /// A-priori time uncertainty, s (the solver's bound).
     pub time_uncertainty_s: f64,
+    /// Height above the ellipsoid used as an observation (`None`: five free unknowns).
+    pub height: Option<HeightConstraint>,
 }
 
 /// How good a snapshot's position is.
@@ -82,13 +84,15 @@ pub fn tx_time_mod_1ms_s(code_phase_samples: f64, fs_hz: f64, doppler_hz: f64) -
     }
 }
 
-/// Solves one snapshot; `Err` carries the reason in words.
+/// Solves one snapshot (the a-priori time an observation of sigma `time_sigma_s` if given);
+/// `Err` carries the reason in words.
 pub fn solve_snapshot(
     sats: &[SatCodePhase],
     fs_hz: f64,
     nav: &NavData,
     apriori_time: GpsTime,
     apriori_pos: &Vector3<f64>,
+    time_sigma_s: Option<f64>,
     opts: &SolveOptions,
 ) -> Result<(CoarseTimeSolution, SnapshotQuality), String> {
     let meas: Vec<CoarseMeasurement<'_>> = sats
@@ -108,6 +112,8 @@ pub fn solve_snapshot(
         pos_ecef_m: *apriori_pos,
         time_uncertainty_s: opts.time_uncertainty_s,
         pos_uncertainty_m: opts.pos_uncertainty_m,
+        height: opts.height,
+        time_sigma_s,
     };
     let sol = solve_coarse_time(&meas, &apriori, &opts.pvt).map_err(|e| e.to_string())?;
     let rms = residual_rms_m(&sol);
