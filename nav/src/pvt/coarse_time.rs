@@ -566,6 +566,29 @@ fn evaluate(
     Ok(Evaluated { pred, rate_mps })
 }
 
+/// The SV transmit time modulo 1 ms that satellite `prn` (ephemeris `eph`) should show at the
+/// common reception instant of `sol`, solved with the a-priori time `apriori_time`:
+/// `phi = (t_a - (R(x, t) + b) / c) mod 1 ms` with R the pseudorange model at the solution's
+/// position x and time t, and b its clock-bias unknown (module docs). Used to look for a
+/// satellite the search missed at the code phase the fix predicts.
+pub fn predicted_tx_time_mod_1ms(
+    sol: &CoarseTimeSolution,
+    apriori_time: GpsTime,
+    eph: &Ephemeris,
+    opts: &PvtOptions,
+) -> Result<f64, PvtError> {
+    let m = CoarseMeasurement {
+        prn: eph.prn,
+        tx_time_mod_1ms_s: 0.0,
+        cn0_dbhz: 40.0,
+        ephemeris: eph,
+    };
+    let e = evaluate(&m, 0.0, &sol.pos_ecef_m, sol.time, opts)?;
+    let tx = apriori_time.add_seconds(-(e.pred.range_model_m + sol.clock_bias_m) / SPEED_OF_LIGHT_MPS);
+    let phi = tx.tow_s.rem_euclid(CA_CODE_PERIOD_S);
+    Ok(if phi >= CA_CODE_PERIOD_S { 0.0 } else { phi })
+}
+
 /// Indices of the active satellites, highest a-priori elevation first.
 fn by_elevation(p: &Problem<'_>, active: &[bool]) -> Vec<usize> {
     let mut idx: Vec<usize> = (0..p.meas.len()).filter(|&i| active[i]).collect();

@@ -28,6 +28,7 @@ pub mod wls;
 pub use coarse_time::{
     solve_coarse_time, CoarseApriori, CoarseIntegrity, CoarseMeasurement, CoarseSatellite,
     CoarseTimeError, CoarseTimeSolution, HeightConstraint,
+    predicted_tx_time_mod_1ms,
 };
 pub use dop::Dop;
 pub use landmark::Landmark;

@@ -13,9 +13,13 @@
 use super::clock::SequenceClock;
 use super::input::Snapshot;
 use super::measure::{
-    acquire_snapshot, predict_visible, search_layout, MeasureOptions, SnapshotAcquisition,
+    acquire_snapshot, look_at_predicted, predict_visible, search_layout, MeasureOptions,
+    SnapshotAcquisition,
 };
-use super::solve::{residual_rms_m, solve_snapshot, SnapshotQuality, SolveOptions};
+use super::solve::{
+    predict_missed, residual_rms_m, solve_snapshot, SnapshotQuality, SolveOptions,
+};
+use gpsrx_nav::pvt::CoarseTimeSolution;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
 use gpsrx_nav::pvt::{PvtOptions, Weighting};
 use gpsrx_nav::{GpsTime, Llh, NavData, Vector3};
@@ -207,7 +211,7 @@ impl<'a> SnapshotProcessor<'a> {
             let Some((corr, sigma)) = clock.at(tag.diff_s(t0)) else {
                 continue;
             };
-            let again = self.solve_one(s, acq, tag.add_seconds(corr), pos, corr, Some(sigma));
+            let again = self.solve_augmented(s, acq, tag.add_seconds(corr), pos, corr, Some(sigma));
             if again.quality == SnapshotQuality::Fix || o.quality != SnapshotQuality::Fix {
                 *o = again;
             } else {
@@ -246,7 +250,7 @@ impl<'a> SnapshotProcessor<'a> {
             Ok(a) => a,
             Err(reason) => return (SnapshotOutcome::none(s, apriori_time, reason), None),
         };
-        let o = self.solve_one(s, &acq, t_a, &seed.pos_ecef_m, tagged, None);
+        let o = self.solve_augmented(s, &acq, t_a, &seed.pos_ecef_m, tagged, None);
         (o, Some(acq))
     }
 
@@ -260,7 +264,7 @@ impl<'a> SnapshotProcessor<'a> {
         pos: &Vector3<f64>,
         tagged_s: f64,
         time_sigma_s: Option<f64>,
-    ) -> SnapshotOutcome {
+    ) -> (SnapshotOutcome, Option<CoarseTimeSolution>) {
         let mut o = SnapshotOutcome::none(s, Some(t_a), String::new());
         o.searched = acq.searched;
         o.detected = acq.sats.len();
@@ -271,7 +275,7 @@ impl<'a> SnapshotProcessor<'a> {
                 "{} satellites detected: too few to find the front-end frequency offset",
                 acq.sats.len()
             );
-            return o;
+            return (o, None);
         }
         let solved = solve_snapshot(
             &acq.sats,
@@ -299,12 +303,53 @@ impl<'a> SnapshotProcessor<'a> {
                 if quality == SnapshotQuality::Unverified {
                     o.reason = "5 satellites: no redundancy to check the fix".into();
                 }
+                return (o, Some(sol));
             }
             Err(reason) => {
                 o.reason = format!("{} satellites: {reason}", acq.sats.len());
             }
         }
-        o
+        (o, None)
+    }
+
+    /// [`Self::solve_one`], then the satellites the search missed looked for where that
+    /// solution puts them ([`look_at_predicted`]); with any found, solved again with them and
+    /// that solution kept if it is a `fix`.
+    fn solve_augmented(
+        &self,
+        s: &Snapshot,
+        acq: &SnapshotAcquisition,
+        t_a: GpsTime,
+        pos: &Vector3<f64>,
+        tagged_s: f64,
+        time_sigma_s: Option<f64>,
+    ) -> SnapshotOutcome {
+        let (o, sol) = self.solve_one(s, acq, t_a, pos, tagged_s, time_sigma_s);
+        let (Some(sol), Some(offset)) = (sol, acq.offset_hz) else {
+            return o;
+        };
+        let have: Vec<_> = acq.sats.iter().map(|x| x.prn).collect();
+        let missed = predict_missed(
+            &sol,
+            t_a,
+            self.nav,
+            &self.opts.solve.pvt,
+            s.fs_hz,
+            &acq.predicted,
+            &have,
+        );
+        let extra = look_at_predicted(&s.samples, s.fs_hz, offset, &missed);
+        if extra.is_empty() {
+            return o;
+        }
+        let mut more = acq.clone();
+        more.sats.extend(extra);
+        let (again, _) = self.solve_one(s, &more, t_a, pos, tagged_s, time_sigma_s);
+        if again.quality == SnapshotQuality::Fix {
+            again
+        } else {
+            o
+        }
     }
 
     /// The assisted acquisition of `s` at the a-priori time and position.

@@ -24,6 +24,8 @@
 //! ([`gpsrx_nav::pvt::coarse_time`]: chi-square and leave-one-out).
 
 use gpsrx_core::PosVel;
+use gpsrx_dsp::acquisition::code_fit::{fit_code_phase, peak_to_noise, CodeFitOptions};
+use gpsrx_dsp::acquisition::stats::detection_threshold;
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::Prn;
 use gpsrx_nav::{GpsTime, HealthPolicy, NavData, Vector3};
@@ -77,6 +79,8 @@ pub struct SnapshotAcquisition {
     pub rejected_prns: Vec<u8>,
     /// Satellites searched.
     pub searched: usize,
+    /// The predictions the search used.
+    pub predicted: Vec<Predicted>,
 }
 
 /// Settings of the snapshot search.
@@ -233,7 +237,75 @@ pub fn acquire_snapshot(
             results.extend(second);
         }
     }
-    Ok(assemble(&results, pred, offset, folded))
+    let mut acq = assemble(&results, pred, offset, folded);
+    let fit = CodeFitOptions::default();
+    for s in &mut acq.sats {
+        if let Some(tau) = fit_code_phase(
+            samples,
+            wide.fs_hz(),
+            s.prn,
+            s.code_phase_samples,
+            s.doppler_seen_hz,
+            &fit,
+        ) {
+            s.code_phase_samples = tau;
+        }
+    }
+    Ok(acq)
+}
+
+/// A satellite the searches missed, where a fix predicts it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PredictedPhase {
+    /// The satellite.
+    pub prn: Prn,
+    /// Predicted code phase, samples.
+    pub code_phase_samples: f64,
+    /// Predicted satellite Doppler, Hz (without the front-end offset).
+    pub doppler_hz: f64,
+    /// Elevation, deg.
+    pub elevation_deg: f64,
+}
+
+/// False-alarm probability of the check at a predicted code phase (one cell per satellite).
+pub const PREDICTED_PFA: f64 = 1e-3;
+/// A peak found at a predicted code phase must lie this close to it after the fit, chips.
+pub const PREDICTED_MAX_SHIFT_CHIPS: f64 = 0.3;
+
+/// Looks for each missed satellite at its predicted code phase and Doppler (plus the
+/// front-end offset): accepted when the non-coherent power there over the noise passes the
+/// Gamma(K) threshold for [`PREDICTED_PFA`] (one cell: the position is known) and the fitted
+/// peak stays within [`PREDICTED_MAX_SHIFT_CHIPS`]. A wrong one is left to the residual test.
+pub fn look_at_predicted(
+    samples: &[Complex32],
+    fs_hz: f64,
+    offset_hz: f64,
+    missed: &[PredictedPhase],
+) -> Vec<SatCodePhase> {
+    let per_chip = fs_hz / gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
+    let period = fs_hz * 1e-3;
+    let fit = CodeFitOptions::default();
+    missed
+        .iter()
+        .filter_map(|m| {
+            let seen = m.doppler_hz + offset_hz;
+            let tau = fit_code_phase(samples, fs_hz, m.prn, m.code_phase_samples, seen, &fit)?;
+            let d = (tau - m.code_phase_samples + 0.5 * period).rem_euclid(period) - 0.5 * period;
+            if d.abs() > PREDICTED_MAX_SHIFT_CHIPS * per_chip {
+                return None;
+            }
+            let (ratio, k) = peak_to_noise(samples, fs_hz, m.prn, tau, seen, 1000)?;
+            let threshold = detection_threshold(k as u32, PREDICTED_PFA, 1) / k as f64;
+            (ratio >= threshold).then(|| SatCodePhase {
+                prn: m.prn,
+                code_phase_samples: tau,
+                doppler_seen_hz: seen,
+                doppler_hz: m.doppler_hz,
+                cn0_dbhz: 10.0 * ((ratio - 1.0).max(1e-3) / 1e-3).log10(),
+                elevation_deg: m.elevation_deg,
+            })
+        })
+        .collect()
 }
 
 fn detections(results: &[AcqResult]) -> impl Iterator<Item = &AcqResult> {
@@ -252,6 +324,7 @@ fn assemble(
         offset_hz: offset,
         rejected_prns: Vec::new(),
         searched: pred.len(),
+        predicted: pred.to_vec(),
     };
     for r in results {
         if r.cross_correlation_of.is_some() {

@@ -23,11 +23,12 @@
 //! [`SolveOptions::max_residual_rms_m`] and its HDOP at most [`SolveOptions::max_hdop`]. With
 //! exactly five satellites nothing can be checked: such a fix is reported as `unverified`.
 
-use super::measure::SatCodePhase;
+use super::measure::{PredictedPhase, Predicted, SatCodePhase};
+use gpsrx_dsp::Prn;
 use gpsrx_dsp::constants::F_L1_HZ;
 use gpsrx_nav::pvt::{
     solve_coarse_time, CoarseApriori, CoarseIntegrity, CoarseMeasurement, CoarseTimeSolution,
-    HeightConstraint, PvtOptions,
+    predicted_tx_time_mod_1ms, HeightConstraint, PvtOptions,
 };
 use gpsrx_nav::{GpsTime, HealthPolicy, NavData, Vector3};
 
@@ -134,6 +135,34 @@ pub fn solve_snapshot(
         CoarseIntegrity::Unverified => SnapshotQuality::Unverified,
     };
     Ok((sol, quality))
+}
+
+/// The code phases at which a fix `sol` (solved at a-priori time `apriori_time`) predicts the
+/// satellites of `pred` that are not in `have`
+/// ([`gpsrx_nav::pvt::coarse_time::predicted_tx_time_mod_1ms`]; `tau = -phi fs mod fs 1 ms`).
+pub fn predict_missed(
+    sol: &CoarseTimeSolution,
+    apriori_time: GpsTime,
+    nav: &NavData,
+    opts: &PvtOptions,
+    fs_hz: f64,
+    pred: &[Predicted],
+    have: &[Prn],
+) -> Vec<PredictedPhase> {
+    let period = fs_hz * CODE_PERIOD_S;
+    pred.iter()
+        .filter(|p| !have.contains(&p.prn))
+        .filter_map(|p| {
+            let eph = nav.select_with(p.prn.get(), apriori_time, HealthPolicy::HealthyOnly)?;
+            let phi = predicted_tx_time_mod_1ms(sol, apriori_time, eph, opts).ok()?;
+            Some(PredictedPhase {
+                prn: p.prn,
+                code_phase_samples: (-phi * fs_hz).rem_euclid(period),
+                doppler_hz: p.doppler_hz,
+                elevation_deg: p.elevation_deg,
+            })
+        })
+        .collect()
 }
 
 /// RMS of the post-fit residuals, m.
