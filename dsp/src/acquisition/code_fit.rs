@@ -22,14 +22,14 @@ use crate::{CaCode, Prn};
 use num_complex::{Complex32, Complex64};
 
 /// Re-centrings of the fit at most.
-pub const MAX_ITERATIONS: usize = 4;
+pub const MAX_ITERATIONS: usize = 8;
 
 /// Settings of [`fit_code_phase`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CodeFitOptions {
     /// Lag spacing d, chips.
     pub spacing_chips: f64,
-    /// Lags either side of the centre, J (2 J + 1 <= 8).
+    /// Lags either side of the centre, J (1 <= J, 2 J + 1 <= 8).
     pub half_lags: usize,
     /// Whole code periods of prompts used at most.
     pub max_periods: usize,
@@ -61,7 +61,7 @@ pub fn fit_code_phase(
     opts: &CodeFitOptions,
 ) -> Option<f64> {
     let n_lags = 2 * opts.half_lags + 1;
-    if n_lags > MAX_TAPS || !(opts.spacing_chips > 0.0 && opts.spacing_chips < 1.0) {
+    if opts.half_lags == 0 || n_lags > MAX_TAPS || !(opts.spacing_chips > 0.0 && opts.spacing_chips < 1.0) {
         return None;
     }
     if !(fs_hz.is_finite() && fs_hz > 0.0 && code_phase_samples.is_finite()) {
