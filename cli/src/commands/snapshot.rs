@@ -40,7 +40,10 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
     let mut opts = SnapshotOptions::default();
     opts.measure.coherent_ms = args.coherent_ms;
     if !(args.height_sigma.is_finite() && args.height_sigma >= 0.0) {
-        bail!("--height-sigma {}: give a non-negative number of metres", args.height_sigma);
+        bail!(
+            "--height-sigma {}: give a non-negative number of metres",
+            args.height_sigma
+        );
     }
     opts.solve.height = (args.height_sigma > 0.0).then_some(HeightConstraint {
         h_m: llh.h_m,

@@ -61,7 +61,10 @@ pub fn fit_code_phase(
     opts: &CodeFitOptions,
 ) -> Option<f64> {
     let n_lags = 2 * opts.half_lags + 1;
-    if opts.half_lags == 0 || n_lags > MAX_TAPS || !(opts.spacing_chips > 0.0 && opts.spacing_chips < 1.0) {
+    if opts.half_lags == 0
+        || n_lags > MAX_TAPS
+        || !(opts.spacing_chips > 0.0 && opts.spacing_chips < 1.0)
+    {
         return None;
     }
     if !(fs_hz.is_finite() && fs_hz > 0.0 && code_phase_samples.is_finite()) {
@@ -192,7 +195,10 @@ mod tests {
     #[test]
     fn vertex_of_a_sampled_parabola() {
         let x: Vec<f64> = (-3..=3).map(|j| f64::from(j) * 0.1).collect();
-        let y: Vec<f64> = x.iter().map(|v| 5.0 - 2.0 * (v - 0.037) * (v - 0.037)).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .map(|v| 5.0 - 2.0 * (v - 0.037) * (v - 0.037))
+            .collect();
         let v = parabola_vertex(&x, &y).expect("maximum");
         assert!((v - 0.037).abs() < 1e-12, "{v}");
         let up: Vec<f64> = y.iter().map(|v| -v).collect();

@@ -584,7 +584,8 @@ pub fn predicted_tx_time_mod_1ms(
         ephemeris: eph,
     };
     let e = evaluate(&m, 0.0, &sol.pos_ecef_m, sol.time, opts)?;
-    let tx = apriori_time.add_seconds(-(e.pred.range_model_m + sol.clock_bias_m) / SPEED_OF_LIGHT_MPS);
+    let tx =
+        apriori_time.add_seconds(-(e.pred.range_model_m + sol.clock_bias_m) / SPEED_OF_LIGHT_MPS);
     let phi = tx.tow_s.rem_euclid(CA_CODE_PERIOD_S);
     Ok(if phi >= CA_CODE_PERIOD_S { 0.0 } else { phi })
 }

@@ -16,11 +16,9 @@ use super::measure::{
     acquire_snapshot, look_at_predicted, predict_visible, search_layout, MeasureOptions,
     SnapshotAcquisition,
 };
-use super::solve::{
-    predict_missed, residual_rms_m, solve_snapshot, SnapshotQuality, SolveOptions,
-};
-use gpsrx_nav::pvt::CoarseTimeSolution;
+use super::solve::{predict_missed, residual_rms_m, solve_snapshot, SnapshotQuality, SolveOptions};
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
+use gpsrx_nav::pvt::CoarseTimeSolution;
 use gpsrx_nav::pvt::{PvtOptions, Weighting};
 use gpsrx_nav::{GpsTime, Llh, NavData, Vector3};
 use std::collections::HashMap;

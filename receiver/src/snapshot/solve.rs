@@ -23,12 +23,12 @@
 //! [`SolveOptions::max_residual_rms_m`] and its HDOP at most [`SolveOptions::max_hdop`]. With
 //! exactly five satellites nothing can be checked: such a fix is reported as `unverified`.
 
-use super::measure::{PredictedPhase, Predicted, SatCodePhase};
-use gpsrx_dsp::Prn;
+use super::measure::{Predicted, PredictedPhase, SatCodePhase};
 use gpsrx_dsp::constants::F_L1_HZ;
+use gpsrx_dsp::Prn;
 use gpsrx_nav::pvt::{
-    solve_coarse_time, CoarseApriori, CoarseIntegrity, CoarseMeasurement, CoarseTimeSolution,
-    predicted_tx_time_mod_1ms, HeightConstraint, PvtOptions,
+    predicted_tx_time_mod_1ms, solve_coarse_time, CoarseApriori, CoarseIntegrity,
+    CoarseMeasurement, CoarseTimeSolution, HeightConstraint, PvtOptions,
 };
 use gpsrx_nav::{GpsTime, HealthPolicy, NavData, Vector3};
 

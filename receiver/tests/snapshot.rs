@@ -1,0 +1,288 @@
+//! Snapshot positioning (`gpsrx_receiver::snapshot`): short simulated snapshots against the
+//! simulator's truth, bad snapshots, and the shared real snapshots (skipped with a note when
+//! `../shared/data` is absent, required with CI=true).
+
+use gpsrx_nav::{GpsTime, Llh, NavData};
+use gpsrx_receiver::snapshot::driver::Seed;
+use gpsrx_receiver::snapshot::output::{horizontal_error_m, score, Truth};
+use gpsrx_receiver::snapshot::snappergps::read_snappergps;
+use gpsrx_receiver::snapshot::{
+    read_raw_snapshot, SampleSpec, Snapshot, SnapshotOptions, SnapshotProcessor, SnapshotQuality,
+};
+use gpsrx_samples::sim::{Scenario, Simulator};
+use num_complex::Complex32;
+use std::path::{Path, PathBuf};
+
+const SEOUL: [f64; 3] = [37.5665, 126.9780, 40.0];
+/// Receiver-clock time of the first simulated sample.
+const START: &str = "2022-01-01 12:29:48";
+
+fn samples_data() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data")
+}
+
+fn nav() -> NavData {
+    gpsrx_nav::read_rinex_nav(&samples_data().join("brdc0010.22n")).expect("shipped nav file")
+}
+
+/// A simulated snapshot of `ms` milliseconds: format, rate, IF, C/N0 for every satellite, and
+/// a receiver moving east at `speed_mps` (0: static).
+fn simulate(
+    dir: &Path,
+    format: &str,
+    fs_hz: f64,
+    if_hz: f64,
+    ms: f64,
+    cn0: f64,
+    speed_mps: f64,
+    seed: u64,
+) -> Snapshot {
+    let receiver = if speed_mps == 0.0 {
+        format!(
+            "kind = \"static\"\nllh_deg = [{}, {}, {}]",
+            SEOUL[0], SEOUL[1], SEOUL[2]
+        )
+    } else {
+        format!(
+            "kind = \"motion\"\nstart_llh_deg = [{}, {}, {}]\nheading_deg = 90.0\nspeed_mps = {speed_mps}\n\
+             segments = [{{ type = \"cruise\", duration_s = 1.0 }}]",
+            SEOUL[0], SEOUL[1], SEOUL[2]
+        )
+    };
+    let toml = format!(
+        "duration_s = {}\nseed = {seed}\nnav = \"brdc0010.22n\"\n[start]\ngps_calendar = \"{START}\"\n\
+         [output]\nformat = \"{format}\"\nfs_hz = {fs_hz}\nif_hz = {if_hz}\n[receiver]\n{receiver}\n\
+         [clock]\nbias_s = -3.0e-4\ndrift_s_s = 1.0e-7\n[satellites]\ncn0_all_dbhz = {cn0}\n\
+         [atmosphere]\nionosphere = true\ntroposphere = true\n",
+        ms * 1e-3
+    );
+    let scenario = Scenario::from_toml(&toml).expect("scenario");
+    let sim = Simulator::new(&scenario, &samples_data()).expect("simulator");
+    let report = sim.run(dir, &|_| {}).expect("simulated");
+    let spec = SampleSpec {
+        format: None,
+        fs_hz: None,
+        if_hz: 0.0,
+        invert_q: false,
+    };
+    read_raw_snapshot(&report.data_path, &spec, None).expect("read back")
+}
+
+fn start_time() -> GpsTime {
+    GpsTime::from_calendar(2022, 1, 1, 12, 29, 48.0)
+}
+
+/// An a-priori 30 km north-east of Seoul and `dt_s` late.
+fn seed(dt_s: f64) -> Seed {
+    Seed {
+        pos_ecef_m: Llh::from_degrees(SEOUL[0] + 0.19, SEOUL[1] + 0.24, 0.0).to_ecef(),
+        time_correction_s: 0.0,
+        time: Some(start_time().add_seconds(dt_s)),
+    }
+}
+
+#[test]
+fn simulated_snapshots_are_positioned_from_30_km_and_seconds_away() {
+    let nav = nav();
+    let truth = Llh::from_degrees(SEOUL[0], SEOUL[1], SEOUL[2]);
+    // (format, fs, IF, ms, C/N0, speed, largest horizontal error m)
+    let cases = [
+        ("ci2", 4.0e6, 0.0, 10.0, 42.0, 0.0, 30.0),
+        ("ri1_lsb", 4.092e6, 1.3e6, 20.0, 45.0, 0.0, 30.0),
+        ("ri2", 8.0e6, 2.1e6, 4.0, 45.0, 30.0, 40.0),
+    ];
+    for (k, &(format, fs, if_hz, ms, cn0, speed, max_err)) in cases.iter().enumerate() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let snap = simulate(dir.path(), format, fs, if_hz, ms, cn0, speed, 11 + k as u64);
+        let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+        let out = p.run(std::slice::from_ref(&snap), seed(2.5), |_| {});
+        let o = &out[0];
+        assert_eq!(o.quality, SnapshotQuality::Fix, "{format}: {}", o.reason);
+        let e = horizontal_error_m(&o.llh.expect("position"), &truth);
+        // The a-priori was 2.5 s late: the correction finds it (receiver clock -0.3 ms).
+        let dt = o.time_correction_s.expect("time");
+        eprintln!("{format} {ms} ms {cn0} dB-Hz {speed} m/s: {} satellites, error {e:.1} m, dt {dt:+.4} s", o.used_prns.len());
+        assert!(e < max_err, "{format}: {e:.1} m");
+        assert!((dt + 2.5).abs() < 0.05, "{format}: {dt}");
+        assert!(o.used_prns.len() >= 6, "{format}: {:?}", o.used_prns);
+    }
+}
+
+#[test]
+fn bad_snapshots_give_rows_with_reasons_and_do_not_move_the_seed() {
+    let nav = nav();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let good = simulate(dir.path(), "ci2", 4.0e6, 0.0, 10.0, 44.0, 0.0, 5);
+    let with = |samples: Vec<Complex32>, index: usize| Snapshot {
+        index,
+        samples,
+        ..good.clone()
+    };
+    let fs = good.fs_hz;
+    // Noise only: a fixed-seed pseudo-random sign sequence.
+    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+    let noise: Vec<Complex32> = (0..good.samples.len())
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            Complex32::new(
+                if x & 1 == 0 { 1.0 } else { -1.0 },
+                if x & 2 == 0 { 1.0 } else { -1.0 },
+            )
+        })
+        .collect();
+    let snaps = vec![
+        with(good.samples.clone(), 0),
+        with(vec![Complex32::new(0.0, 0.0); good.samples.len()], 1),
+        with(good.samples[..(fs * 0.5e-3) as usize].to_vec(), 2),
+        with(noise, 3),
+        with(Vec::new(), 4),
+        with(good.samples.clone(), 5),
+    ];
+    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+    let out = p.run(&snaps, seed(1.0), |_| {});
+    assert_eq!(out.len(), 6);
+    let q: Vec<SnapshotQuality> = out.iter().map(|o| o.quality).collect();
+    use SnapshotQuality::{Fix, None};
+    assert_eq!(q, vec![Fix, None, None, None, None, Fix]);
+    assert!(out[1].reason.contains("zero"), "{}", out[1].reason);
+    assert!(out[2].reason.contains("too short"), "{}", out[2].reason);
+    assert!(out[3].reason.contains("satellites"), "{}", out[3].reason);
+    assert!(out[4].reason.contains("too short"), "{}", out[4].reason);
+    // The same samples from the seed the first one left (the bad ones in between moved
+    // nothing): the same position to a millimetre.
+    let (a, b) = (out[0].llh.expect("fix"), out[5].llh.expect("fix"));
+    assert!(horizontal_error_m(&a, &b) < 1e-3 && (a.h_m - b.h_m).abs() < 1e-3);
+    // No time at all: said, not guessed.
+    let no_time = Seed {
+        time: Option::None,
+        ..seed(0.0)
+    };
+    let o = p.run(&snaps[..1], no_time, |_| {});
+    assert_eq!(o[0].quality, None);
+    assert!(o[0].reason.contains("--time"), "{}", o[0].reason);
+}
+
+#[test]
+fn an_apriori_beyond_the_limits_gives_no_fix() {
+    let nav = nav();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let snap = simulate(dir.path(), "ci2", 4.0e6, 0.0, 10.0, 44.0, 0.0, 9);
+    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+    // 1000 km away (Beijing is ~950 km from Seoul), the right time.
+    let far = Seed {
+        pos_ecef_m: Llh::from_degrees(39.9, 116.4, 50.0).to_ecef(),
+        ..seed(0.0)
+    };
+    let o = &p.run(std::slice::from_ref(&snap), far, |_| {})[0];
+    if let Some(l) = o.llh {
+        let truth = Llh::from_degrees(SEOUL[0], SEOUL[1], SEOUL[2]);
+        assert!(
+            horizontal_error_m(&l, &truth) < 100.0,
+            "a confident wrong fix: {o:?}"
+        );
+    } else {
+        assert_eq!(o.quality, SnapshotQuality::None);
+        assert!(!o.reason.is_empty());
+    }
+}
+
+/// A file in `../shared/data`, or `None` (with a note) when it is absent outside CI.
+fn shared_data(name: &str) -> Option<PathBuf> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/data")
+        .join(name);
+    if path.is_file() {
+        return Some(path);
+    }
+    if std::env::var("CI").as_deref() == Ok("true") {
+        panic!(
+            "shared test data {} is missing, and CI=true requires it",
+            path.display()
+        );
+    }
+    eprintln!("skip: shared test data {} is absent", path.display());
+    None
+}
+
+#[test]
+fn snappergps_walk_first_60_snapshots_against_rtk_truth() {
+    let (Some(json), Some(navp), Some(truthp)) = (
+        shared_data("real/snapshots/snappergps_w00_first60.json"),
+        shared_data("real/snapshots/snappergps_w00.nav"),
+        shared_data("real/snapshots/snappergps_w00_first60_truth.json"),
+    ) else {
+        return;
+    };
+    let nav = gpsrx_nav::read_rinex_nav(&navp).expect("nav");
+    let snaps = read_snappergps(&json).expect("snapshots");
+    assert_eq!(snaps.len(), 60);
+    // 30 km north of the walk, at its height.
+    let apriori = Llh::from_degrees(52.03, -1.2574, 112.0);
+    let mut opts = SnapshotOptions::default();
+    opts.solve.height = Some(gpsrx_nav::pvt::HeightConstraint {
+        h_m: 112.0,
+        sigma_m: 30.0,
+    });
+    let mut p = SnapshotProcessor::new(&nav, opts);
+    let seed = Seed {
+        pos_ecef_m: apriori.to_ecef(),
+        time_correction_s: 0.0,
+        time: None,
+    };
+    let out = p.run(&snaps, seed, |_| {});
+    let truth = gpsrx_receiver::snapshot::output::read_truth_track(&truthp, 112.4).expect("truth");
+    let errors = truth.errors(&out);
+    let s = score(&out, &errors);
+    eprintln!("{s:?}");
+    // Measured: 56 of 60, median 18.6 m, 95th percentile 43.3 m (the issue's target of 10 m
+    // median is not reached yet): these bounds guard against regressions.
+    assert!(s.fixes >= 54, "{s:?}");
+    assert!(s.median_m <= 25.0 && s.p95_m <= 60.0, "{s:?}");
+    assert!(matches!(truth, Truth::Track { .. }));
+}
+
+#[test]
+fn airborne_capture_within_50_m_of_the_reference() {
+    let (Some(stream), Some(navp)) = (
+        shared_data("real/snapshots/sxnsr_test_data_flight.stream"),
+        shared_data("real/snapshots/sxnsr_test_data_flight.12n"),
+    ) else {
+        return;
+    };
+    let nav = gpsrx_nav::read_rinex_nav(&navp).expect("nav");
+    let spec = SampleSpec {
+        format: Some(gpsrx_samples::SampleFormat::Packed2 {
+            complex: false,
+            map: [0.5, 1.5, -1.5, -0.5],
+            msb_first: false,
+        }),
+        fs_hz: Some(20.48e6),
+        if_hz: 5_499_998.474,
+        invert_q: false,
+    };
+    // The time 3 s late and the position 35 km off.
+    let t = GpsTime::new(1672, 391_561.0);
+    let snap = read_raw_snapshot(&stream, &spec, Some(t)).expect("capture");
+    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+    let seed = Seed {
+        pos_ecef_m: Llh::from_degrees(52.6, 10.9, 0.0).to_ecef(),
+        time_correction_s: 0.0,
+        time: Some(t),
+    };
+    let o = &p.run(std::slice::from_ref(&snap), seed, |_| {})[0];
+    assert_eq!(o.quality, SnapshotQuality::Fix, "{}", o.reason);
+    let reference = Llh::from_ecef(&gpsrx_nav::Vector3::new(
+        3_839_479.7,
+        721_777.3,
+        5_025_349.9,
+    ));
+    let e = horizontal_error_m(&o.llh.expect("position"), &reference);
+    let dz = (o.llh.expect("position").h_m - reference.h_m).abs();
+    // Measured 5.0 m horizontally, 2 m vertically, 9 satellites.
+    assert!(e < 50.0 && dz < 50.0, "{e:.1} m, {dz:.1} m");
+    // First sample at TOW 391558.1 +- 0.1 s.
+    let dt = o.time_correction_s.expect("time");
+    assert!((dt + 2.9).abs() < 0.15, "{dt}");
+}
