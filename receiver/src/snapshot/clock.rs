@@ -80,7 +80,7 @@ mod tests {
         c.push(5.0, 0.15);
         let (m, s) = c.at(2.0).expect("six points");
         assert!((m - 0.15).abs() < 0.006, "{m}");
-        assert!(s >= MIN_SIGMA_S && s < 0.01, "{s}");
+        assert!((MIN_SIGMA_S..0.01).contains(&s), "{s}");
         // Far away in time: nothing near.
         assert_eq!(c.at(1000.0), None);
     }

@@ -379,12 +379,11 @@ impl<'a> SnapshotProcessor<'a> {
             refine_ms: len_ms,
             ..AcqConfig::default()
         };
-        if !self.engines.contains_key(&key) {
-            let engine = AcquisitionEngine::new(s.fs_hz, cfg.clone()).map_err(|e| e.to_string())?;
-            self.engines.insert(key, engine);
-        }
-        let Some(engine) = self.engines.get(&key) else {
-            return Err("no acquisition engine".into());
+        let engine = match self.engines.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(v) => {
+                v.insert(AcquisitionEngine::new(s.fs_hz, cfg.clone()).map_err(|e| e.to_string())?)
+            }
         };
         acquire_snapshot(
             &s.samples,

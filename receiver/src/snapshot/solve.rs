@@ -124,7 +124,7 @@ pub fn solve_snapshot(
             opts.max_residual_rms_m
         ));
     }
-    if !(sol.dop.hdop <= opts.max_hdop) {
+    if sol.dop.hdop.is_nan() || sol.dop.hdop > opts.max_hdop {
         return Err(format!(
             "HDOP {:.1} above {:.0}: weak geometry",
             sol.dop.hdop, opts.max_hdop
