@@ -151,12 +151,12 @@ fn simulated_snapshots_are_positioned_from_30_km_and_seconds_away() {
 fn snapshot_table() {
     let nav = nav();
     let truth = Llh::from_degrees(SEOUL[0], SEOUL[1], SEOUL[2]);
-    println!("| format | ms | C/N0 | speed m/s | satellites | quality | horizontal error m | time error ms |");
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("| format | ms | C/N0 | speed m/s | satellites | quality | horizontal error m | time error ms | reason |");
+    println!("|---|---|---|---|---|---|---|---|---|");
     let mut seed_no = 100;
     for (format, fs, if_hz) in [("ri1_lsb", 4.092e6, 1.3e6), ("ci2", 4.0e6, 0.0)] {
         for ms in [2.0, 5.0, 10.0, 20.0] {
-            for cn0 in [30.0, 40.0] {
+            for cn0 in [35.0, 45.0] {
                 for speed in [0.0, 100.0] {
                     seed_no += 1;
                     let dir = tempfile::tempdir().expect("tempdir");
@@ -165,7 +165,9 @@ fn snapshot_table() {
                         &case(format, fs, if_hz, ms, cn0, speed),
                         seed_no,
                     );
-                    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+                    let mut opts = SnapshotOptions::default();
+                    opts.measure.max_speed_mps = 120.0;
+                    let mut p = SnapshotProcessor::new(&nav, opts);
                     let o = &p.run(std::slice::from_ref(&snap), seed(2.5), |_| {})[0];
                     let e = o.llh.map_or("-".to_string(), |l| {
                         format!("{:.1}", horizontal_error_m(&l, &truth))
@@ -174,9 +176,10 @@ fn snapshot_table() {
                         .time_correction_s
                         .map_or("-".to_string(), |d| format!("{:.1}", (d + 2.5) * 1e3));
                     println!(
-                        "| {format} | {ms} | {cn0} | {speed} | {} | {} | {e} | {dt} |",
+                        "| {format} | {ms} | {cn0} | {speed} | {} | {} | {e} | {dt} | {} |",
                         o.used_prns.len(),
-                        o.quality.name()
+                        o.quality.name(),
+                        o.reason.chars().take(70).collect::<String>()
                     );
                 }
             }

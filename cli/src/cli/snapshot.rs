@@ -37,6 +37,9 @@ pub struct SnapshotArgs {
     /// use 0 for an aircraft or when the height is not known to tens of metres).
     #[arg(long, value_name = "M", default_value_t = 30.0)]
     pub height_sigma: f64,
+    /// Largest receiver speed, m/s (widens the Doppler checks: 50 m/s adds 263 Hz).
+    #[arg(long, value_name = "M/S", default_value_t = 50.0)]
+    pub max_speed: f64,
     /// Coherent integration, ms (default: 1 ms below 40 ms of samples, else 10 ms).
     #[arg(long, value_name = "MS")]
     pub coherent_ms: Option<u32>,

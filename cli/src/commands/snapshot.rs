@@ -39,6 +39,10 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
     };
     let mut opts = SnapshotOptions::default();
     opts.measure.coherent_ms = args.coherent_ms;
+    if !(args.max_speed.is_finite() && (0.0..=2000.0).contains(&args.max_speed)) {
+        bail!("--max-speed {}: give 0 to 2000 m/s", args.max_speed);
+    }
+    opts.measure.max_speed_mps = args.max_speed;
     if !(args.height_sigma.is_finite() && args.height_sigma >= 0.0) {
         bail!(
             "--height-sigma {}: give a non-negative number of metres",

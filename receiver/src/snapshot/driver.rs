@@ -392,6 +392,7 @@ impl<'a> SnapshotProcessor<'a> {
             engine,
             &cfg,
             self.opts.fe_offset_max_hz,
+            self.opts.measure.max_speed_mps,
         )
         .map_err(|e| e.to_string())
     }

@@ -12,12 +12,13 @@
 //!    `f_k = D_k + f_fe` (with `D_k` predicted from the a-priori position and time), or
 //!    `+-(D_k + f_fe)` when the spectrum is folded (real samples with IF = k fs: a tone at `f`
 //!    and at `-f` are the same real signal). The offset is the one that explains most
-//!    detections within [`DOPPLER_TOLERANCE_HZ`] (grid of 5 Hz; a-priori errors of 100 km and
-//!    60 s move the `D_k` by at most about 60 Hz).
-//! 3. The satellites not yet detected are searched again in `+-NARROW_WINDOW_HZ` around
-//!    `D_k + f_fe`: fewer cells, so a lower threshold for the same false-alarm probability.
+//!    detections within [`doppler_tolerance_hz`] (grid of 5 Hz; a-priori errors of 100 km and
+//!    60 s move the `D_k` by at most about 60 Hz; the receiver's own speed by v / lambda).
+//! 3. The satellites not yet detected are searched again in `+-(NARROW_WINDOW_HZ + v / lambda)`
+//!    around `D_k + f_fe`: fewer cells, so a lower threshold for the same false-alarm
+//!    probability.
 //! 4. A detection whose Doppler disagrees with `D_k + f_fe` by more than
-//!    [`DOPPLER_TOLERANCE_HZ`] is a false peak (or a cross-correlation) and is dropped; the
+//!    [`doppler_tolerance_hz`] is a false peak (or a cross-correlation) and is dropped; the
 //!    engine's own cross-correlation test (15 dB weaker and a whole kHz away) has run before.
 //!
 //! A wrong code phase that survives these tests is left to the solver's residual test
@@ -33,8 +34,17 @@ use num_complex::Complex32;
 
 use crate::pipeline::visibility;
 
-/// A detection must agree with the predicted Doppler plus the common offset to this, Hz.
-pub const DOPPLER_TOLERANCE_HZ: f64 = 250.0;
+/// A detection must agree with the predicted Doppler plus the common offset to this, Hz, plus
+/// the Doppler of the receiver's own speed ([`doppler_tolerance_hz`]).
+pub const DOPPLER_TOLERANCE_HZ: f64 = 200.0;
+/// GPS L1 wavelength, m.
+const L1_WAVELENGTH_M: f64 = gpsrx_nav::constants::SPEED_OF_LIGHT_MPS / 1_575.42e6;
+
+/// The Doppler tolerance for a receiver moving at up to `max_speed_mps`:
+/// [`DOPPLER_TOLERANCE_HZ`] + v / lambda_L1 (the predictions are for a static receiver).
+pub fn doppler_tolerance_hz(max_speed_mps: f64) -> f64 {
+    DOPPLER_TOLERANCE_HZ + max_speed_mps.max(0.0) / L1_WAVELENGTH_M
+}
 /// Half-width of the second, narrow search around the predicted Doppler, Hz.
 pub const NARROW_WINDOW_HZ: f64 = 150.0;
 /// Detections needed to estimate the common offset.
@@ -95,16 +105,19 @@ pub struct MeasureOptions {
     pub elevation_mask_deg: f64,
     /// False-alarm probability per PRN search (first, wide search).
     pub pfa: f64,
+    /// Largest receiver speed, m/s: widens the Doppler tolerance and the narrow search.
+    pub max_speed_mps: f64,
 }
 
 impl Default for MeasureOptions {
-    /// Automatic coherent time, +-7 kHz, 5 deg, pfa 1e-4.
+    /// Automatic coherent time, +-7 kHz, 5 deg, pfa 1e-4, 50 m/s.
     fn default() -> Self {
         Self {
             coherent_ms: None,
             doppler_max_hz: 7_000.0,
             elevation_mask_deg: 5.0,
             pfa: 1e-4,
+            max_speed_mps: 50.0,
         }
     }
 }
@@ -160,10 +173,15 @@ pub fn doppler_error_hz(seen_hz: f64, d_hz: f64, offset_hz: f64, folded: bool) -
     }
 }
 
-/// The common offset explaining most detections `(seen, predicted)` within
-/// [`DOPPLER_TOLERANCE_HZ`] (ties: smallest summed error), searched over
-/// `-max_hz..=max_hz` in 5 Hz steps. `None` when fewer than [`MIN_FOR_OFFSET`] agree.
-pub fn estimate_offset(pairs: &[(f64, f64)], max_hz: f64, folded: bool) -> Option<f64> {
+/// The common offset explaining most detections `(seen, predicted)` within `tol_hz`
+/// (ties: smallest summed error), searched over `-max_hz..=max_hz` in 5 Hz steps. `None` when
+/// fewer than [`MIN_FOR_OFFSET`] agree.
+pub fn estimate_offset(
+    pairs: &[(f64, f64)],
+    max_hz: f64,
+    folded: bool,
+    tol_hz: f64,
+) -> Option<f64> {
     let steps = (max_hz / 5.0).ceil() as i64;
     let mut best: Option<(usize, f64, f64)> = None;
     for k in -steps..=steps {
@@ -171,7 +189,7 @@ pub fn estimate_offset(pairs: &[(f64, f64)], max_hz: f64, folded: bool) -> Optio
         let (mut n, mut cost) = (0usize, 0.0);
         for &(seen, d) in pairs {
             let e = doppler_error_hz(seen, d, off, folded);
-            if e <= DOPPLER_TOLERANCE_HZ {
+            if e <= tol_hz {
                 n += 1;
                 cost += e;
             }
@@ -196,7 +214,10 @@ pub fn acquire_snapshot(
     wide: &AcquisitionEngine,
     narrow_config: &AcqConfig,
     fe_offset_max_hz: f64,
+    max_speed_mps: f64,
 ) -> Result<SnapshotAcquisition, gpsrx_dsp::acquisition::AcqError> {
+    let tol = doppler_tolerance_hz(max_speed_mps);
+    let narrow_hz = NARROW_WINDOW_HZ + (tol - DOPPLER_TOLERANCE_HZ);
     let targets: Vec<SearchTarget> = pred.iter().map(|p| SearchTarget::full(p.prn)).collect();
     let mut results = wide.search(samples, &targets)?;
     let pairs: Vec<(f64, f64)> = detections(&results)
@@ -205,12 +226,12 @@ pub fn acquire_snapshot(
             Some((r.doppler_hz, p.doppler_hz))
         })
         .collect();
-    let offset = estimate_offset(&pairs, fe_offset_max_hz, folded);
+    let offset = estimate_offset(&pairs, fe_offset_max_hz, folded, tol);
     if let Some(off) = offset {
         let missing: Vec<SearchTarget> = pred
             .iter()
             .filter(|p| !detections(&results).any(|r| r.prn == p.prn))
-            .map(|p| SearchTarget::around(p.prn, p.doppler_hz + off, NARROW_WINDOW_HZ))
+            .map(|p| SearchTarget::around(p.prn, p.doppler_hz + off, narrow_hz))
             .collect();
         if !missing.is_empty() {
             let lo = missing
@@ -237,7 +258,7 @@ pub fn acquire_snapshot(
             results.extend(second);
         }
     }
-    let mut acq = assemble(&results, pred, offset, folded);
+    let mut acq = assemble(&results, pred, offset, folded, tol);
     let fit = CodeFitOptions::default();
     for s in &mut acq.sats {
         if let Some(tau) = fit_code_phase(
@@ -318,6 +339,7 @@ fn assemble(
     pred: &[Predicted],
     offset: Option<f64>,
     folded: bool,
+    tol_hz: f64,
 ) -> SnapshotAcquisition {
     let mut out = SnapshotAcquisition {
         sats: Vec::new(),
@@ -337,7 +359,7 @@ fn assemble(
         let (Some(p), Some(off)) = (pred.iter().find(|p| p.prn == r.prn), offset) else {
             continue;
         };
-        if doppler_error_hz(r.doppler_hz, p.doppler_hz, off, folded) > DOPPLER_TOLERANCE_HZ {
+        if doppler_error_hz(r.doppler_hz, p.doppler_hz, off, folded) > tol_hz {
             out.rejected_prns.push(r.prn.get());
             continue;
         }
@@ -376,12 +398,14 @@ mod tests {
             .enumerate()
             .map(|(k, &dk)| (if k % 2 == 0 { 1.0 } else { -1.0 } * (dk + off + 20.0), dk))
             .collect();
-        let est = estimate_offset(&folded, 3000.0, true).expect("offset");
+        let est = estimate_offset(&folded, 3000.0, true, 200.0).expect("offset");
         assert!((est - off).abs() <= 40.0, "{est}");
         let signed: Vec<(f64, f64)> = d.iter().map(|&dk| (dk + off - 15.0, dk)).collect();
-        let est = estimate_offset(&signed, 3000.0, false).expect("offset");
+        let est = estimate_offset(&signed, 3000.0, false, 200.0).expect("offset");
         assert!((est - off).abs() <= 40.0, "{est}");
-        assert_eq!(estimate_offset(&signed[..1], 3000.0, false), None);
+        assert_eq!(estimate_offset(&signed[..1], 3000.0, false, 200.0), None);
+        // 100 m/s adds up to 525 Hz.
+        assert!((doppler_tolerance_hz(100.0) - 725.5).abs() < 1.0);
     }
 
     #[test]
