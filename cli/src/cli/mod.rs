@@ -98,7 +98,8 @@ pub struct ConfigArgs {
 pub struct SourceArgs {
     /// The recording (raw samples, .wav, or SigMF .sigmf-meta/.sigmf-data).
     pub file: PathBuf,
-    /// Sample format: ci8, cu8, ci16_le, cf32_le, cf64_le, ri8, ri16_le, rf32_le, ci2, ri2, ci1
+    /// Sample format: ci8, cu8, ci16_le, cf32_le, cf64_le, ri8, ri16_le, rf32_le, ci2, ri2, ci1,
+    /// ri1, ri1_lsb
     /// (default: from SigMF or WAV metadata).
     #[arg(long)]
     pub format: Option<String>,
