@@ -15,7 +15,7 @@
 //! first order whatever the front-end filter, and its noise is that of an early-minus-late
 //! discriminator about `2 J d` wide.
 
-use super::refine::correlate_periods;
+use super::refine::correlate_periods_code_doppler;
 use crate::constants::CA_CHIP_RATE_HZ;
 use crate::correlator::{Correlator, PackedCode, MAX_TAPS};
 use crate::{CaCode, Prn};
@@ -49,7 +49,9 @@ impl Default for CodeFitOptions {
 }
 
 /// The code phase (sample index where a C/A period starts, in `[0, fs 1 ms)`) refined from
-/// `code_phase_samples` for `prn` at carrier Doppler `doppler_hz` (module docs). `None` when
+/// `code_phase_samples` for `prn`, the carrier wiped off at `dopplers_hz.0` (as seen) and the
+/// code run at the rate of the satellite's Doppler `dopplers_hz.1` (they differ in sign for a
+/// folded real spectrum; module docs of [`super`]). `None` when
 /// the samples hold no whole code period after the start, when the power is not peaked
 /// (c >= 0), or when the settings are out of range.
 pub fn fit_code_phase(
@@ -57,7 +59,7 @@ pub fn fit_code_phase(
     fs_hz: f64,
     prn: Prn,
     code_phase_samples: f64,
-    doppler_hz: f64,
+    dopplers_hz: (f64, f64),
     opts: &CodeFitOptions,
 ) -> Option<f64> {
     let n_lags = 2 * opts.half_lags + 1;
@@ -81,13 +83,13 @@ pub fn fit_code_phase(
     let mut tau = code_phase_samples;
     let max_step = opts.half_lags as f64 * d_samples;
     for _ in 0..MAX_ITERATIONS {
-        correlate_periods(
+        correlate_periods_code_doppler(
             samples,
             &correlator,
             &code,
             fs_hz,
             tau,
-            doppler_hz,
+            dopplers_hz,
             opts.max_periods,
             &offsets,
             &mut out,
@@ -114,7 +116,8 @@ pub fn fit_code_phase(
 const NOISE_LAGS_CHIPS: [f64; 7] = [97.0, 211.0, 333.0, 457.0, 599.0, 733.0, 877.0];
 
 /// Non-coherent power at `code_phase_samples` over the mean power at seven far lags (noise),
-/// both from the same whole code periods (at most `max_periods`): about 1 on noise alone (the
+/// both from the same whole code periods (at most `max_periods`), Dopplers as in
+/// [`fit_code_phase`]: about 1 on noise alone (the
 /// power is a mean of K exponential terms, K periods) and `1 + T C/N0` on a signal (T = 1 ms).
 /// `None` without a whole period or with zero noise.
 pub fn peak_to_noise(
@@ -122,7 +125,7 @@ pub fn peak_to_noise(
     fs_hz: f64,
     prn: Prn,
     code_phase_samples: f64,
-    doppler_hz: f64,
+    dopplers_hz: (f64, f64),
     max_periods: usize,
 ) -> Option<(f64, usize)> {
     let correlator = Correlator::best();
@@ -131,13 +134,13 @@ pub fn peak_to_noise(
     let mut offsets = vec![0.0];
     offsets.extend(NOISE_LAGS_CHIPS.iter().map(|c| c * per_chip));
     let mut out: Vec<Vec<Complex64>> = vec![Vec::new(); offsets.len()];
-    correlate_periods(
+    correlate_periods_code_doppler(
         samples,
         &correlator,
         &code,
         fs_hz,
         code_phase_samples,
-        doppler_hz,
+        dopplers_hz,
         max_periods,
         &offsets,
         &mut out,

@@ -266,7 +266,7 @@ pub fn acquire_snapshot(
             wide.fs_hz(),
             s.prn,
             s.code_phase_samples,
-            s.doppler_seen_hz,
+            (s.doppler_seen_hz, s.doppler_hz),
             &fit,
         ) {
             s.code_phase_samples = tau;
@@ -310,12 +310,13 @@ pub fn look_at_predicted(
         .iter()
         .filter_map(|m| {
             let seen = m.doppler_hz + offset_hz;
-            let tau = fit_code_phase(samples, fs_hz, m.prn, m.code_phase_samples, seen, &fit)?;
+            let dopplers = (seen, m.doppler_hz);
+            let tau = fit_code_phase(samples, fs_hz, m.prn, m.code_phase_samples, dopplers, &fit)?;
             let d = (tau - m.code_phase_samples + 0.5 * period).rem_euclid(period) - 0.5 * period;
             if d.abs() > PREDICTED_MAX_SHIFT_CHIPS * per_chip {
                 return None;
             }
-            let (ratio, k) = peak_to_noise(samples, fs_hz, m.prn, tau, seen, 1000)?;
+            let (ratio, k) = peak_to_noise(samples, fs_hz, m.prn, tau, dopplers, 1000)?;
             let threshold = detection_threshold(k as u32, PREDICTED_PFA, 1) / k as f64;
             (ratio >= threshold).then(|| SatCodePhase {
                 prn: m.prn,
