@@ -61,7 +61,9 @@ fn bad_snappergps_snapshots_give_rows_with_reasons() {
     assert!(rows[4].contains("no time"), "{}", rows[4]);
     // The constant snapshot has signal power but no satellite.
     assert!(rows[2].contains("satellites"), "{}", rows[2]);
-    assert!(out.join("track.geojson").is_file());
+    for f in ["track.geojson", "track.kml", "track.gpx"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
 }
 
 #[test]

@@ -56,7 +56,7 @@ pub enum Command {
     #[command(after_help = BATCH_EXIT_STATUS)]
     Batch(BatchArgs),
     /// Position snapshots of a few milliseconds each (coarse-time navigation): SnapperGPS
-    /// JSON files or one raw snapshot; writes snapshots.csv and track.geojson.
+    /// JSON files or one raw snapshot; writes snapshots.csv and GeoJSON/KML/GPX tracks.
     Snapshot(SnapshotArgs),
     /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
     Config(ConfigArgs),

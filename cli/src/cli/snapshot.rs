@@ -43,7 +43,7 @@ pub struct SnapshotArgs {
     /// Coherent integration, ms (default: 1 ms below 40 ms of samples, else 10 ms).
     #[arg(long, value_name = "MS")]
     pub coherent_ms: Option<u32>,
-    /// Output directory: snapshots.csv and track.geojson.
+    /// Output directory: snapshots.csv and track.geojson, track.kml, track.gpx.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Score against a truth: a SnapperGPS truth JSON file (time, latitude, longitude).

@@ -69,7 +69,7 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     output::write_csv(&args.out.join("snapshots.csv"), &outcomes, &errors)?;
-    output::write_track(&args.out.join("track.geojson"), &outcomes)?;
+    output::write_tracks(&args.out, &outcomes)?;
     let mut out = crate::exit::stdout();
     let s = output::score(&outcomes, &errors);
     writeln!(

@@ -1,11 +1,14 @@
 //! Outputs of a snapshot run: `snapshots.csv` (one row per input snapshot, in input order),
-//! the GeoJSON track of the positions ([`crate::output::geojson`]), and the horizontal errors
+//! the GeoJSON, KML and GPX tracks of the positions ([`crate::output`]), and the horizontal errors
 //! against a truth (a SnapperGPS truth file matched by UTC second, or one static reference).
 
 use super::driver::SnapshotOutcome;
 use super::snappergps::{utc_seconds_of_day, TruthPoint};
 use super::{SnapshotError, SnapshotQuality};
-use crate::output::{create_file, geojson::write_geojson, Fix, FixQuality, OutputError};
+use crate::output::{
+    create_file, geojson::write_geojson, gpx::write_gpx, kml::write_kml, Fix, FixQuality,
+    OutputError,
+};
 use gpsrx_core::frames::enu_rotation;
 use gpsrx_nav::utc::utc_from_gps;
 use gpsrx_nav::{Llh, Vector3};
@@ -120,12 +123,21 @@ pub fn fixes(outcomes: &[SnapshotOutcome]) -> Vec<Fix> {
         .collect()
 }
 
-/// Writes the GeoJSON track of the positions to `path`.
-pub fn write_track(path: &Path, outcomes: &[SnapshotOutcome]) -> Result<(), OutputError> {
+/// Writes the track of the positions into `dir`: `track.geojson`, `track.kml` and
+/// `track.gpx` ([`crate::output`]'s writers; rows with a position only).
+pub fn write_tracks(dir: &Path, outcomes: &[SnapshotOutcome]) -> Result<(), OutputError> {
+    let fixes = fixes(outcomes);
+    let path = dir.join("track.geojson");
     let name = path.display().to_string();
-    let mut f = create_file(path)?;
-    write_geojson(&mut f, &name, &fixes(outcomes))?;
-    f.flush().map_err(OutputError::io(&name))
+    let mut f = create_file(&path)?;
+    write_geojson(&mut f, &name, &fixes)?;
+    f.flush().map_err(OutputError::io(&name))?;
+    let path = dir.join("track.kml");
+    let name = path.display().to_string();
+    write_kml(&mut create_file(&path)?, &name, "gpsrx snapshot", &fixes)?;
+    let path = dir.join("track.gpx");
+    let name = path.display().to_string();
+    write_gpx(&mut create_file(&path)?, &name, "gpsrx snapshot", &fixes)
 }
 
 /// Horizontal distance between two positions, m (east/north at `truth`).
