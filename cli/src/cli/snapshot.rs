@@ -46,7 +46,8 @@ pub struct SnapshotArgs {
     /// Output directory: snapshots.csv and track.geojson, track.kml, track.gpx.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Score against a truth: a SnapperGPS truth JSON file (time, latitude, longitude).
+    /// Score against a truth: a SnapperGPS truth JSON file (time, latitude, longitude); adds
+    /// the errors to snapshots.csv, prints the median and 95th percentile, draws errors.png.
     #[arg(long, value_name = "FILE")]
     pub truth: Option<PathBuf>,
     /// Ellipsoidal height of the --truth track, m.

@@ -70,6 +70,9 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     output::write_csv(&args.out.join("snapshots.csv"), &outcomes, &errors)?;
     output::write_tracks(&args.out, &outcomes)?;
+    if truth.is_some() {
+        output::draw_errors(&args.out.join("errors.png"), &outcomes, &errors)?;
+    }
     let mut out = crate::exit::stdout();
     let s = output::score(&outcomes, &errors);
     writeln!(

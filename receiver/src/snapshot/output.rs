@@ -235,6 +235,47 @@ pub fn score(outcomes: &[SnapshotOutcome], errors: &[Option<f64>]) -> Score {
     }
 }
 
+/// Draws `errors.png`: the horizontal error of every `fix` row against its index, and the
+/// median as a dashed line ([`crate::output::plots::draw_line_plot`]).
+pub fn draw_errors(
+    path: &Path,
+    outcomes: &[SnapshotOutcome],
+    errors: &[Option<f64>],
+) -> Result<(), crate::output::plots::PlotError> {
+    use crate::output::plots::{draw_line_plot, LinePlot, Series};
+    let points: Vec<(f64, f64)> = outcomes
+        .iter()
+        .zip(errors)
+        .filter(|(o, _)| o.quality == SnapshotQuality::Fix)
+        .filter_map(|(o, e)| Some((o.index as f64, (*e)?)))
+        .collect();
+    let s = score(outcomes, errors);
+    let last = outcomes.len().saturating_sub(1) as f64;
+    let plot = LinePlot {
+        file_name: "errors.png".into(),
+        title: format!(
+            "Snapshot fixes against the truth: median {:.1} m, 95 % {:.1} m",
+            s.median_m, s.p95_m
+        ),
+        x_label: "snapshot index".into(),
+        y_label: "horizontal error (m)".into(),
+        series: vec![
+            Series {
+                name: "horizontal error".into(),
+                points,
+                reference: false,
+            },
+            Series {
+                name: "median".into(),
+                points: vec![(0.0, s.median_m), (last.max(1.0), s.median_m)],
+                reference: true,
+            },
+        ],
+        ..LinePlot::default()
+    };
+    draw_line_plot(&plot, path)
+}
+
 /// Reads a truth: a SnapperGPS truth JSON file (height `h_m`).
 pub fn read_truth_track(path: &Path, h_m: f64) -> Result<Truth, SnapshotError> {
     Ok(Truth::Track {
