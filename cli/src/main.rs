@@ -30,6 +30,7 @@ fn main() -> ExitCode {
         Command::Info(args) => done(commands::info::run(&args)),
         Command::Demo(args) => commands::demo::run(&args),
         Command::Acquire(args) => done(commands::acquire::run(&args)),
+        Command::Snapshot(args) => done(commands::snapshot::run(&args)),
         Command::Track(args) => done(commands::track::run(&args)),
         Command::Run(args) => commands::run::run(&args),
         Command::Batch(args) => commands::batch::run(&args),

@@ -13,4 +13,5 @@ mod dr_run;
 mod ins_simulate;
 mod outputs;
 mod run;
+mod snapshot;
 mod tracking;

@@ -69,6 +69,7 @@ pub mod fusion;
 pub mod landmarks;
 pub mod output;
 pub mod pipeline;
+pub mod snapshot;
 
 pub use config::ReceiverConfig;
 pub use pipeline::{Assistance, MemorySink, Receiver, ReceiverError, RunSummary, Sink};

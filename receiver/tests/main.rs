@@ -7,3 +7,4 @@ mod faults;
 mod pipeline;
 mod plots;
 mod sigmf_lo;
+mod snapshot;

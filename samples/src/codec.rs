@@ -3,6 +3,7 @@
 //! Decoding turns non-finite floats into 0 and counts them. Encoding rounds to the nearest
 //! representable value (2-bit: nearest map value, ties to the larger value; 1-bit: +1 when
 //! the value is > 0, else -1, as GPS-SDR-SIM does), saturates, and counts what it clipped.
+//! `ri1` stores the sign bit (1 = negative), `ci1` the opposite (1 = positive).
 
 use num_complex::Complex32;
 
@@ -113,6 +114,18 @@ pub(crate) fn decode(
             for (k, o) in out.iter_mut().enumerate() {
                 let j = 2 * (first + k);
                 *o = Complex32::new(bit(j), bit(j + 1));
+            }
+        }
+        SampleFormat::Packed1Real { lsb_first } => {
+            for (k, o) in out.iter_mut().enumerate() {
+                let j = first + k;
+                let shift = if *lsb_first { j % 8 } else { 7 - j % 8 } as u32;
+                let v = if (bytes[j / 8] >> shift) & 1 == 1 {
+                    -1.0
+                } else {
+                    1.0
+                };
+                *o = Complex32::new(v, 0.0);
             }
         }
     }
@@ -331,6 +344,22 @@ impl Encoder {
                     }
                 }
             }
+            SampleFormat::Packed1Real { lsb_first } => {
+                let lsb_first = *lsb_first;
+                out.reserve(samples.len() / 8 + 1);
+                for s in samples {
+                    let v = if s.re.is_finite() {
+                        s.re
+                    } else {
+                        self.counts.non_finite += 1;
+                        0.0
+                    };
+                    if v.abs() > 2.0 {
+                        self.counts.clipped += 1;
+                    }
+                    self.push_bits(u8::from(v <= 0.0), 1, lsb_first, out);
+                }
+            }
         }
     }
 
@@ -389,6 +418,28 @@ mod tests {
         );
         assert_eq!(out, vec![0b1001_1100]);
         assert_eq!(e.counts.clipped, 2);
+    }
+
+    #[test]
+    fn ri1_lsb_layout_matches_snappergps() {
+        // Samples + - - + + + - + from the least significant bit: bit 1 = negative.
+        let f = SampleFormat::Packed1Real { lsb_first: true };
+        let mut e = Encoder::new(&f);
+        let mut out = Vec::new();
+        let v = [1.0, -1.0, -0.5, 2.0, 0.1, 3.0, -3.0, 1.0];
+        let samples: Vec<Complex32> = v.iter().map(|&x| c(x, 0.0)).collect();
+        e.encode(&samples, &mut out);
+        assert_eq!(out, vec![0b0100_0110]);
+        assert_eq!(e.counts.clipped, 2);
+        let mut back = [Complex32::default(); 8];
+        decode(&f, &out, 0, &mut back);
+        let signs: Vec<f32> = back.iter().map(|s| s.re).collect();
+        assert_eq!(signs, vec![1.0, -1.0, -1.0, 1.0, 1.0, 1.0, -1.0, 1.0]);
+        // The same bits MSB first read in the opposite order; a start inside the byte.
+        let msb = SampleFormat::Packed1Real { lsb_first: false };
+        let mut back = [Complex32::default(); 3];
+        decode(&msb, &[0b0100_0110], 5, &mut back);
+        assert_eq!(back.map(|s| s.re), [-1.0, -1.0, 1.0]);
     }
 
     #[test]

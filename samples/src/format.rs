@@ -24,11 +24,13 @@
 //! | `ri2` | `Packed2 { complex: false, map, msb_first: true }` | 4 samples per byte, 2-bit codes from the most significant bits down | `map[code]` | same map |
 //! | `ri2_lsb` | `Packed2 { complex: false, msb_first: false, .. }` | as `ri2` but from the least significant bits up | `map[code]` | same map |
 //! | `ci1` | `Packed1Complex` | 4 samples per byte: I0 Q0 I1 Q1 I2 Q2 I3 Q3 from the most significant bit down (GPS-SDR-SIM `-b 1`) | bit 1 → +1, bit 0 → -1 | |
+//! | `ri1` | `Packed1Real { lsb_first: false }` | 8 real samples per byte from the most significant bit down | bit 0 → +1, bit 1 → -1 (sign bit) | |
+//! | `ri1_lsb` | `Packed1Real { lsb_first: true }` | 8 real samples per byte from the least significant bit up (SnapperGPS) | bit 0 → +1, bit 1 → -1 (sign bit) | |
 //!
 //! Writing quantises to the nearest representable value and saturates (see [`crate::writer`]).
 //! A packed file whose sample count does not fill its last byte is padded with zero bits, which read
-//! back as extra samples (`map[0b00]`, or -1 for `ci1`): at most 1 extra sample for `ci2`, 3 for
-//! `ri2` and `ci1`.
+//! back as extra samples (`map[0b00]`, -1 for `ci1`, +1 for `ri1`): at most 1 extra sample for
+//! `ci2`, 3 for `ri2` and `ci1`, 7 for `ri1`.
 //!
 //! Aliases accepted by [`str::parse`] (case-insensitive), for files described by other tools:
 //! `ibyte`, `int8`, `sc8` → `ci8`; `ishort`, `int16`, `sc16`, `ci16` → `ci16_le`; `gr_complex`,
@@ -81,13 +83,20 @@ pub enum SampleFormat {
     /// 1-bit complex samples packed four to a byte, MSB first, I0 Q0 I1 Q1 ...; bit 1 = +1,
     /// bit 0 = -1 (GPS-SDR-SIM `-b 1`).
     Packed1Complex,
+    /// 1-bit real samples packed eight to a byte; bit 0 = +1, bit 1 = -1 (a sign bit, as the
+    /// MAX2769 front end of SnapperGPS delivers it).
+    Packed1Real {
+        /// First sample in the least significant bit (SnapperGPS), else in the most
+        /// significant one.
+        lsb_first: bool,
+    },
 }
 
 impl SampleFormat {
     /// Every canonical name [`str::parse`] accepts (aliases aside).
     pub const SUPPORTED: &'static [&'static str] = &[
         "ci8", "cu8", "ci16_le", "cf32_le", "cf64_le", "ri8", "ri16_le", "rf32_le", "ci2",
-        "ci2_lsb", "ri2", "ri2_lsb", "ci1",
+        "ci2_lsb", "ri2", "ri2_lsb", "ci1", "ri1", "ri1_lsb",
     ];
 
     /// `ci2` with the default map, MSB first.
@@ -124,7 +133,10 @@ impl SampleFormat {
             | SampleFormat::Cf32Le
             | SampleFormat::Cf64Le
             | SampleFormat::Packed1Complex => true,
-            SampleFormat::Ri8 | SampleFormat::Ri16Le | SampleFormat::Rf32Le => false,
+            SampleFormat::Ri8
+            | SampleFormat::Ri16Le
+            | SampleFormat::Rf32Le
+            | SampleFormat::Packed1Real { .. } => false,
             SampleFormat::Packed2 { complex, .. } => *complex,
         }
     }
@@ -162,11 +174,13 @@ impl SampleFormat {
                 ..
             } => "ri2_lsb",
             SampleFormat::Packed1Complex => "ci1",
+            SampleFormat::Packed1Real { lsb_first: false } => "ri1",
+            SampleFormat::Packed1Real { lsb_first: true } => "ri1_lsb",
         }
         .to_string()
     }
 
-    /// Bits per complex (or real) sample: `ci8` = 16, `ci2` = 4, `ri2` = 2, `ci1` = 2.
+    /// Bits per complex (or real) sample: `ci8` = 16, `ci2` = 4, `ri2` = 2, `ci1` = 2, `ri1` = 1.
     pub fn bits_per_sample(&self) -> u32 {
         match self {
             SampleFormat::Ci8 | SampleFormat::Cu8 { .. } | SampleFormat::Ri16Le => 16,
@@ -176,11 +190,12 @@ impl SampleFormat {
             SampleFormat::Ri8 => 8,
             SampleFormat::Packed2 { complex: true, .. } => 4,
             SampleFormat::Packed2 { complex: false, .. } | SampleFormat::Packed1Complex => 2,
+            SampleFormat::Packed1Real { .. } => 1,
         }
     }
 
     /// Largest magnitude of one component: 127 (`ci8`, `ri8`), 127.5 (`cu8` with the default
-    /// zero), 32767 (16-bit), 1.0 (floats, by convention), max |map| (2-bit), 1 (`ci1`).
+    /// zero), 32767 (16-bit), 1.0 (floats, by convention), max |map| (2-bit), 1 (`ci1`, `ri1`).
     pub fn full_scale(&self) -> f32 {
         match self {
             SampleFormat::Ci8 | SampleFormat::Ri8 => 127.0,
@@ -188,7 +203,7 @@ impl SampleFormat {
             SampleFormat::Ci16Le | SampleFormat::Ri16Le => 32767.0,
             SampleFormat::Cf32Le | SampleFormat::Cf64Le | SampleFormat::Rf32Le => 1.0,
             SampleFormat::Packed2 { map, .. } => map.iter().fold(0.0f32, |m, v| m.max(v.abs())),
-            SampleFormat::Packed1Complex => 1.0,
+            SampleFormat::Packed1Complex | SampleFormat::Packed1Real { .. } => 1.0,
         }
     }
 
@@ -200,11 +215,13 @@ impl SampleFormat {
         )
     }
 
-    /// True for the packed sub-byte formats (`ci2`, `ri2`, `ci1`).
+    /// True for the packed sub-byte formats (`ci2`, `ri2`, `ci1`, `ri1`).
     pub fn is_packed(&self) -> bool {
         matches!(
             self,
-            SampleFormat::Packed2 { .. } | SampleFormat::Packed1Complex
+            SampleFormat::Packed2 { .. }
+                | SampleFormat::Packed1Complex
+                | SampleFormat::Packed1Real { .. }
         )
     }
 
@@ -257,6 +274,8 @@ impl FromStr for SampleFormat {
             "ri2" => packed(false, true),
             "ri2_lsb" => packed(false, false),
             "ci1" => SampleFormat::Packed1Complex,
+            "ri1" => SampleFormat::Packed1Real { lsb_first: false },
+            "ri1_lsb" => SampleFormat::Packed1Real { lsb_first: true },
             _ => {
                 return Err(SampleError::UnknownFormat {
                     name: s.to_string(),

@@ -20,8 +20,10 @@ pub struct Mixer {
 impl Mixer {
     /// A mixer removing `if_hz` from samples taken at `fs_hz`.
     pub fn new(if_hz: f64, fs_hz: f64) -> Self {
+        // Only the fractional cycles per sample matter at integer sample indices; keeping just
+        // them makes an IF of a whole multiple of fs exactly the identity.
         Mixer {
-            cycles_per_sample: if_hz / fs_hz,
+            cycles_per_sample: (if_hz / fs_hz).rem_euclid(1.0),
         }
     }
 
@@ -73,5 +75,16 @@ mod tests {
         }
         // IF = fs/4: the phasor is -j^n; n divisible by 4 gives +1
         assert!((block[0] - Complex32::new(1.0, 0.0)).norm() < 1e-4);
+    }
+
+    #[test]
+    fn an_if_of_fs_is_the_identity() {
+        let m = Mixer::new(4.092e6, 4.092e6);
+        let mut block: Vec<Complex32> = (0..5000).map(|k| Complex32::new(k as f32, 1.0)).collect();
+        let orig = block.clone();
+        m.mix(123_456_789, &mut block);
+        for (a, b) in block.iter().zip(&orig) {
+            assert!((a - b).norm() < 1e-3 * b.norm().max(1.0));
+        }
     }
 }

@@ -102,7 +102,17 @@ pub(crate) fn locate(path: &Path) -> Result<(PathBuf, Option<PathBuf>), SampleEr
     Ok((path.to_path_buf(), meta))
 }
 
-/// Checks fs and IF against what GPS L1 C/A needs.
+/// Whether a real recording's IF is a whole multiple k >= 1 of fs (to 1e-9 relative): sampling
+/// then moves the IF to 0 Hz and folds the spectrum onto itself, so a carrier offset f is seen
+/// at +f and -f alike (the MAX2769 set-up of SnapperGPS: IF = fs = 4.092 MHz). Mixing by such an
+/// IF is the identity ([`crate::mixer::Mixer`] keeps only the fractional cycles per sample).
+pub fn is_folded_if(if_hz: f64, fs_hz: f64) -> bool {
+    let k = if_hz / fs_hz;
+    k.is_finite() && k >= 0.5 && (k - k.round()).abs() < 1e-9
+}
+
+/// Checks fs and IF against what GPS L1 C/A needs: complex samples |IF| <= fs/2; real samples
+/// 0 < IF < fs/2, or IF a whole multiple of fs ([`is_folded_if`]).
 pub fn validate_rates(
     path: &Path,
     format: &SampleFormat,
@@ -132,13 +142,16 @@ pub fn validate_rates(
     let ok = if complex {
         if_hz.is_finite() && if_hz.abs() <= half
     } else {
-        if_hz.is_finite() && if_hz > 0.0 && if_hz < half
+        if_hz.is_finite() && ((if_hz > 0.0 && if_hz < half) || is_folded_if(if_hz, fs_hz))
     };
     if !ok {
         let allowed = if complex {
             format!("[-{half}, {half}] Hz (complex samples: |IF| <= fs/2)")
         } else {
-            format!("(0, {half}) Hz (real samples need 0 < IF < fs/2)")
+            format!(
+                "(0, {half}) Hz or a whole multiple of fs (real samples need 0 < IF < fs/2, or \
+                 IF = k fs: the signal folded around 0 Hz)"
+            )
         };
         return Err(SampleError::IfOutOfRange {
             path: path.to_path_buf(),

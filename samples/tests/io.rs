@@ -69,7 +69,9 @@ fn quantise(format: &SampleFormat, v: f32) -> (f32, bool) {
             let hi = sorted[3] + 0.5 * (sorted[3] - sorted[2]);
             (best, v < lo || v > hi)
         }
-        SampleFormat::Packed1Complex => (if v > 0.0 { 1.0 } else { -1.0 }, v.abs() > 2.0),
+        SampleFormat::Packed1Complex | SampleFormat::Packed1Real { .. } => {
+            (if v > 0.0 { 1.0 } else { -1.0 }, v.abs() > 2.0)
+        }
     }
 }
 
@@ -77,6 +79,8 @@ fn quantise(format: &SampleFormat, v: f32) -> (f32, bool) {
 fn pad_value(format: &SampleFormat) -> f32 {
     match format {
         SampleFormat::Packed2 { map, .. } => map[0],
+        // A zero bit is the positive sign.
+        SampleFormat::Packed1Real { .. } => 1.0,
         _ => -1.0,
     }
 }
@@ -305,6 +309,8 @@ fn packed_partial_byte_is_padded_as_documented() {
         (SampleFormat::ci2(), 3, 1),
         (SampleFormat::ri2(), 5, 3),
         (SampleFormat::Packed1Complex, 6, 2),
+        (SampleFormat::Packed1Real { lsb_first: true }, 5, 3),
+        (SampleFormat::Packed1Real { lsb_first: false }, 9, 7),
     ] {
         let path = dir.path().join(format.name());
         let samples = vec![c(-3.0, -3.0); n];
@@ -1056,7 +1062,7 @@ mod stream {
     #[test]
     fn stream_matches_file_source_bit_for_bit() {
         let dir = tempfile::tempdir().expect("tempdir");
-        let cases: [(SampleFormat, f64, bool); 9] = [
+        let cases: [(SampleFormat, f64, bool); 10] = [
             (SampleFormat::Ci8, 0.0, false),
             (SampleFormat::cu8(), 0.0, false),
             (SampleFormat::Ci16Le, -0.7e6, true),
@@ -1066,6 +1072,7 @@ mod stream {
             (SampleFormat::ci2(), 0.3e6, true),
             (SampleFormat::ri2(), 1.25e6, false),
             (SampleFormat::Packed1Complex, 0.0, false),
+            (SampleFormat::Packed1Real { lsb_first: true }, 1.0e6, false),
         ];
         let spans = [
             (0u64, None),

@@ -3,11 +3,13 @@
 mod acquire;
 mod bench;
 mod run;
+mod snapshot;
 mod track;
 
 pub use acquire::AcquireArgs;
 pub use bench::BenchArgs;
 pub use run::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
+pub use snapshot::SnapshotArgs;
 pub use track::TrackArgs;
 
 use clap::{Args, Parser, Subcommand};
@@ -53,6 +55,9 @@ pub enum Command {
     /// table.
     #[command(after_help = BATCH_EXIT_STATUS)]
     Batch(BatchArgs),
+    /// Position snapshots of a few milliseconds each (coarse-time navigation): SnapperGPS
+    /// JSON files or one raw snapshot; writes snapshots.csv and GeoJSON/KML/GPX tracks.
+    Snapshot(SnapshotArgs),
     /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
     Config(ConfigArgs),
     /// Loop studies: steady-state errors, bandwidth vs noise, high dynamics (seed 004).
@@ -93,7 +98,8 @@ pub struct ConfigArgs {
 pub struct SourceArgs {
     /// The recording (raw samples, .wav, or SigMF .sigmf-meta/.sigmf-data).
     pub file: PathBuf,
-    /// Sample format: ci8, cu8, ci16_le, cf32_le, cf64_le, ri8, ri16_le, rf32_le, ci2, ri2, ci1
+    /// Sample format: ci8, cu8, ci16_le, cf32_le, cf64_le, ri8, ri16_le, rf32_le, ci2, ri2, ci1,
+    /// ri1, ri1_lsb
     /// (default: from SigMF or WAV metadata).
     #[arg(long)]
     pub format: Option<String>,

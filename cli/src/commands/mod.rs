@@ -8,6 +8,7 @@ pub mod demo;
 pub mod info;
 pub mod run;
 pub mod simulate;
+pub mod snapshot;
 pub mod source;
 pub mod track;
 

@@ -108,7 +108,8 @@
 //!   and form a tone at twice the residual Doppler, located by a zero-padded FFT and a parabola.
 //!   Measured on the simulator with 100 prompts: 0.1 Hz rms at 40 dB-Hz, 0.4 Hz at 32 dB-Hz.
 //! - Code phase again: early, prompt and late correlators half a chip apart at the fine Doppler,
-//!   triangle fit (to a few hundredths of a sample at 42 to 45 dB-Hz).
+//!   triangle fit (to a few hundredths of a sample at 42 to 45 dB-Hz). [`code_fit`] refines it
+//!   further from the shape of the peak when the front end rounds it (snapshot positioning).
 //! - C/N0: power-minus-noise at the apex of that triangle,
 //!   `C/N0 = (mean |p_k|^2 - sigma_p^2) / (sigma_p^2 * 1 ms)`, with the prompt noise variance
 //!   `sigma_p^2` taken from the grid floor (so it is the noise the correlator sees, whatever the
@@ -118,6 +119,7 @@
 //!   0.3 dB low (the signal's own correlation sidelobes raise its row's floor by about 1/1023 of
 //!   its peak power per lag).
 
+pub mod code_fit;
 mod config;
 mod correlate;
 mod detect;

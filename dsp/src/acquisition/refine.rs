@@ -35,8 +35,38 @@ pub(crate) fn correlate_periods(
     offsets_samples: &[f64],
     out: &mut [Vec<Complex64>],
 ) {
+    correlate_periods_code_doppler(
+        samples,
+        correlator,
+        code,
+        fs_hz,
+        code_phase_samples,
+        (doppler_hz, doppler_hz),
+        k_max,
+        offsets_samples,
+        out,
+    );
+}
+
+/// [`correlate_periods`] with the carrier wiped off at `dopplers_hz.0` and the code run at
+/// the rate of the carrier Doppler `dopplers_hz.1`: the two differ for real samples whose
+/// spectrum is folded around 0 Hz (IF = k fs), where a satellite at Doppler D may be seen at
+/// -D while its code still runs at 1.023 MHz (1 + D / f_L1).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn correlate_periods_code_doppler(
+    samples: &[Complex32],
+    correlator: &Correlator,
+    code: &PackedCode,
+    fs_hz: f64,
+    code_phase_samples: f64,
+    dopplers_hz: (f64, f64),
+    k_max: usize,
+    offsets_samples: &[f64],
+    out: &mut [Vec<Complex64>],
+) {
     out.iter_mut().for_each(Vec::clear);
-    let chip_rate = CA_CHIP_RATE_HZ * (1.0 + doppler_hz / F_L1_HZ);
+    let (doppler_hz, code_doppler_hz) = dopplers_hz;
+    let chip_rate = CA_CHIP_RATE_HZ * (1.0 + code_doppler_hz / F_L1_HZ);
     let chips_per_sample = chip_rate / fs_hz;
     let period = CA_CODE_LENGTH as f64 / chips_per_sample;
     let tau = code_phase_samples.rem_euclid(period);

@@ -57,6 +57,20 @@
 //! noise. The whole milliseconds of the absolute time are therefore known only to that
 //! precision; the transmit-time differences between satellites are exact.
 //!
+//! # Height constraint
+//!
+//! With [`CoarseApriori::height`] the height above the ellipsoid enters as one more
+//! observation, `h(x) = h_a` with sigma `sigma_h`: the row `[u^T, 0, 0]` (u the local up unit
+//! vector at the current estimate) and the misclosure `h_a - h(x)`. Snapshot receivers near the
+//! ground use it (the vertical is the worst-determined coordinate of a five-state fix with few
+//! satellites, and its error leaks into the horizontal through the time unknown). The row
+//! counts as one more degree of freedom in the chi-square test and in the DOPs; the
+//! satellites' residuals and the search for a faulty satellite leave it out.
+//!
+//! [`CoarseApriori::time_sigma_s`] does the same for the time: the a-priori time itself as an
+//! observation `dt_c = 0` with sigma `sigma_t` (row `[0, 0, 0, 0, 1]`, misclosure `-dt_c`),
+//! for a sequence of snapshots whose device clock error is already known from the others.
+//!
 //! # Integrity
 //!
 //! With n >= 6 satellites each hypothesis must pass the chi-square test of
@@ -157,6 +171,20 @@ pub struct CoarseApriori {
     pub time_uncertainty_s: f64,
     /// Bound on the position error, m. A solution further away is rejected.
     pub pos_uncertainty_m: f64,
+    /// Optional height constraint (module docs, "Height constraint").
+    pub height: Option<HeightConstraint>,
+    /// Standard deviation of `time` as an observation, s (`None`: the time is a free unknown
+    /// within `time_uncertainty_s`).
+    pub time_sigma_s: Option<f64>,
+}
+
+/// A known height above the WGS-84 ellipsoid, used as an observation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeightConstraint {
+    /// Height above the ellipsoid, m.
+    pub h_m: f64,
+    /// Its standard deviation, m (> 0).
+    pub sigma_m: f64,
 }
 
 impl CoarseApriori {
@@ -168,6 +196,8 @@ impl CoarseApriori {
             pos_ecef_m,
             time_uncertainty_s: DEFAULT_TIME_UNCERTAINTY_S,
             pos_uncertainty_m: DEFAULT_POS_UNCERTAINTY_M,
+            height: None,
+            time_sigma_s: None,
         }
     }
 
@@ -480,6 +510,19 @@ fn validate_apriori(a: &CoarseApriori) -> Result<(), CoarseTimeError> {
     if !(a.pos_uncertainty_m.is_finite() && a.pos_uncertainty_m > 0.0) {
         return bad("pos_uncertainty_m", a.pos_uncertainty_m);
     }
+    if let Some(h) = a.height {
+        if !(h.h_m.is_finite() && h.h_m.abs() < 1.0e6) {
+            return bad("height.h_m", h.h_m);
+        }
+        if !(h.sigma_m.is_finite() && h.sigma_m > 0.0) {
+            return bad("height.sigma_m", h.sigma_m);
+        }
+    }
+    if let Some(s) = a.time_sigma_s {
+        if !(s.is_finite() && s > 0.0) {
+            return bad("time_sigma_s", s);
+        }
+    }
     Ok(())
 }
 
@@ -521,6 +564,30 @@ fn evaluate(
     let pred = predict(&sat, rx, true, opts, t.tow_s);
     let rate_mps = sat_range_rate(&sat, &pred).rate_mps;
     Ok(Evaluated { pred, rate_mps })
+}
+
+/// The SV transmit time modulo 1 ms that satellite `prn` (ephemeris `eph`) should show at the
+/// common reception instant of `sol`, solved with the a-priori time `apriori_time`:
+/// `phi = (t_a - (R(x, t) + b) / c) mod 1 ms` with R the pseudorange model at the solution's
+/// position x and time t, and b its clock-bias unknown (module docs). Used to look for a
+/// satellite the search missed at the code phase the fix predicts.
+pub fn predicted_tx_time_mod_1ms(
+    sol: &CoarseTimeSolution,
+    apriori_time: GpsTime,
+    eph: &Ephemeris,
+    opts: &PvtOptions,
+) -> Result<f64, PvtError> {
+    let m = CoarseMeasurement {
+        prn: eph.prn,
+        tx_time_mod_1ms_s: 0.0,
+        cn0_dbhz: 40.0,
+        ephemeris: eph,
+    };
+    let e = evaluate(&m, 0.0, &sol.pos_ecef_m, sol.time, opts)?;
+    let tx =
+        apriori_time.add_seconds(-(e.pred.range_model_m + sol.clock_bias_m) / SPEED_OF_LIGHT_MPS);
+    let phi = tx.tow_s.rem_euclid(CA_CODE_PERIOD_S);
+    Ok(if phi >= CA_CODE_PERIOD_S { 0.0 } else { phi })
 }
 
 /// Indices of the active satellites, highest a-priori elevation first.
@@ -619,6 +686,20 @@ fn linearise(
         lin.y_m.push(rho_m - e.pred.range_model_m - clock_bias_m);
         lin.used.push(k);
         lin.evals.push(e);
+    }
+    if let Some(hc) = p.apriori.height {
+        // Up unit vector and height at the current estimate: d h = u . dx.
+        let llh = Llh::from_ecef(x);
+        let (slat, clat) = llh.lat_rad.sin_cos();
+        let (slon, clon) = llh.lon_rad.sin_cos();
+        lin.rows.push([clat * clon, clat * slon, slat, 0.0, 0.0]);
+        lin.sigmas_m.push(hc.sigma_m);
+        lin.y_m.push(hc.h_m - llh.h_m);
+    }
+    if let Some(sigma_s) = p.apriori.time_sigma_s {
+        lin.rows.push([0.0, 0.0, 0.0, 0.0, 1.0]);
+        lin.sigmas_m.push(sigma_s);
+        lin.y_m.push(-dt_s);
     }
     Ok(lin)
 }
@@ -803,7 +884,9 @@ fn worst_satellite(p: &Problem<'_>, solved: &[Candidate]) -> Option<(Hypothesis,
         })?;
     let f = &best.fix;
     let w = normalised_residuals(&f.rows, &f.sigmas_m, &f.residuals_m, &f.n_inv);
-    let j = (0..w.len()).max_by(|&a, &b| w[a].total_cmp(&w[b]))?;
+    // Satellite rows only (a height row comes after them).
+    let n_sat = f.used.len().min(w.len());
+    let j = (0..n_sat).max_by(|&a, &b| w[a].total_cmp(&w[b]))?;
     Some((best.hyp.clone(), f.used[j]))
 }
 

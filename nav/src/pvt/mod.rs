@@ -26,8 +26,8 @@ pub mod velocity;
 pub mod wls;
 
 pub use coarse_time::{
-    solve_coarse_time, CoarseApriori, CoarseIntegrity, CoarseMeasurement, CoarseSatellite,
-    CoarseTimeError, CoarseTimeSolution,
+    predicted_tx_time_mod_1ms, solve_coarse_time, CoarseApriori, CoarseIntegrity,
+    CoarseMeasurement, CoarseSatellite, CoarseTimeError, CoarseTimeSolution, HeightConstraint,
 };
 pub use dop::Dop;
 pub use landmark::Landmark;

@@ -637,3 +637,68 @@ proptest! {
         prop_assert!(tx_dev < 1e-6);
     }
 }
+
+/// The height and time constraints (snapshot positioning): five satellites and the true
+/// height become checkable (one degree of freedom) and stay within metres of the truth; a
+/// time known to 1 ms pins the correction; a left-out satellite's phase is predicted from the
+/// fix to a fraction of a metre.
+#[test]
+fn height_and_time_constraints_and_predicted_phase() {
+    use gpsrx_nav::pvt::{predicted_tx_time_mod_1ms, HeightConstraint};
+    let nav = brdc();
+    let site = sites()[0];
+    let sats = sky(&nav, &site);
+    assert!(sats.len() >= 7, "{}", sats.len());
+    let mut g = Gauss(27);
+    let noise: Vec<f64> = (0..sats.len()).map(|_| 3.0 * g.normal()).collect();
+    let m = measurements(&site, &sats, &noise);
+    let five = &m[..5];
+    let free = apriori(&site, 0.3 * MS, 2.0, 20e3, 45.0);
+    let o = opts(3.0);
+    // Without a height: five satellites cannot be checked.
+    let sol = solve_coarse_time(five, &free, &o).expect("five");
+    assert_eq!(sol.integrity, CoarseIntegrity::Unverified);
+    let with_h = CoarseApriori {
+        height: Some(HeightConstraint {
+            h_m: site.llh.h_m,
+            sigma_m: 5.0,
+        }),
+        ..free
+    };
+    let sol_h = solve_coarse_time(five, &with_h, &o).expect("five and a height");
+    assert!(
+        matches!(sol_h.integrity, CoarseIntegrity::Passed { dof: 1, .. }),
+        "{:?}",
+        sol_h.integrity
+    );
+    assert!(
+        (sol_h.llh.h_m - site.llh.h_m).abs() < 15.0,
+        "{}",
+        sol_h.llh.h_m
+    );
+    assert!((sol_h.pos_ecef_m - site.llh.to_ecef()).norm() < 60.0);
+    // A time known to 1 ms: the correction is the 2 s offset to within a few ms.
+    let with_t = CoarseApriori {
+        time: site.t_true.add_seconds(0.3 * MS + 0.0005),
+        time_sigma_s: Some(1e-3),
+        ..with_h
+    };
+    let sol_t = solve_coarse_time(&m, &with_t, &o).expect("all, time known");
+    assert!(sol_t.time.diff_s(site.t_true).abs() < 3e-3);
+    // The sixth satellite as predicted from a fix of the others.
+    let others: Vec<CoarseMeasurement<'_>> =
+        m.iter().copied().filter(|x| x.prn != m[5].prn).collect();
+    let sol_o = solve_coarse_time(&others, &with_h, &o).expect("without the sixth");
+    let phi = predicted_tx_time_mod_1ms(&sol_o, with_h.time, m[5].ephemeris, &o).expect("phase");
+    let d = ((phi - phase(&site, m[5].ephemeris, 0.0) + 0.5 * MS).rem_euclid(MS) - 0.5 * MS) * C;
+    assert!(d.abs() < 30.0, "predicted phase off by {d:.1} m");
+    // Invalid constraints are refused.
+    let bad = CoarseApriori {
+        time_sigma_s: Some(0.0),
+        ..free
+    };
+    assert!(matches!(
+        solve_coarse_time(&m, &bad, &o),
+        Err(CoarseTimeError::InvalidApriori { .. })
+    ));
+}

@@ -559,7 +559,7 @@ impl Scenario {
                 let outer = map.iter().map(|v| v.abs()).fold(0.0f32, f32::max);
                 f64::from(inner + outer) / 2.0
             }
-            SampleFormat::Packed1Complex => 1.0,
+            SampleFormat::Packed1Complex | SampleFormat::Packed1Real { .. } => 1.0,
         })
     }
 
