@@ -165,5 +165,14 @@ else
   bad "cannot decompress the GPS-SDR-SIM recording"
 fi
 
+# --- 6. Positions from the real sky: snapshot positioning on the SnapperGPS walk (RTK truth)
+# and the airborne capture (reference position). Regression bounds (scripts/snapshot-check.sh):
+# >= 90 % fixes, median <= 25 m, 95th percentile <= 60 m; airborne within 50 m.
+if GPSRX="$GPSRX" bash scripts/snapshot-check.sh; then
+  ok "gpsrx snapshot on the real SnapperGPS and airborne snapshots within the regression bounds"
+else
+  bad "gpsrx snapshot on the real snapshots (scripts/snapshot-check.sh)"
+fi
+
 echo "cross-check: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
