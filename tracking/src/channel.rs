@@ -26,6 +26,7 @@ use crate::config::{ConfigError, LoopConfig};
 use crate::correlator_choice::{CorrelatorArithmetic, CorrelatorIsa};
 use crate::fade_detector::FadeDetector;
 use crate::lock_detector::{CodeLockDetector, PllLockConfig, PllLockDetector};
+use crate::phase_fit::QuadraticPhaseFit;
 use gpsrx_dsp::acquisition::AcqResult;
 use gpsrx_dsp::ca_code::{CaCode, Prn};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, CA_CODE_LENGTH, F_L1_HZ};
@@ -371,6 +372,15 @@ pub struct Channel {
     /// A completed bit and the `ms_count` of its first code period, waiting for the end of the
     /// integration interval.
     pending_bit: Option<(Bit, u64)>,
+    /// The least-squares fit of the carrier phase the loop tracks (NCO phase less the
+    /// feed-forward's, plus the discriminator output): the frequency and Doppler rate a
+    /// narrowed loop starts from ([`crate::phase_fit`]).
+    phase_fit: QuadraticPhaseFit,
+    /// The feed-forward's phase accumulated up to the start of the interval being summed,
+    /// cycles.
+    ff_phase_cycles: f64,
+    /// The aid came or went at the last loop update: the phase fit starts again.
+    aid_switched: bool,
     /// The stage of a weak-signal pull-in (`None`: the normal pull-in, or after the hand-over).
     weak_stage: Option<WeakStage>,
     /// The weak pull-in's C/N0 estimator before bit synchronisation (NWPR over unaligned
@@ -444,6 +454,9 @@ impl Channel {
             acc_start: (start.code_start_sample, 0.0, 0.0, 0.0),
             taps: [d / 2.0, 0.0, -d / 2.0],
             rate_fit: [0.0; 5],
+            phase_fit: QuadraticPhaseFit::new(),
+            ff_phase_cycles: 0.0,
+            aid_switched: false,
             pending_bit: None,
             weak_stage: weak_pull_in.map(|_| WeakStage::Frequency),
             presync_cn0: SmoothedNwpr::new(
@@ -529,6 +542,7 @@ impl Channel {
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
         self.carrier.reset_history();
+        self.phase_fit.reset();
         self.bit_sync.reset();
         self.bit_sync_origin_ms = self.ms_count;
         self.weak_restart_frequency_stage();
@@ -592,6 +606,7 @@ impl Channel {
         }
         let bit = self.pending_bit.take();
         let (co, cl) = self.update_loops();
+        self.feed_phase_fit(co.phase_error_cycles);
         let epoch = self.build_epoch(ms_index, timing, &co, &cl, bit);
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
@@ -808,11 +823,13 @@ impl Channel {
         let ff_rate = self.aid.map_or(0.0, |(a, _)| a.doppler_rate_hz_s);
         match (self.ff_applied_hz, ff_opt) {
             (None, Some(f)) => {
+                self.aid_switched = true;
                 self.carrier.shift_base_hz(-f);
                 self.carrier.shift_doppler_rate(-ff_rate);
                 self.ff_rate_applied_hz_s = ff_rate;
             }
             (Some(f), None) => {
+                self.aid_switched = true;
                 self.carrier.shift_base_hz(f);
                 self.carrier.shift_doppler_rate(self.ff_rate_applied_hz_s);
                 self.ff_rate_applied_hz_s = 0.0;
@@ -913,14 +930,15 @@ impl Channel {
         self.weak_stage = None;
         let which = self.wanted_loops();
         let loops = self.loop_config(which);
-        let (Some(carrier), Ok(code_loop)) = (self.carrier_toward(&loops), CodeLoop::new(&loops))
+        let (Some((carrier, from_fit)), Ok(code_loop)) =
+            (self.carrier_toward(&loops), CodeLoop::new(&loops))
         else {
             return; // validated at construction; keep pulling in otherwise
         };
         self.carrier = carrier;
         let [n, st, sf, stt, stf] = self.rate_fit;
         let den = n * stt - st * st;
-        if n >= 100.0 && den > 0.0 {
+        if !from_fit && n >= 100.0 && den > 0.0 {
             self.carrier.preset_doppler_rate((n * stf - st * sf) / den);
         }
         self.code_loop = code_loop;
@@ -968,7 +986,8 @@ impl Channel {
             return;
         }
         let loops = self.loop_config(which);
-        let (Some(carrier), Ok(code_loop)) = (self.carrier_toward(&loops), CodeLoop::new(&loops))
+        let (Some((carrier, _)), Ok(code_loop)) =
+            (self.carrier_toward(&loops), CodeLoop::new(&loops))
         else {
             return;
         };

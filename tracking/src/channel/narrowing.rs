@@ -8,13 +8,29 @@
 //! to slip and to make the lock detector drop the channel before a manoeuvre has even begun.
 //! Halving the bandwidth at a time ([`NARROW_RATIO`]), each stage held for [`STAGE_BN_S`] / Bn
 //! seconds (a few time constants), starts every stage with the errors of a loop only twice as
-//! wide, which settle within a fraction of a cycle; the stage states carry over bumplessly
-//! ([`CarrierLoop::retuned`]: frequency and Doppler-rate memory). 18 Hz to 0.4 Hz takes six
-//! stages and about 8 s.
+//! wide; the stage states carry over bumplessly ([`CarrierLoop::retuned`]: frequency and
+//! Doppler-rate memory). 18 Hz to 0.4 Hz takes six stages and about 8 s.
+//!
+//! # The frequency and rate a stage starts from (issue 25)
+//!
+//! The memories of the running loop are not good enough for a 3rd-order loop: its lightly
+//! damped pole pair (`(-0.149 +- 0.673 j) w0`, [`crate::phase_fit`]) keeps about 70 % of a
+//! rate error over a stage of `2 / Bn`, while the next stage tolerates four times less
+//! (`dr / w0^2` cycles). Measured on the simulator (static, perfect clock, 36 dB-Hz): the
+//! hand-over left G29's rate memory at -1.82 Hz/s against a true -0.637 Hz/s, the stages
+//! carried -0.83 Hz/s into the 0.94 Hz stage and -0.75 Hz/s into the 0.47 Hz one, whose phase
+//! then ran to a quarter cycle: the Costas loop slipped and stayed 0.3-0.7 Hz off.
+//!
+//! So every stage (and the hand-over from pull-in) starts from the open-loop least-squares fit
+//! of the tracked carrier phase since the pull-in's FLL assist went off
+//! ([`QuadraticPhaseFit`]) whenever the fit's own 1-sigma errors cost the new loop less than
+//! [`FIT_TOLERANCE_CYCLES`] (`sigma_f / w0 + sigma_r / w0^2`); otherwise (a short or
+//! disturbed window) from the running loop's memories as before.
 
-use super::Channel;
+use super::{Channel, ChannelState};
 use crate::carrier_loop::CarrierLoop;
 use crate::config::LoopConfig;
+use crate::loop_filter::omega0;
 
 /// Bandwidth ratio between consecutive stages; a target narrower than the running loop by more
 /// than this is reached in stages.
@@ -22,6 +38,14 @@ pub const NARROW_RATIO: f64 = 2.0;
 /// Length of a stage in units of its own `1 / Bn`: `Bn t` (2: about 2.5 time constants
 /// `1 / w0` of a 3rd-order loop).
 pub const STAGE_BN_S: f64 = 2.0;
+/// Largest phase excursion (cycles) the 1-sigma errors of the phase fit may cost a loop
+/// started from it (`sigma_f / w0 + sigma_r / w0^2`): 3 sigma within 1/8 cycle (45 deg, the
+/// rule of thumb for a Costas PLL whose discriminator folds at 90 deg).
+pub const FIT_TOLERANCE_CYCLES: f64 = 0.125 / 3.0;
+/// Longest window of the phase fit, s: a static receiver's Doppler rate changes by about
+/// 1e-4 Hz/s^2, so a quadratic phase holds for far longer; under dynamics the residuals grow
+/// and the fit is not used anyway.
+pub const MAX_FIT_WINDOW_S: f64 = 30.0;
 
 /// Where a channel's stepwise narrowing stands.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,7 +88,9 @@ impl Channel {
     /// The carrier loop for `target` loops from the running one: the first narrowing stage
     /// when `target` is much narrower (and the narrowing started), else `target`, with the
     /// running loop's frequency and rate memory.
-    pub(super) fn carrier_toward(&mut self, target: &LoopConfig) -> Option<CarrierLoop> {
+    ///
+    /// Also returns whether the new loop starts from the phase fit ([`Channel::retune`]).
+    pub(super) fn carrier_toward(&mut self, target: &LoopConfig) -> Option<(CarrierLoop, bool)> {
         let running = self.carrier.config();
         let bw = if running.pll_order > 0 {
             running.pll_bw_hz
@@ -72,9 +98,68 @@ impl Channel {
             running.fll_bw_hz
         };
         let (stage, narrowing) = next_stage(bw, target, self.ms_count);
-        let next = self.carrier.retuned(&stage).ok()?;
+        let next = self.retune(&stage)?;
         self.narrowing = narrowing;
         Some(next)
+    }
+
+    /// The running carrier loop with the settings `stage`, starting from the phase fit's
+    /// frequency and Doppler rate (evaluated at the middle of the next interval) when the fit
+    /// is good enough for it ([`FIT_TOLERANCE_CYCLES`]), else from the running loop's memories
+    /// ([`CarrierLoop::retuned`]). The flag says which.
+    fn retune(&self, stage: &LoopConfig) -> Option<(CarrierLoop, bool)> {
+        let mut next = self.carrier.retuned(stage).ok()?;
+        if stage.pll_order == 0 {
+            return Some((next, false));
+        }
+        let t_s = self.next_sample as f64 / self.fs_hz + 0.5 * stage.t_coh_s;
+        let w0 = omega0(stage.pll_order, stage.pll_bw_hz);
+        let Some(fit) = self.phase_fit.estimate(t_s) else {
+            return Some((next, false));
+        };
+        if !(fit.phase_cost_cycles(w0) <= FIT_TOLERANCE_CYCLES) {
+            return Some((next, false));
+        }
+        next.shift_base_hz(fit.freq_hz - next.frequency_memory_hz());
+        next.preset_doppler_rate(fit.rate_hz_s);
+        Some((next, true))
+    }
+
+    /// Adds the interval just closed to the phase fit: at its middle time, the NCO's mean
+    /// phase over it less the feed-forward's, plus the discriminator output
+    /// `phase_error_cycles`. Fed during a normal pull-in once the FLL assist is off and in
+    /// tracking while the phase is locked; the fit starts again when the aid comes or goes,
+    /// when the lock indicator is out in tracking (a slip would corrupt it), during a
+    /// weak-signal pull-in, and after [`MAX_FIT_WINDOW_S`].
+    pub(super) fn feed_phase_fit(&mut self, phase_error_cycles: f64) {
+        let (s0, _, ph0, _) = self.acc_start;
+        let dur_s = (self.next_sample.saturating_sub(s0)) as f64 / self.fs_hz;
+        let ff = self.acc_feedforward_hz.unwrap_or(0.0);
+        let ff_mid = self.ff_phase_cycles + 0.5 * ff * dur_s;
+        self.ff_phase_cycles += ff * dur_s;
+        let t_mid = (s0 as f64 / self.fs_hz) + 0.5 * dur_s;
+        let feeding = match self.state {
+            ChannelState::PullIn => {
+                self.weak_stage.is_none() && self.pull_in_ms > (self.cfg.fll_assist_s * 1e3) as u64
+            }
+            ChannelState::Track => self.pll_lock.locked(),
+            ChannelState::Lost => false,
+        };
+        if !feeding || self.phase_fit.span_s(t_mid) > MAX_FIT_WINDOW_S {
+            self.phase_fit.reset();
+        }
+        if feeding {
+            let y = 0.5 * (ph0 + self.carrier_phase_cycles) - ff_mid + phase_error_cycles;
+            self.phase_fit.push(
+                t_mid,
+                y,
+                self.carrier_freq_hz - self.ff_applied_hz.unwrap_or(0.0),
+            );
+        }
+        if self.aid_switched {
+            self.aid_switched = false;
+            self.phase_fit.reset();
+        }
     }
 
     /// At a data-bit edge (integrations stay aligned), moves to the next narrowing stage once
@@ -88,7 +173,7 @@ impl Channel {
         }
         let bw = self.carrier.config().pll_bw_hz;
         let (stage, narrowing) = next_stage(bw, &n.target, self.ms_count);
-        if let Ok(next) = self.carrier.retuned(&stage) {
+        if let Some((next, _)) = self.retune(&stage) {
             self.carrier = next;
         }
         self.narrowing = narrowing;
