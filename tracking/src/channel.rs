@@ -36,6 +36,7 @@ use serde::{Deserialize, Serialize};
 
 mod narrowing;
 mod realign;
+mod recover;
 mod weak_pull_in;
 pub use realign::CodeShift;
 use weak_pull_in::WeakStage;
@@ -77,6 +78,12 @@ pub struct ChannelConfig {
     pub cn0_window_s: f64,
     /// How many consecutive C/N0 estimates below the threshold release the channel.
     pub lost_estimates: u32,
+    /// Time without phase lock after which a tracking channel goes back through a pull-in of
+    /// its carrier ([`ChannelState::Recover`]), s (0: never; it then stays in tracking until
+    /// its C/N0 is lost).
+    pub relock_after_s: f64,
+    /// Longest recovery before the channel is released and the satellite searched again, s.
+    pub recover_s: f64,
     /// The weak-signal pull-in (`None`: every channel takes the `pull_in` loops): a channel
     /// whose acquisition C/N0 is below [`WeakPullInConfig::enter_dbhz`] pulls in with an FLL on
     /// 10 ms sums, differential bit synchronisation and a bit-aligned 20 ms PLL instead, then
@@ -134,6 +141,11 @@ impl Default for ChannelConfig {
             cn0_lost_dbhz: 25.0,
             cn0_window_s: 0.2,
             lost_estimates: 5,
+            // A slipped narrow loop does not come back by itself (issue 25): after 1 s out of
+            // lock (the lock detector itself needs 0.2 s of tests to drop), pull in again;
+            // a normal pull-in locks within 0.5-1 s, a weak one within a few seconds.
+            relock_after_s: 1.0,
+            recover_s: 5.0,
             weak_pull_in: Some(WeakPullInConfig::default()),
             correlator: CorrelatorIsa::Auto,
             correlator_arithmetic: CorrelatorArithmetic::Auto,
@@ -197,6 +209,18 @@ impl ChannelConfig {
                 ),
             });
         }
+        for (field, value) in [
+            ("relock_after_s", self.relock_after_s),
+            ("recover_s", self.recover_s),
+        ] {
+            if !(value.is_finite() && (0.0..=600.0).contains(&value)) {
+                return Err(ConfigError::OutOfRange {
+                    field,
+                    value,
+                    valid: "0 to 600 s".into(),
+                });
+            }
+        }
         if !self.cn0_lost_dbhz.is_finite() {
             return Err(ConfigError::OutOfRange {
                 field: "cn0_lost_dbhz",
@@ -217,6 +241,11 @@ pub enum ChannelState {
     PullIn,
     /// The user's loops, integrations aligned to data bits.
     Track,
+    /// Carrier lock lost in tracking for [`ChannelConfig::relock_after_s`]: code-only
+    /// tracking while the carrier is pulled in again (the pull-in loops, or the weak
+    /// pull-in's phase stage); back to [`ChannelState::Track`] on phase lock, released after
+    /// [`ChannelConfig::recover_s`]. Its measurements are not used.
+    Recover,
     /// Signal lost: release the channel.
     Lost,
 }
@@ -359,6 +388,10 @@ pub struct Channel {
     /// The carrier loop is being narrowed in stages to its tracking loops.
     narrowing: Option<narrowing::Narrowing>,
     low_cn0_count: u32,
+    /// Time without phase lock in tracking, ms.
+    unlocked_ms: u64,
+    /// Recoveries from a loss of carrier lock so far.
+    recoveries: u32,
     /// Accumulators of the current interval: E, P, L. The early replica leads the prompt by
     /// d/2 chip (its code phase is `c + d/2`), the late one lags it.
     acc: [Complex64; 3],
@@ -449,6 +482,8 @@ impl Channel {
             release_requested: false,
             narrowing: None,
             low_cn0_count: 0,
+            unlocked_ms: 0,
+            recoveries: 0,
             acc: [Complex64::new(0.0, 0.0); 3],
             acc_ms: 0,
             acc_start: (start.code_start_sample, 0.0, 0.0, 0.0),
@@ -466,6 +501,12 @@ impl Channel {
                 cn0_window_blocks,
             ),
         })
+    }
+
+    /// Whether the carrier is being pulled in: after acquisition ([`ChannelState::PullIn`])
+    /// or after a loss of lock ([`ChannelState::Recover`]).
+    fn pulling_in(&self) -> bool {
+        matches!(self.state, ChannelState::PullIn | ChannelState::Recover)
     }
 
     /// The satellite.
@@ -595,7 +636,7 @@ impl Channel {
         let (p, t_start_s, ms_index) = self.correlate_period(samples);
         let timing = self.update_bit_sync(p, t_start_s, ms_index);
         self.update_detectors(p, timing.next_is_edge);
-        if self.state == ChannelState::PullIn && self.weak_pull_in_step(timing.next_is_edge) {
+        if self.pulling_in() && self.weak_pull_in_step(timing.next_is_edge) {
             return None;
         }
         if !self.interval_complete(ms_index, timing) {
@@ -608,6 +649,7 @@ impl Channel {
         let (co, cl) = self.update_loops();
         self.feed_phase_fit(co.phase_error_cycles);
         let epoch = self.build_epoch(ms_index, timing, &co, &cl, bit);
+        self.watch_carrier_lock(self.acc_ms as u64);
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
         self.maybe_hand_over(timing.next_is_edge);
@@ -656,7 +698,7 @@ impl Channel {
         self.advance(samples.len());
         let ms_index = self.ms_count;
         self.ms_count += 1;
-        if self.state == ChannelState::PullIn {
+        if self.pulling_in() {
             self.pull_in_ms += 1;
             // (A weak pull-in switches its own assist: [`Channel::weak_pull_in_step`].)
             if self.pull_in_ms == (self.cfg.fll_assist_s * 1e3).round() as u64
@@ -856,7 +898,7 @@ impl Channel {
     /// 3rd-order tracking loop at the hand-over ([`Channel::maybe_hand_over`]).
     #[inline]
     fn accumulate_rate_fit(&mut self, nco_freq_hz: f64, ff: f64) {
-        if self.state == ChannelState::PullIn
+        if self.pulling_in()
             && self.weak_stage.is_none()
             && self.pull_in_ms > (self.cfg.fll_assist_s * 1e3) as u64
         {
@@ -920,7 +962,7 @@ impl Channel {
     /// pull-in time has passed; the switch happens on a bit edge so that the longer
     /// integrations are aligned with the data bits.
     fn maybe_hand_over(&mut self, at_edge: bool) {
-        if self.state != ChannelState::PullIn || !at_edge {
+        if !self.pulling_in() || !at_edge {
             return;
         }
         let min_ms = (self.cfg.min_pull_in_s * 1e3) as u64;

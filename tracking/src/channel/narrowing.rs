@@ -24,8 +24,9 @@
 //! So every stage (and the hand-over from pull-in) starts from the open-loop least-squares fit
 //! of the tracked carrier phase since the pull-in's FLL assist went off
 //! ([`QuadraticPhaseFit`]) whenever the fit's own 1-sigma errors cost the new loop less than
-//! [`FIT_TOLERANCE_CYCLES`] (`sigma_f / w0 + sigma_r / w0^2`); otherwise (a short or
-//! disturbed window) from the running loop's memories as before.
+//! [`FIT_TOLERANCE_CYCLES`] (`sigma_f / w0 + sigma_r / w0^2`) and its latest samples show no
+//! slip ([`MAX_END_RESIDUAL_CYCLES`]); otherwise (a short or disturbed window) from the
+//! running loop's memories as before.
 
 use super::{Channel, ChannelState};
 use crate::carrier_loop::CarrierLoop;
@@ -42,6 +43,10 @@ pub const STAGE_BN_S: f64 = 2.0;
 /// started from it (`sigma_f / w0 + sigma_r / w0^2`): 3 sigma within 1/8 cycle (45 deg, the
 /// rule of thumb for a Costas PLL whose discriminator folds at 90 deg).
 pub const FIT_TOLERANCE_CYCLES: f64 = 0.125 / 3.0;
+/// Largest mean residual of the phase fit's latest samples, cycles: a Costas slip in the
+/// middle of the window leaves them 0.12 cycle off ([`crate::phase_fit`]), a later one more;
+/// the noise of 64 samples is below 0.015 cycle rms down to 30 dB-Hz at 1 ms (4 sigma).
+pub const MAX_END_RESIDUAL_CYCLES: f64 = 0.06;
 /// Longest window of the phase fit, s: a static receiver's Doppler rate changes by about
 /// 1e-4 Hz/s^2, so a quadratic phase holds for far longer; under dynamics the residuals grow
 /// and the fit is not used anyway.
@@ -117,7 +122,9 @@ impl Channel {
         let Some(fit) = self.phase_fit.estimate(t_s) else {
             return Some((next, false));
         };
-        if !(fit.phase_cost_cycles(w0) <= FIT_TOLERANCE_CYCLES) {
+        if !(fit.phase_cost_cycles(w0) <= FIT_TOLERANCE_CYCLES
+            && fit.end_residual_cycles.abs() <= MAX_END_RESIDUAL_CYCLES)
+        {
             return Some((next, false));
         }
         next.shift_base_hz(fit.freq_hz - next.frequency_memory_hz());
@@ -139,7 +146,7 @@ impl Channel {
         self.ff_phase_cycles += ff * dur_s;
         let t_mid = (s0 as f64 / self.fs_hz) + 0.5 * dur_s;
         let feeding = match self.state {
-            ChannelState::PullIn => {
+            ChannelState::PullIn | ChannelState::Recover => {
                 self.weak_stage.is_none() && self.pull_in_ms > (self.cfg.fll_assist_s * 1e3) as u64
             }
             ChannelState::Track => self.pll_lock.locked(),
