@@ -969,9 +969,12 @@ impl Channel {
         if self.pull_in_ms < min_ms || !self.pll_lock.locked() || !self.weak_ready_for_hand_over() {
             return;
         }
-        self.weak_stage = None;
         let which = self.wanted_loops();
         let loops = self.loop_config(which);
+        if self.state == ChannelState::Recover && !self.recovery_ready(&loops) {
+            return;
+        }
+        self.weak_stage = None;
         let (Some((carrier, from_fit)), Ok(code_loop)) =
             (self.carrier_toward(&loops), CodeLoop::new(&loops))
         else {

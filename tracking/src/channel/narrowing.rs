@@ -32,6 +32,7 @@ use super::{Channel, ChannelState};
 use crate::carrier_loop::CarrierLoop;
 use crate::config::LoopConfig;
 use crate::loop_filter::omega0;
+use crate::phase_fit::PhaseFitEstimate;
 
 /// Bandwidth ratio between consecutive stages; a target narrower than the running loop by more
 /// than this is reached in stages.
@@ -114,30 +115,54 @@ impl Channel {
     /// ([`CarrierLoop::retuned`]). The flag says which.
     fn retune(&self, stage: &LoopConfig) -> Option<(CarrierLoop, bool)> {
         let mut next = self.carrier.retuned(stage).ok()?;
-        if stage.pll_order == 0 {
-            return Some((next, false));
-        }
-        let t_s = self.next_sample as f64 / self.fs_hz + 0.5 * stage.t_coh_s;
-        let w0 = omega0(stage.pll_order, stage.pll_bw_hz);
-        let Some(fit) = self.phase_fit.estimate(t_s) else {
+        let Some(fit) = self.usable_fit(stage) else {
             return Some((next, false));
         };
-        if !(fit.phase_cost_cycles(w0) <= FIT_TOLERANCE_CYCLES
-            && fit.end_residual_cycles.abs() <= MAX_END_RESIDUAL_CYCLES)
-        {
-            return Some((next, false));
-        }
         next.shift_base_hz(fit.freq_hz - next.frequency_memory_hz());
         next.preset_doppler_rate(fit.rate_hz_s);
         Some((next, true))
     }
 
+    /// The phase fit's estimate at the middle of the next interval, if a loop `stage` may
+    /// start from it: its 1-sigma errors cost that loop at most [`FIT_TOLERANCE_CYCLES`] and
+    /// its latest samples show no slip ([`MAX_END_RESIDUAL_CYCLES`]).
+    fn usable_fit(&self, stage: &LoopConfig) -> Option<PhaseFitEstimate> {
+        if stage.pll_order == 0 {
+            return None;
+        }
+        let t_s = self.next_sample as f64 / self.fs_hz + 0.5 * stage.t_coh_s;
+        let w0 = omega0(stage.pll_order, stage.pll_bw_hz);
+        self.phase_fit.estimate(t_s).filter(|fit| {
+            fit.phase_cost_cycles(w0) <= FIT_TOLERANCE_CYCLES
+                && fit.end_residual_cycles.abs() <= MAX_END_RESIDUAL_CYCLES
+        })
+    }
+
+    /// Whether a recovering channel may hand over to `target` loops: at once for loops without
+    /// a rate memory, else once the phase fit is good enough for the first stage toward them
+    /// (the pull-in loop's rate memory after the kick that lost the lock is no start for a
+    /// narrow 3rd-order loop; measured: a 1 Hz loop slipped again 0.5 s after every such
+    /// hand-over). The recovery's time limit bounds the wait.
+    pub(super) fn recovery_ready(&self, target: &LoopConfig) -> bool {
+        if target.pll_order < 3 {
+            return true;
+        }
+        let running = self.carrier.config();
+        let bw = if running.pll_order > 0 {
+            running.pll_bw_hz
+        } else {
+            running.fll_bw_hz
+        };
+        let (stage, _) = next_stage(bw, target, self.ms_count);
+        self.usable_fit(&stage).is_some()
+    }
+
     /// Adds the interval just closed to the phase fit: at its middle time, the NCO's mean
     /// phase over it less the feed-forward's, plus the discriminator output
-    /// `phase_error_cycles`. Fed during a normal pull-in once the FLL assist is off and in
-    /// tracking while the phase is locked; the fit starts again when the aid comes or goes,
-    /// when the lock indicator is out in tracking (a slip would corrupt it), during a
-    /// weak-signal pull-in, and after [`MAX_FIT_WINDOW_S`].
+    /// `phase_error_cycles`. Fed while the phase-lock indicator says locked (in pull-in,
+    /// recovery and tracking; not in a weak pull-in's frequency stage, whose sums are not
+    /// aligned); the fit starts again when the lock indicator is out (a slip would corrupt
+    /// it), when the aid comes or goes, and after [`MAX_FIT_WINDOW_S`].
     pub(super) fn feed_phase_fit(&mut self, phase_error_cycles: f64) {
         let (s0, _, ph0, _) = self.acc_start;
         let dur_s = (self.next_sample.saturating_sub(s0)) as f64 / self.fs_hz;
@@ -145,13 +170,9 @@ impl Channel {
         let ff_mid = self.ff_phase_cycles + 0.5 * ff * dur_s;
         self.ff_phase_cycles += ff * dur_s;
         let t_mid = (s0 as f64 / self.fs_hz) + 0.5 * dur_s;
-        let feeding = match self.state {
-            ChannelState::PullIn | ChannelState::Recover => {
-                self.weak_stage.is_none() && self.pull_in_ms > (self.cfg.fll_assist_s * 1e3) as u64
-            }
-            ChannelState::Track => self.pll_lock.locked(),
-            ChannelState::Lost => false,
-        };
+        let feeding = self.state != ChannelState::Lost
+            && self.pll_lock.locked()
+            && !self.weak_frequency_stage();
         if !feeding || self.phase_fit.span_s(t_mid) > MAX_FIT_WINDOW_S {
             self.phase_fit.reset();
         }

@@ -13,8 +13,8 @@
 //!   (or without a weak pull-in) with the wide, FLL-assisted pull-in loops
 //!   ([`ChannelConfig::pull_in`](super::ChannelConfig::pull_in), 1 ms; the FLL assist off
 //!   after `fll_assist_s`), as after acquisition;
-//! - below it with the weak pull-in's phase stage (bit-aligned 20 ms FLL-assisted PLL: the
-//!   bit edges are known, so its frequency stage is skipped).
+//! - below it with the weak pull-in: its FLL on unaligned 10 ms sums, then at the next bit
+//!   edge (the bits are still synchronised) its bit-aligned 20 ms FLL-assisted PLL.
 //!
 //! Once the phase is locked again the usual hand-over returns it, at a bit edge, to its
 //! configured loops (narrowed in stages from the phase fit if they are narrow). A channel
@@ -63,12 +63,18 @@ impl Channel {
             .cfg
             .weak_pull_in
             .filter(|w| !(self.cn0_dbhz >= w.enter_dbhz));
-        let loops = weak.map_or(self.cfg.pull_in, |w| w.pll);
-        let Ok(carrier) = CarrierLoop::new(&loops, f) else {
-            return; // validated at construction
-        };
-        self.carrier = carrier;
-        self.weak_stage = weak.map(|_| WeakStage::Phase { ms: 0 });
+        if let Some(w) = weak {
+            // The frequency stage's 10 ms sums need no alignment; the stage hands over to the
+            // bit-aligned phase stage at the next bit edge ([`Channel::weak_pull_in_step`]).
+            self.set_weak_loops(&w.fll);
+            self.weak_stage = Some(WeakStage::Frequency);
+        } else {
+            let Ok(carrier) = CarrierLoop::new(&self.cfg.pull_in, f) else {
+                return; // validated at construction
+            };
+            self.carrier = carrier;
+            self.weak_stage = None;
+        }
         self.state = ChannelState::Recover;
         self.recoveries += 1;
         self.unlocked_ms = 0;
@@ -98,7 +104,7 @@ mod tests {
     const FS: f64 = 2.048e6;
     const DOPPLER_HZ: f64 = 1234.5;
 
-    /// PRN 7 at 45 dB-Hz in unit complex noise (`A^2 fs / 2 = C/N0`), 50 bit/s data
+    /// PRN 7 at `cn0_dbhz` in unit complex noise (`A^2 fs / 2 = C/N0`), 50 bit/s data
     /// alternating in pairs, the carrier Doppler stepping by `step_hz` at `step_s`
     /// (phase-continuous); no signal at all from `off_s` on.
     struct Signal {
@@ -106,6 +112,7 @@ mod tests {
         step_s: f64,
         step_hz: f64,
         off_s: f64,
+        cn0_dbhz: f64,
         rng: SimRng,
     }
 
@@ -125,7 +132,7 @@ mod tests {
             } else {
                 -1.0
             };
-            let amp = (2.0 * 10f64.powf(4.5) / FS).sqrt();
+            let amp = (2.0 * 10f64.powf(0.1 * self.cn0_dbhz) / FS).sqrt();
             let v = Complex64::from_polar(amp * chip * bit, std::f64::consts::TAU * cycles) + n;
             Complex32::new(v.re as f32, v.im as f32)
         }
@@ -194,6 +201,7 @@ mod tests {
             step_s: 4.0,
             step_hz: 5.0,
             off_s: f64::INFINITY,
+            cn0_dbhz: 45.0,
             rng: SimRng::new(11),
         };
         let mut ch = Channel::new(&start(), FS, &narrow_config()).expect("channel");
@@ -217,6 +225,54 @@ mod tests {
         assert!((end.3 - (DOPPLER_HZ + 5.0)).abs() < 0.5, "{end:?}");
     }
 
+    /// The same at 31 dB-Hz (loops without the weak-signal switch, so the 1 Hz loop at 1 ms
+    /// tracks it): the recovery takes the weak pull-in (an FLL on 10 ms sums, then at a bit
+    /// edge the bit-aligned 20 ms PLL) and hands back to the configured loops.
+    #[test]
+    fn a_weak_channel_recovers_through_the_weak_pull_in() {
+        let mut sig = Signal {
+            code: CaCode::new(Prn::new(7).expect("PRN")),
+            step_s: 6.0,
+            step_hz: 5.0,
+            off_s: f64::INFINITY,
+            cn0_dbhz: 31.0,
+            rng: SimRng::new(23),
+        };
+        let cfg = ChannelConfig {
+            weak_track: None,
+            ..narrow_config()
+        };
+        let start = ChannelStart {
+            cn0_dbhz: 31.0,
+            ..start()
+        };
+        let mut ch = Channel::new(&start, FS, &cfg).expect("channel");
+        let eps = run(&mut ch, &mut sig, 16.0);
+        let before = eps
+            .iter()
+            .rev()
+            .find(|e| e.0 < 6.0)
+            .copied()
+            .expect("report");
+        assert_eq!(
+            (before.1, before.2),
+            (ChannelState::Track, true),
+            "{before:?}"
+        );
+        // The weak pull-in's 20 ms sums report in recovery.
+        assert!(
+            eps.iter().any(|e| e.1 == ChannelState::Recover && e.2),
+            "never locked in recovery"
+        );
+        // Measured: before the hand-over waited for the phase fit, the 1 Hz loop slipped again
+        // 0.5 s after each of three recoveries.
+        assert_eq!(ch.recoveries(), 1);
+        assert!(longest_unlocked_track(&eps) < 1.1);
+        let end = eps.last().copied().expect("report");
+        assert_eq!((end.1, end.2), (ChannelState::Track, true), "{end:?}");
+        assert!((end.3 - (DOPPLER_HZ + 5.0)).abs() < 0.5, "{end:?}");
+    }
+
     /// Without the signal (and with the C/N0 loss switched off) the recovery cannot lock:
     /// the channel is released `recover_s` after it started, and reports `Lost`.
     #[test]
@@ -226,6 +282,7 @@ mod tests {
             step_s: f64::INFINITY,
             step_hz: 0.0,
             off_s: 2.0,
+            cn0_dbhz: 45.0,
             rng: SimRng::new(5),
         };
         let cfg = ChannelConfig {
