@@ -412,8 +412,10 @@ pub struct Channel {
     /// The feed-forward's phase accumulated up to the start of the interval being summed,
     /// cycles.
     ff_phase_cycles: f64,
-    /// The aid came or went at the last loop update: the phase fit starts again.
-    aid_switched: bool,
+    /// The aid came (or went) at the last loop update: the feed-forward trajectory
+    /// `(t_c, f, rate)` (negated when it went) the phase fit's samples are to be measured
+    /// against from then on ([`QuadraticPhaseFit::subtract_trajectory`]).
+    aid_switched: Option<(f64, f64, f64)>,
     /// The stage of a weak-signal pull-in (`None`: the normal pull-in, or after the hand-over).
     weak_stage: Option<WeakStage>,
     /// The weak pull-in's C/N0 estimator before bit synchronisation (NWPR over unaligned
@@ -491,7 +493,7 @@ impl Channel {
             rate_fit: [0.0; 5],
             phase_fit: QuadraticPhaseFit::new(),
             ff_phase_cycles: 0.0,
-            aid_switched: false,
+            aid_switched: None,
             pending_bit: None,
             weak_stage: weak_pull_in.map(|_| WeakStage::Frequency),
             presync_cn0: SmoothedNwpr::new(
@@ -649,6 +651,13 @@ impl Channel {
         let (co, cl) = self.update_loops();
         self.feed_phase_fit(co.phase_error_cycles);
         let epoch = self.build_epoch(ms_index, timing, &co, &cl, bit);
+        if std::env::var("GPSRX_DBG_PRN")
+            .ok()
+            .and_then(|v| v.parse::<u8>().ok())
+            == Some(self.prn.get())
+        {
+            eprintln!("DBG {} {:?} ff {:?} fit {:?} bw {} ord {} t {} pe {:.4} nco {:.4} fmem {:.4} rate {:?} c2p {:.3} lock {}", ms_index, self.state, self.ff_applied_hz, self.phase_fit.estimate(self.next_sample as f64 / self.fs_hz).map(|e| (e.freq_hz, e.freq_sigma_hz, e.rate_hz_s, e.rate_sigma_hz_s, e.end_residual_cycles)), self.carrier.config().pll_bw_hz, self.carrier.config().pll_order, self.carrier.t_coh_s(), co.phase_error_cycles, co.nco_freq_hz, self.carrier.frequency_memory_hz(), self.carrier.filter().rate_memory(), self.pll_lock.cos_2phi(), self.pll_lock.locked());
+        }
         self.watch_carrier_lock(self.acc_ms as u64);
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
@@ -865,13 +874,18 @@ impl Channel {
         let ff_rate = self.aid.map_or(0.0, |(a, _)| a.doppler_rate_hz_s);
         match (self.ff_applied_hz, ff_opt) {
             (None, Some(f)) => {
-                self.aid_switched = true;
+                // The feed-forward's phase is counted from the next interval's first sample: the
+                // phase fit's earlier samples move onto it with the same origin (an origin off
+                // by dt would put them f dt cycles off the later ones).
+                let t_c = self.next_sample as f64 / self.fs_hz;
+                self.aid_switched = Some((t_c, f, ff_rate));
                 self.carrier.shift_base_hz(-f);
                 self.carrier.shift_doppler_rate(-ff_rate);
                 self.ff_rate_applied_hz_s = ff_rate;
             }
             (Some(f), None) => {
-                self.aid_switched = true;
+                let t_c = self.next_sample as f64 / self.fs_hz;
+                self.aid_switched = Some((t_c, -f, -self.ff_rate_applied_hz_s));
                 self.carrier.shift_base_hz(f);
                 self.carrier.shift_doppler_rate(self.ff_rate_applied_hz_s);
                 self.ff_rate_applied_hz_s = 0.0;
@@ -983,7 +997,7 @@ impl Channel {
         self.carrier = carrier;
         let [n, st, sf, stt, stf] = self.rate_fit;
         let den = n * stt - st * st;
-        if !from_fit && n >= 100.0 && den > 0.0 {
+        if !from_fit && !self.phase_fit_started() && n >= 100.0 && den > 0.0 {
             self.carrier.preset_doppler_rate((n * stf - st * sf) / den);
         }
         self.code_loop = code_loop;

@@ -127,6 +127,43 @@ impl QuadraticPhaseFit {
         self.recent.push_back((tau, u));
     }
 
+    /// Subtracts the phase trajectory `g(t) = f (t - t_c) + r (t - t_c)^2 / 2` (cycles; `f` in
+    /// Hz, `r` in Hz/s) from every sample taken so far, as if it had been measured against
+    /// it: when a feed-forward of this frequency and rate starts at `t_c` (or, with `-f` and
+    /// `-r`, stops), the samples before and after describe the same residual phase and the
+    /// fit carries on. Exact on the sums: with `g = g0 + g1 tau + h tau^2`,
+    /// `sum tau^k (u - g) = sum tau^k u - g0 S_k - g1 S_{k+1} - h S_{k+2}` and
+    /// `sum (u - g)^2 = sum u^2 - 2 sum u g + sum g^2`.
+    pub fn subtract_trajectory(&mut self, t_c: f64, f_hz: f64, rate_hz_s: f64) {
+        let Some((t0, _, _)) = self.origin else {
+            return;
+        };
+        if !(t_c.is_finite() && f_hz.is_finite() && rate_hz_s.is_finite()) {
+            self.reset();
+            return;
+        }
+        let d = t0 - t_c;
+        let (g0, g1, h) = (
+            f_hz * d + 0.5 * rate_hz_s * d * d,
+            f_hz + rate_hz_s * d,
+            0.5 * rate_hz_s,
+        );
+        let s = self.st;
+        let sum_ug = g0 * self.sy[0] + g1 * self.sy[1] + h * self.sy[2];
+        let sum_gg = g0 * g0 * s[0]
+            + 2.0 * g0 * g1 * s[1]
+            + (g1 * g1 + 2.0 * g0 * h) * s[2]
+            + 2.0 * g1 * h * s[3]
+            + h * h * s[4];
+        self.syy += sum_gg - 2.0 * sum_ug;
+        for k in 0..3 {
+            self.sy[k] -= g0 * s[k] + g1 * s[k + 1] + h * s[k + 2];
+        }
+        for (tau, u) in &mut self.recent {
+            *u -= g0 + g1 * *tau + h * *tau * *tau;
+        }
+    }
+
     /// Time span from the first sample to `t_s`, s (0 when empty).
     pub fn span_s(&self, t_s: f64) -> f64 {
         self.origin.map_or(0.0, |(t0, _, _)| t_s - t0)
@@ -283,6 +320,55 @@ mod tests {
         }
         let e = fit.estimate(3.0).unwrap_or_else(|| panic!("estimate"));
         assert!(e.end_residual_cycles.abs() < 0.025, "{e:?}");
+    }
+
+    /// Subtracting a trajectory from the sums equals fitting the samples measured against it:
+    /// a feed-forward that starts mid-window leaves the fit's frequency and rate those of the
+    /// residual.
+    #[test]
+    fn a_feedforward_starting_mid_window_keeps_the_fit() {
+        let mut rng = SimRng::new(9);
+        let (f, r) = (2443.97, -0.0856);
+        let theta = |t: f64| 17.0 + f * t + 0.5 * r * t * t;
+        // The feed-forward (an INS with a 0.05 Hz, 0.01 Hz/s error) from t_c = 1.5 s on.
+        let (t_c, ff, ffr) = (1.5, f + r * 1.5 - 0.05, r - 0.01);
+        let ff_phase = |t: f64| ff * (t - t_c) + 0.5 * ffr * (t - t_c) * (t - t_c);
+        let mut fit = QuadraticPhaseFit::new();
+        let mut direct = QuadraticPhaseFit::new();
+        for k in 0..3000 {
+            let t = k as f64 * 1e-3;
+            let n = 0.05 * rng.gauss();
+            if t < t_c {
+                fit.push(t, theta(t) + n, f);
+            } else {
+                if k == 1500 {
+                    fit.subtract_trajectory(t_c, ff, ffr);
+                }
+                fit.push(t, theta(t) - ff_phase(t) + n, 0.0);
+            }
+            direct.push(t, theta(t) - ff_phase(t) + n, 0.0);
+        }
+        let (a, b) = (fit.estimate(3.0), direct.estimate(3.0));
+        let (a, b) = (
+            a.unwrap_or_else(|| panic!("fit")),
+            b.unwrap_or_else(|| panic!("fit")),
+        );
+        let want_f = (f + r * 3.0) - (ff + ffr * (3.0 - t_c));
+        assert!(
+            (a.freq_hz - want_f).abs() < 4.0 * a.freq_sigma_hz,
+            "{a:?} want {want_f}"
+        );
+        assert!(
+            (a.rate_hz_s - 0.01).abs() < 4.0 * a.rate_sigma_hz_s,
+            "{a:?}"
+        );
+        assert!((a.freq_hz - b.freq_hz).abs() < 1e-6, "{a:?} {b:?}");
+        assert!((a.rate_hz_s - b.rate_hz_s).abs() < 1e-6, "{a:?} {b:?}");
+        assert!(
+            (a.rate_sigma_hz_s / b.rate_sigma_hz_s - 1.0).abs() < 1e-3,
+            "{a:?} {b:?}"
+        );
+        assert!((a.end_residual_cycles - b.end_residual_cycles).abs() < 1e-6);
     }
 
     #[test]

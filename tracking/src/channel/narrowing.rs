@@ -22,17 +22,17 @@
 //! then ran to a quarter cycle: the Costas loop slipped and stayed 0.3-0.7 Hz off.
 //!
 //! So every stage (and the hand-over from pull-in) starts from the open-loop least-squares fit
-//! of the tracked carrier phase since the pull-in's FLL assist went off
-//! ([`QuadraticPhaseFit`]) whenever the fit's own 1-sigma errors cost the new loop less than
-//! [`FIT_TOLERANCE_CYCLES`] (`sigma_f / w0 + sigma_r / w0^2`) and its latest samples show no
-//! slip ([`MAX_END_RESIDUAL_CYCLES`]); otherwise (a short or disturbed window) from the
-//! running loop's memories as before.
+//! of the carrier phase tracked since the phase locked
+//! ([`crate::phase_fit::QuadraticPhaseFit`]): its frequency when its 1-sigma error costs the
+//! new loop less than [`FIT_TOLERANCE_CYCLES`] (`sigma_f / w0`), its rate likewise
+//! (`sigma_r / w0^2`), provided its latest samples show no slip
+//! ([`MAX_END_RESIDUAL_CYCLES`]); otherwise (a short or disturbed window) from the running
+//! loop's memories as before.
 
 use super::{Channel, ChannelState};
 use crate::carrier_loop::CarrierLoop;
 use crate::config::LoopConfig;
 use crate::loop_filter::omega0;
-use crate::phase_fit::PhaseFitEstimate;
 
 /// Bandwidth ratio between consecutive stages; a target narrower than the running loop by more
 /// than this is reached in stages.
@@ -41,7 +41,7 @@ pub const NARROW_RATIO: f64 = 2.0;
 /// `1 / w0` of a 3rd-order loop).
 pub const STAGE_BN_S: f64 = 2.0;
 /// Largest phase excursion (cycles) the 1-sigma errors of the phase fit may cost a loop
-/// started from it (`sigma_f / w0 + sigma_r / w0^2`): 3 sigma within 1/8 cycle (45 deg, the
+/// started from it (`sigma_f / w0` and `sigma_r / w0^2`, each): 3 sigma within 1/8 cycle (45 deg, the
 /// rule of thumb for a Costas PLL whose discriminator folds at 90 deg).
 pub const FIT_TOLERANCE_CYCLES: f64 = 0.125 / 3.0;
 /// Largest mean residual of the phase fit's latest samples, cycles: a Costas slip in the
@@ -115,27 +115,46 @@ impl Channel {
     /// ([`CarrierLoop::retuned`]). The flag says which.
     fn retune(&self, stage: &LoopConfig) -> Option<(CarrierLoop, bool)> {
         let mut next = self.carrier.retuned(stage).ok()?;
-        let Some(fit) = self.usable_fit(stage) else {
-            return Some((next, false));
-        };
-        next.shift_base_hz(fit.freq_hz - next.frequency_memory_hz());
-        next.preset_doppler_rate(fit.rate_hz_s);
-        Some((next, true))
+        let (freq, rate) = self.usable_fit(stage);
+        if let Some(f) = freq {
+            next.shift_base_hz(f - next.frequency_memory_hz());
+        }
+        if let Some(r) = rate {
+            next.preset_doppler_rate(r);
+        }
+        Some((next, rate.is_some()))
     }
 
-    /// The phase fit's estimate at the middle of the next interval, if a loop `stage` may
-    /// start from it: its 1-sigma errors cost that loop at most [`FIT_TOLERANCE_CYCLES`] and
-    /// its latest samples show no slip ([`MAX_END_RESIDUAL_CYCLES`]).
-    fn usable_fit(&self, stage: &LoopConfig) -> Option<PhaseFitEstimate> {
+    /// The phase fit's frequency and rate at the middle of the next interval, each if a loop
+    /// `stage` may start from it: its 1-sigma error costs that loop at most
+    /// [`FIT_TOLERANCE_CYCLES`] (`sigma_f / w0`, `sigma_r / w0^2`), and the latest samples
+    /// show no slip ([`MAX_END_RESIDUAL_CYCLES`]). The two are judged apart: a short window
+    /// gives a usable frequency long before a usable rate.
+    fn usable_fit(&self, stage: &LoopConfig) -> (Option<f64>, Option<f64>) {
         if stage.pll_order == 0 {
-            return None;
+            return (None, None);
         }
         let t_s = self.next_sample as f64 / self.fs_hz + 0.5 * stage.t_coh_s;
         let w0 = omega0(stage.pll_order, stage.pll_bw_hz);
-        self.phase_fit.estimate(t_s).filter(|fit| {
-            fit.phase_cost_cycles(w0) <= FIT_TOLERANCE_CYCLES
-                && fit.end_residual_cycles.abs() <= MAX_END_RESIDUAL_CYCLES
-        })
+        let Some(fit) = self
+            .phase_fit
+            .estimate(t_s)
+            .filter(|fit| fit.end_residual_cycles.abs() <= MAX_END_RESIDUAL_CYCLES)
+        else {
+            return (None, None);
+        };
+        let freq = (fit.freq_sigma_hz / w0 <= FIT_TOLERANCE_CYCLES).then_some(fit.freq_hz);
+        let rate =
+            (fit.rate_sigma_hz_s / (w0 * w0) <= FIT_TOLERANCE_CYCLES).then_some(fit.rate_hz_s);
+        (freq, rate)
+    }
+
+    /// Whether the phase fit has samples (the phase has been locked since its last reset):
+    /// the pull-in's NCO-frequency rate fit is then not used, usable fit or not (it spans the
+    /// unlocked part of the pull-in too: +8.4 Hz/s against a true -0.09 Hz/s at 34 dB-Hz,
+    /// measured, which a 7.5 Hz stage turned into a 1.4 Hz frequency error).
+    pub(super) fn phase_fit_started(&self) -> bool {
+        !self.phase_fit.is_empty()
     }
 
     /// Whether a recovering channel may hand over to `target` loops: at once for loops without
@@ -154,7 +173,8 @@ impl Channel {
             running.fll_bw_hz
         };
         let (stage, _) = next_stage(bw, target, self.ms_count);
-        self.usable_fit(&stage).is_some()
+        let (freq, rate) = self.usable_fit(&stage);
+        freq.is_some() && rate.is_some()
     }
 
     /// Adds the interval just closed to the phase fit: at its middle time, the NCO's mean
@@ -162,7 +182,8 @@ impl Channel {
     /// `phase_error_cycles`. Fed while the phase-lock indicator says locked (in pull-in,
     /// recovery and tracking; not in a weak pull-in's frequency stage, whose sums are not
     /// aligned); the fit starts again when the lock indicator is out (a slip would corrupt
-    /// it), when the aid comes or goes, and after [`MAX_FIT_WINDOW_S`].
+    /// it) and after [`MAX_FIT_WINDOW_S`]; when the aid comes or goes its samples are moved
+    /// onto the new reference ([`crate::phase_fit::QuadraticPhaseFit::subtract_trajectory`]).
     pub(super) fn feed_phase_fit(&mut self, phase_error_cycles: f64) {
         let (s0, _, ph0, _) = self.acc_start;
         let dur_s = (self.next_sample.saturating_sub(s0)) as f64 / self.fs_hz;
@@ -184,9 +205,8 @@ impl Channel {
                 self.carrier_freq_hz - self.ff_applied_hz.unwrap_or(0.0),
             );
         }
-        if self.aid_switched {
-            self.aid_switched = false;
-            self.phase_fit.reset();
+        if let Some((t_c, f, rate)) = self.aid_switched.take() {
+            self.phase_fit.subtract_trajectory(t_c, f, rate);
         }
     }
 
