@@ -651,13 +651,6 @@ impl Channel {
         let (co, cl) = self.update_loops();
         self.feed_phase_fit(co.phase_error_cycles);
         let epoch = self.build_epoch(ms_index, timing, &co, &cl, bit);
-        if std::env::var("GPSRX_DBG_PRN")
-            .ok()
-            .and_then(|v| v.parse::<u8>().ok())
-            == Some(self.prn.get())
-        {
-            eprintln!("DBG {} {:?} ff {:?} fit {:?} bw {} ord {} t {} pe {:.4} nco {:.4} fmem {:.4} rate {:?} c2p {:.3} lock {}", ms_index, self.state, self.ff_applied_hz, self.phase_fit.estimate(self.next_sample as f64 / self.fs_hz).map(|e| (e.freq_hz, e.freq_sigma_hz, e.rate_hz_s, e.rate_sigma_hz_s, e.end_residual_cycles)), self.carrier.config().pll_bw_hz, self.carrier.config().pll_order, self.carrier.t_coh_s(), co.phase_error_cycles, co.nco_freq_hz, self.carrier.frequency_memory_hz(), self.carrier.filter().rate_memory(), self.pll_lock.cos_2phi(), self.pll_lock.locked());
-        }
         self.watch_carrier_lock(self.acc_ms as u64);
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
