@@ -171,6 +171,7 @@ mod tests {
     fn narrow_config() -> ChannelConfig {
         let base = ChannelConfig::default();
         ChannelConfig {
+            relock_after_s: 1.0,
             track: LoopConfig {
                 pll_order: 3,
                 pll_bw_hz: 1.0,
@@ -191,9 +192,9 @@ mod tests {
 
     /// A 3rd-order 1 Hz loop hit by a 5 Hz Doppler step (4 cycles of phase against its
     /// `w0` = 1.27 rad/s) slips and stays off; the channel goes to recovery after 1 s without
-    /// lock, the FLL-assisted pull-in finds the new frequency, and it tracks locked again at
-    /// the new Doppler. It is never in tracking without lock for more than about
-    /// `relock_after_s`.
+    /// lock (`relock_after_s` = 1 s here), the FLL-assisted pull-in finds the new frequency,
+    /// and it tracks locked again at the new Doppler. It is never in tracking without lock
+    /// for more than about `relock_after_s`.
     #[test]
     fn a_slipped_narrow_loop_is_pulled_in_again() {
         let mut sig = Signal {
@@ -287,6 +288,7 @@ mod tests {
         };
         let cfg = ChannelConfig {
             cn0_lost_dbhz: -100.0,
+            relock_after_s: 1.0,
             ..ChannelConfig::default()
         };
         let mut ch = Channel::new(&start(), FS, &cfg).expect("channel");
