@@ -50,14 +50,6 @@ pub struct PhaseFitEstimate {
     pub end_residual_cycles: f64,
 }
 
-impl PhaseFitEstimate {
-    /// The phase excursion (cycles) the estimate's 1-sigma errors cost a loop of natural
-    /// frequency `w0_rad_s`: `sigma_f / w0 + sigma_r / w0^2` (module documentation).
-    pub fn phase_cost_cycles(&self, w0_rad_s: f64) -> f64 {
-        self.freq_sigma_hz / w0_rad_s + self.rate_sigma_hz_s / (w0_rad_s * w0_rad_s)
-    }
-}
-
 /// Running sums of a least-squares fit `y = a + f tau + r tau^2 / 2` of phase samples `y`
 /// (cycles) at times `tau` (s) from the first sample; the phase is taken relative to the
 /// first sample's phase and frequency guess to keep the sums well conditioned.

@@ -44,11 +44,9 @@ impl Channel {
                     self.start_recovery();
                 }
             }
-            ChannelState::Recover => {
-                if self.pull_in_ms as f64 >= self.cfg.recover_s * 1e3 {
-                    // Reported as lost with the next interval (as a release from outside).
-                    self.release_requested = true;
-                }
+            // Reported as lost with the next interval (as a release from outside).
+            ChannelState::Recover if self.pull_in_ms as f64 >= self.cfg.recover_s * 1e3 => {
+                self.release_requested = true;
             }
             _ => {}
         }
@@ -62,7 +60,7 @@ impl Channel {
         let weak = self
             .cfg
             .weak_pull_in
-            .filter(|w| !(self.cn0_dbhz >= w.enter_dbhz));
+            .filter(|w| self.cn0_dbhz.is_nan() || self.cn0_dbhz < w.enter_dbhz);
         if let Some(w) = weak {
             // The frequency stage's 10 ms sums need no alignment; the stage hands over to the
             // bit-aligned phase stage at the next bit edge ([`Channel::weak_pull_in_step`]).
