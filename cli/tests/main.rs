@@ -11,6 +11,7 @@ mod bench;
 mod dating;
 mod dr_run;
 mod ins_simulate;
+mod narrow_loops;
 mod outputs;
 mod run;
 mod snapshot;

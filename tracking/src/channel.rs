@@ -26,6 +26,7 @@ use crate::config::{ConfigError, LoopConfig};
 use crate::correlator_choice::{CorrelatorArithmetic, CorrelatorIsa};
 use crate::fade_detector::FadeDetector;
 use crate::lock_detector::{CodeLockDetector, PllLockConfig, PllLockDetector};
+use crate::phase_fit::QuadraticPhaseFit;
 use gpsrx_dsp::acquisition::AcqResult;
 use gpsrx_dsp::ca_code::{CaCode, Prn};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, CA_CODE_LENGTH, F_L1_HZ};
@@ -35,6 +36,7 @@ use serde::{Deserialize, Serialize};
 
 mod narrowing;
 mod realign;
+mod recover;
 mod weak_pull_in;
 pub use realign::CodeShift;
 use weak_pull_in::WeakStage;
@@ -57,7 +59,8 @@ pub struct ChannelConfig {
     /// below `weak_enter_dbhz`, left when it climbs above `weak_leave_dbhz` (switches at a
     /// data-bit edge). Longer integration and narrower loops hold weaker signals (phase jitter
     /// `sqrt(Bn/(C/N0) (1 + 1/(2 T C/N0)))`) but follow less dynamics, so the default `track`
-    /// loops can stay wide enough for 10 g. An aided channel runs `aided_track` instead.
+    /// loops can stay wide enough for 10 g. An aided channel runs `aided_track` instead, with
+    /// these loops' integration time while weak (when its bandwidth allows it).
     pub weak_track: Option<LoopConfig>,
     /// C/N0 below which the channel takes the `weak_track` loops, dB-Hz.
     pub weak_enter_dbhz: f64,
@@ -76,6 +79,12 @@ pub struct ChannelConfig {
     pub cn0_window_s: f64,
     /// How many consecutive C/N0 estimates below the threshold release the channel.
     pub lost_estimates: u32,
+    /// Time without phase lock after which a tracking channel goes back through a pull-in of
+    /// its carrier ([`ChannelState::Recover`]), s (0: never; it then stays in tracking until
+    /// its C/N0 is lost).
+    pub relock_after_s: f64,
+    /// Longest recovery before the channel is released and the satellite searched again, s.
+    pub recover_s: f64,
     /// The weak-signal pull-in (`None`: every channel takes the `pull_in` loops): a channel
     /// whose acquisition C/N0 is below [`WeakPullInConfig::enter_dbhz`] pulls in with an FLL on
     /// 10 ms sums, differential bit synchronisation and a bit-aligned 20 ms PLL instead, then
@@ -133,6 +142,13 @@ impl Default for ChannelConfig {
             cn0_lost_dbhz: 25.0,
             cn0_window_s: 0.2,
             lost_estimates: 5,
+            // A slipped narrow loop does not come back by itself (issue 25): after 2 s out of
+            // lock, pull in again (a normal pull-in locks within 0.5-1 s, a weak one within a
+            // few seconds). Not sooner: the 20 ms weak loops at 30 dB-Hz drop out of lock for
+            // up to 1.5 s and come back by themselves (measured on the simulator, 60 s static:
+            // with 1 s, two recoveries cost G16 3 % of its locked time).
+            relock_after_s: 2.0,
+            recover_s: 5.0,
             weak_pull_in: Some(WeakPullInConfig::default()),
             correlator: CorrelatorIsa::Auto,
             correlator_arithmetic: CorrelatorArithmetic::Auto,
@@ -196,6 +212,18 @@ impl ChannelConfig {
                 ),
             });
         }
+        for (field, value) in [
+            ("relock_after_s", self.relock_after_s),
+            ("recover_s", self.recover_s),
+        ] {
+            if !(value.is_finite() && (0.0..=600.0).contains(&value)) {
+                return Err(ConfigError::OutOfRange {
+                    field,
+                    value,
+                    valid: "0 to 600 s".into(),
+                });
+            }
+        }
         if !self.cn0_lost_dbhz.is_finite() {
             return Err(ConfigError::OutOfRange {
                 field: "cn0_lost_dbhz",
@@ -216,6 +244,11 @@ pub enum ChannelState {
     PullIn,
     /// The user's loops, integrations aligned to data bits.
     Track,
+    /// Carrier lock lost in tracking for [`ChannelConfig::relock_after_s`]: code-only
+    /// tracking while the carrier is pulled in again (the pull-in loops, or the weak
+    /// pull-in's phase stage); back to [`ChannelState::Track`] on phase lock, released after
+    /// [`ChannelConfig::recover_s`]. Its measurements are not used.
+    Recover,
     /// Signal lost: release the channel.
     Lost,
 }
@@ -358,6 +391,10 @@ pub struct Channel {
     /// The carrier loop is being narrowed in stages to its tracking loops.
     narrowing: Option<narrowing::Narrowing>,
     low_cn0_count: u32,
+    /// Time without phase lock in tracking, ms.
+    unlocked_ms: u64,
+    /// Recoveries from a loss of carrier lock so far.
+    recoveries: u32,
     /// Accumulators of the current interval: E, P, L. The early replica leads the prompt by
     /// d/2 chip (its code phase is `c + d/2`), the late one lags it.
     acc: [Complex64; 3],
@@ -371,6 +408,17 @@ pub struct Channel {
     /// A completed bit and the `ms_count` of its first code period, waiting for the end of the
     /// integration interval.
     pending_bit: Option<(Bit, u64)>,
+    /// The least-squares fit of the carrier phase the loop tracks (NCO phase less the
+    /// feed-forward's, plus the discriminator output): the frequency and Doppler rate a
+    /// narrowed loop starts from ([`crate::phase_fit`]).
+    phase_fit: QuadraticPhaseFit,
+    /// The feed-forward's phase accumulated up to the start of the interval being summed,
+    /// cycles.
+    ff_phase_cycles: f64,
+    /// The aid came (or went) at the last loop update: the feed-forward trajectory
+    /// `(t_c, f, rate)` (negated when it went) the phase fit's samples are to be measured
+    /// against from then on ([`QuadraticPhaseFit::subtract_trajectory`]).
+    aid_switched: Option<(f64, f64, f64)>,
     /// The stage of a weak-signal pull-in (`None`: the normal pull-in, or after the hand-over).
     weak_stage: Option<WeakStage>,
     /// The weak pull-in's C/N0 estimator before bit synchronisation (NWPR over unaligned
@@ -439,11 +487,16 @@ impl Channel {
             release_requested: false,
             narrowing: None,
             low_cn0_count: 0,
+            unlocked_ms: 0,
+            recoveries: 0,
             acc: [Complex64::new(0.0, 0.0); 3],
             acc_ms: 0,
             acc_start: (start.code_start_sample, 0.0, 0.0, 0.0),
             taps: [d / 2.0, 0.0, -d / 2.0],
             rate_fit: [0.0; 5],
+            phase_fit: QuadraticPhaseFit::new(),
+            ff_phase_cycles: 0.0,
+            aid_switched: None,
             pending_bit: None,
             weak_stage: weak_pull_in.map(|_| WeakStage::Frequency),
             presync_cn0: SmoothedNwpr::new(
@@ -453,6 +506,12 @@ impl Channel {
                 cn0_window_blocks,
             ),
         })
+    }
+
+    /// Whether the carrier is being pulled in: after acquisition ([`ChannelState::PullIn`])
+    /// or after a loss of lock ([`ChannelState::Recover`]).
+    fn pulling_in(&self) -> bool {
+        matches!(self.state, ChannelState::PullIn | ChannelState::Recover)
     }
 
     /// The satellite.
@@ -529,6 +588,7 @@ impl Channel {
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
         self.carrier.reset_history();
+        self.phase_fit.reset();
         self.bit_sync.reset();
         self.bit_sync_origin_ms = self.ms_count;
         self.weak_restart_frequency_stage();
@@ -581,7 +641,7 @@ impl Channel {
         let (p, t_start_s, ms_index) = self.correlate_period(samples);
         let timing = self.update_bit_sync(p, t_start_s, ms_index);
         self.update_detectors(p, timing.next_is_edge);
-        if self.state == ChannelState::PullIn && self.weak_pull_in_step(timing.next_is_edge) {
+        if self.pulling_in() && self.weak_pull_in_step(timing.next_is_edge) {
             return None;
         }
         if !self.interval_complete(ms_index, timing) {
@@ -592,7 +652,9 @@ impl Channel {
         }
         let bit = self.pending_bit.take();
         let (co, cl) = self.update_loops();
+        self.feed_phase_fit(co.phase_error_cycles);
         let epoch = self.build_epoch(ms_index, timing, &co, &cl, bit);
+        self.watch_carrier_lock(self.acc_ms as u64);
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
         self.maybe_hand_over(timing.next_is_edge);
@@ -641,7 +703,7 @@ impl Channel {
         self.advance(samples.len());
         let ms_index = self.ms_count;
         self.ms_count += 1;
-        if self.state == ChannelState::PullIn {
+        if self.pulling_in() {
             self.pull_in_ms += 1;
             // (A weak pull-in switches its own assist: [`Channel::weak_pull_in_step`].)
             if self.pull_in_ms == (self.cfg.fll_assist_s * 1e3).round() as u64
@@ -808,11 +870,18 @@ impl Channel {
         let ff_rate = self.aid.map_or(0.0, |(a, _)| a.doppler_rate_hz_s);
         match (self.ff_applied_hz, ff_opt) {
             (None, Some(f)) => {
+                // The feed-forward's phase is counted from the next interval's first sample: the
+                // phase fit's earlier samples move onto it with the same origin (an origin off
+                // by dt would put them f dt cycles off the later ones).
+                let t_c = self.next_sample as f64 / self.fs_hz;
+                self.aid_switched = Some((t_c, f, ff_rate));
                 self.carrier.shift_base_hz(-f);
                 self.carrier.shift_doppler_rate(-ff_rate);
                 self.ff_rate_applied_hz_s = ff_rate;
             }
             (Some(f), None) => {
+                let t_c = self.next_sample as f64 / self.fs_hz;
+                self.aid_switched = Some((t_c, -f, -self.ff_rate_applied_hz_s));
                 self.carrier.shift_base_hz(f);
                 self.carrier.shift_doppler_rate(self.ff_rate_applied_hz_s);
                 self.ff_rate_applied_hz_s = 0.0;
@@ -839,7 +908,7 @@ impl Channel {
     /// 3rd-order tracking loop at the hand-over ([`Channel::maybe_hand_over`]).
     #[inline]
     fn accumulate_rate_fit(&mut self, nco_freq_hz: f64, ff: f64) {
-        if self.state == ChannelState::PullIn
+        if self.pulling_in()
             && self.weak_stage.is_none()
             && self.pull_in_ms > (self.cfg.fll_assist_s * 1e3) as u64
         {
@@ -903,24 +972,28 @@ impl Channel {
     /// pull-in time has passed; the switch happens on a bit edge so that the longer
     /// integrations are aligned with the data bits.
     fn maybe_hand_over(&mut self, at_edge: bool) {
-        if self.state != ChannelState::PullIn || !at_edge {
+        if !self.pulling_in() || !at_edge {
             return;
         }
         let min_ms = (self.cfg.min_pull_in_s * 1e3) as u64;
         if self.pull_in_ms < min_ms || !self.pll_lock.locked() || !self.weak_ready_for_hand_over() {
             return;
         }
-        self.weak_stage = None;
         let which = self.wanted_loops();
         let loops = self.loop_config(which);
-        let (Some(carrier), Ok(code_loop)) = (self.carrier_toward(&loops), CodeLoop::new(&loops))
+        if self.state == ChannelState::Recover && !self.recovery_ready(&loops) {
+            return;
+        }
+        self.weak_stage = None;
+        let (Some((carrier, from_fit)), Ok(code_loop)) =
+            (self.carrier_toward(&loops), CodeLoop::new(&loops))
         else {
             return; // validated at construction; keep pulling in otherwise
         };
         self.carrier = carrier;
         let [n, st, sf, stt, stf] = self.rate_fit;
         let den = n * stt - st * st;
-        if n >= 100.0 && den > 0.0 {
+        if !from_fit && !self.phase_fit_started() && n >= 100.0 && den > 0.0 {
             self.carrier.preset_doppler_rate((n * stf - st * sf) / den);
         }
         self.code_loop = code_loop;
@@ -936,7 +1009,11 @@ impl Channel {
     /// configured), else the normal ones.
     fn wanted_loops(&self) -> TrackLoops {
         if self.ff_applied_hz.is_some() && self.cfg.aided_track.is_some() {
-            TrackLoops::Aided
+            if self.weak && self.aided_weak_config().is_some() {
+                TrackLoops::AidedWeak
+            } else {
+                TrackLoops::Aided
+            }
         } else if self.weak && self.cfg.weak_track.is_some() {
             TrackLoops::Weak
         } else {
@@ -944,9 +1021,25 @@ impl Channel {
         }
     }
 
+    /// The aided loops with the weak-signal loops' integration time (`None` without both, or
+    /// when the aided bandwidth is too wide for it). Issue 25: an aided loop at 1 ms on a
+    /// satellite at 30 dB-Hz runs its Costas discriminator at 0 dB SNR per update, where it
+    /// slips whatever the bandwidth (measured: G16 at 30.3 dB-Hz lost lock for 5 s in the
+    /// 0.4 Hz aided staging); at 20 ms the SNR is 13 dB. The feed-forward has taken the
+    /// dynamics out, so the longer integration costs nothing in a turn.
+    fn aided_weak_config(&self) -> Option<LoopConfig> {
+        let (aided, weak) = (self.cfg.aided_track?, self.cfg.weak_track?);
+        let cfg = LoopConfig {
+            t_coh_s: weak.t_coh_s,
+            ..aided
+        };
+        cfg.validate().ok().map(|()| cfg)
+    }
+
     /// The configuration of `which` loops.
     fn loop_config(&self, which: TrackLoops) -> LoopConfig {
         match which {
+            TrackLoops::AidedWeak => self.aided_weak_config().or(self.cfg.aided_track),
             TrackLoops::Aided => self.cfg.aided_track,
             TrackLoops::Weak => self.cfg.weak_track,
             TrackLoops::Normal => None,
@@ -968,7 +1061,8 @@ impl Channel {
             return;
         }
         let loops = self.loop_config(which);
-        let (Some(carrier), Ok(code_loop)) = (self.carrier_toward(&loops), CodeLoop::new(&loops))
+        let (Some((carrier, _)), Ok(code_loop)) =
+            (self.carrier_toward(&loops), CodeLoop::new(&loops))
         else {
             return;
         };
@@ -988,7 +1082,7 @@ impl Channel {
 
     /// Whether the channel is running its aided tracking loops.
     pub fn aided_loops(&self) -> bool {
-        self.loops == TrackLoops::Aided
+        matches!(self.loops, TrackLoops::Aided | TrackLoops::AidedWeak)
     }
 
     /// Whether the channel is running its weak-signal tracking loops.
@@ -1004,6 +1098,9 @@ enum TrackLoops {
     Normal,
     /// [`ChannelConfig::aided_track`].
     Aided,
+    /// [`ChannelConfig::aided_track`] with the integration time of
+    /// [`ChannelConfig::weak_track`], while aided and weak.
+    AidedWeak,
     /// [`ChannelConfig::weak_track`].
     Weak,
 }

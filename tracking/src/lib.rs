@@ -15,6 +15,8 @@
 //! - [`cn0`]: NWPR and M2M4 C/N0 estimators.
 //! - [`fade_detector`]: a sudden collapse of the prompt power (blockage, sample gap).
 //! - [`bit_sync`]: histogram bit synchronisation and bit decisions.
+//! - [`phase_fit`]: a least-squares quadratic fit of the tracked carrier phase (open-loop
+//!   frequency and Doppler rate for a loop that is narrowed or restarted).
 //! - [`phase_sim`]: a phase-domain closed-loop simulator (correlator-level prompts) for studies.
 //!
 //! Measured closed-loop behaviour (noise bandwidth, stability limits, dynamic and thermal errors,
@@ -33,6 +35,7 @@ pub mod fade_detector;
 pub mod lock_detector;
 pub mod loop_analysis;
 pub mod loop_filter;
+pub mod phase_fit;
 pub mod phase_sim;
 
 pub use aiding::{AidingPort, DopplerAid};

@@ -173,8 +173,18 @@ impl TransferFunction {
     }
 }
 
-/// Whether all roots of `a0 + a1 z^-1 + ... + an z^-n` lie strictly inside the unit circle
-/// (Schur-Cohn / Levinson step-down: all reflection coefficients of magnitude < 1).
+/// Whether all roots of `a0 + a1 z^-1 + ... + an z^-n` lie strictly inside the unit circle.
+///
+/// The bilinear map `w = (z - 1) / (z + 1)` takes the unit disc to the left half plane, so
+/// the test is Routh-Hurwitz on `Q(w) = sum_k a_k (1 - w)^k (1 + w)^(n-k)` (the polynomial
+/// times `(1 + w)^n`, with `z^-1 = (1 - w) / (1 + w)`): all first-column entries of its Routh
+/// array of one sign and none zero.
+///
+/// Why not Schur-Cohn on the `a_k` (as before, issue 25): a narrow loop's poles crowd
+/// `z = 1` (`1 - s_i T`, `|s_i T|` ~ 1e-4 for a 3rd-order 0.1 Hz loop at 1 ms), its reflection
+/// coefficients approach 1 with `1 - k^2` ~ 1e-12, and the recursion lost the sign: the stable
+/// 3rd-order loop at 0.1 Hz was refused as unstable. In `w` the same poles sit at `-s_i T / 2`,
+/// and the small low-order coefficients of `Q` keep their relative precision.
 pub fn polynomial_is_stable(coeffs: &[f64]) -> bool {
     if coeffs.iter().any(|c| !c.is_finite()) {
         return false;
@@ -184,23 +194,54 @@ pub fn polynomial_is_stable(coeffs: &[f64]) -> bool {
         return false;
     }
     let mut a: Vec<f64> = coeffs.iter().map(|c| c / scale).collect();
-    while a.len() > 1 && a.last().is_some_and(|c| c.abs() < 1e-13) {
+    while a.len() > 1 && a.last().is_some_and(|c| *c == 0.0) {
         a.pop(); // roots at z = 0
     }
-    let Some(&a0) = a.first() else { return false };
-    if a0.abs() < 1e-13 {
+    if a.first().is_none_or(|c| *c == 0.0) {
         return false; // a root at infinity
     }
-    let mut a: Vec<f64> = a.iter().map(|c| c / a0).collect();
-    while a.len() > 1 {
-        let m = a.len() - 1;
-        let k = a[m];
-        if k.abs() >= 1.0 {
+    let n = a.len() - 1;
+    // Q(w), ascending powers of w.
+    let mut q = vec![0.0; n + 1];
+    for (k, ak) in a.iter().enumerate() {
+        let mut term = vec![*ak];
+        for _ in 0..k {
+            term = poly_mul(&term, &[1.0, -1.0]);
+        }
+        for _ in 0..(n - k) {
+            term = poly_mul(&term, &[1.0, 1.0]);
+        }
+        for (qi, ti) in q.iter_mut().zip(&term) {
+            *qi += ti;
+        }
+    }
+    routh_hurwitz_stable(&q)
+}
+
+/// Routh-Hurwitz: whether every root of `q0 + q1 w + ... + qn w^n` has a negative real part
+/// (the first column of the Routh array has no zero and no sign change).
+fn routh_hurwitz_stable(q: &[f64]) -> bool {
+    let desc: Vec<f64> = q.iter().rev().copied().collect();
+    if desc.first().is_none_or(|c| *c == 0.0) {
+        return false; // degree dropped: a root of the z-polynomial at z = -1
+    }
+    let mut prev: Vec<f64> = desc.iter().step_by(2).copied().collect();
+    let mut cur: Vec<f64> = desc.iter().skip(1).step_by(2).copied().collect();
+    let sign = desc[0].signum();
+    for _ in 1..desc.len() {
+        let Some(&c0) = cur.first() else { return false };
+        if c0 == 0.0 || c0.signum() != sign {
             return false;
         }
-        let den = 1.0 - k * k;
-        let next: Vec<f64> = (0..m).map(|i| (a[i] - k * a[m - i]) / den).collect();
-        a = next;
+        let next: Vec<f64> = (0..prev.len().saturating_sub(1))
+            .map(|i| {
+                let p1 = prev.get(i + 1).copied().unwrap_or(0.0);
+                let c1 = cur.get(i + 1).copied().unwrap_or(0.0);
+                (c0 * p1 - prev[0] * c1) / c0
+            })
+            .collect();
+        prev = cur;
+        cur = next;
     }
     true
 }
@@ -276,7 +317,7 @@ mod tests {
     }
 
     #[test]
-    fn schur_cohn_on_known_roots() {
+    fn stability_test_on_known_roots() {
         // (1 - 0.5 z^-1)(1 + 0.9 z^-1): stable. (1 - 1.1 z^-1): unstable. (1 - z^-1): marginal.
         assert!(polynomial_is_stable(&poly_mul(&[1.0, -0.5], &[1.0, 0.9])));
         assert!(!polynomial_is_stable(&[1.0, -1.1]));
@@ -296,6 +337,19 @@ mod tests {
         ]));
         assert!(!polynomial_is_stable(&[]));
         assert!(!polynomial_is_stable(&[f64::NAN, 1.0]));
+    }
+
+    /// Issue 25: the 3rd-order loop at 0.1 Hz (and 0.05 Hz) is stable at 1 and 20 ms, as its
+    /// analog prototype is at any bandwidth (its poles `1 - s_i T`, `|s_i T|` <= 2e-3); the
+    /// Schur-Cohn test refused it. The known limits stay: unstable well beyond `Bn T` = 0.56.
+    #[test]
+    fn narrow_third_order_loops_are_stable() {
+        for (bn, t) in [(0.1, 1e-3), (0.05, 1e-3), (0.1, 20e-3), (0.4, 1e-3)] {
+            let f = LoopFilter::pll(3, bn).ok();
+            assert!(f.is_some_and(|f| is_stable(&f, t)), "{bn} Hz at {t} s");
+        }
+        let f = LoopFilter::pll(3, 0.7 / 1e-3).ok();
+        assert!(f.is_some_and(|f| !is_stable(&f, 1e-3)));
     }
 
     #[test]

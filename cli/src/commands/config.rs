@@ -58,6 +58,8 @@ pub fn default_toml() -> anyhow::Result<String> {
          cn0_lost_dbhz = {:?}      # C/N0 below which a channel counts as lost, dB-Hz\n\
          cn0_window_s = {:?}       # length of one C/N0 estimate (bit-aligned NWPR), s\n\
          lost_estimates = {}       # consecutive low estimates that release the channel\n\
+         relock_after_s = {:?}     # out of phase lock this long in tracking: pull the carrier in again (state recover), s (0: never)\n\
+         recover_s = {:?}          # a recovery not locked after this releases the channel (searched again), s\n\
          weak_enter_dbhz = {:?}    # below this C/N0 a channel takes [tracking.weak_track], dB-Hz (0: never)\n\
          weak_leave_dbhz = {:?}    # above this it goes back to [tracking.track], dB-Hz\n\
          correlator = \"{}\"       # widest correlator instruction set: auto, avx512, avx2 or scalar (--correlator)\n\
@@ -114,6 +116,8 @@ pub fn default_toml() -> anyhow::Result<String> {
         c.cn0_lost_dbhz,
         c.cn0_window_s,
         c.lost_estimates,
+        c.relock_after_s,
+        c.recover_s,
         c.weak_enter_dbhz,
         c.weak_leave_dbhz,
         enum_name(&c.correlator)?,

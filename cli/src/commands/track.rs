@@ -38,6 +38,7 @@ fn csv_row(e: &ChannelEpoch) -> String {
     let state = match e.state {
         ChannelState::PullIn => "pull_in",
         ChannelState::Track => "track",
+        ChannelState::Recover => "recover",
         ChannelState::Lost => "lost",
     };
     let (bit, bit_t) = match e.bit {

@@ -88,6 +88,7 @@ impl Channel {
         self.code_phase_chips = (next - new_start) * rate;
         self.acc = [Complex64::new(0.0, 0.0); 3];
         self.acc_ms = 0;
+        self.phase_fit.reset();
         self.low_cn0_count = 0;
         self.bit_sync.reset();
         self.bit_sync_origin_ms = self.ms_count;

@@ -281,7 +281,7 @@ impl Channel {
     }
 
     /// Carrier and code loops of `loops`, from the carrier loop's frequency memory.
-    fn set_weak_loops(&mut self, loops: &LoopConfig) {
+    pub(super) fn set_weak_loops(&mut self, loops: &LoopConfig) {
         if let (Ok(carrier), Ok(code_loop)) = (
             CarrierLoop::new(loops, self.carrier.frequency_memory_hz()),
             CodeLoop::new(loops),
