@@ -11,6 +11,7 @@
 #   weak       the weak-mix recording, with and without --nav [Finding satellites]
 #   faults     samples cut / zeroed in the GPS-SDR-SIM file    [Lost samples and outages]
 #   aided      the 5 g turn with an INS, aided and not         [INS aiding]
+#   loops      narrow 0.4 Hz loops: 10 g turns, the C/N0 ladder [Loss of carrier lock]
 #   dr         the drive with a 30 s outage, --dr --accel      [Dead reckoning]
 #   acquire    the real PocketSDR capture                      [gpsrx acquire]
 #   track      the demo recording through `gpsrx track`        [gpsrx track]
@@ -28,7 +29,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 WORK=${WORK:-$(mktemp -d)}
 SHARED=${SHARED:-$ROOT/../shared/data}
-ALL=(demo seoul hard weak faults aided dr acquire track jitter studies bench vs-gnss-sdr scaling)
+ALL=(demo seoul hard weak faults aided loops dr acquire track jitter studies bench vs-gnss-sdr scaling)
 die() { echo "readme-figures: $*" >&2; exit 1; }
 
 if [[ ${1:-} == --list ]]; then printf '%s\n' "${ALL[@]}"; exit 0; fi
@@ -150,6 +151,26 @@ section_aided() {
         echo "-- the turn (40-50 s):"
         run python3 "$TOOLS/track_error.py" "$WORK/t5-$mode" "$WORK/t5/truth.csv" --from 40 --to 50
     done
+}
+
+section_loops() {
+    for ins in perfect 1mg 2mg; do
+        run "$GPSRX" simulate "$ROOT/samples/scenarios/turn-10g-ins-$ins.toml" -o "$WORK/t10-$ins" >/dev/null
+    done
+    for case in "perfect 3" "1mg 3" "2mg 3" "1mg 2"; do
+        read -r ins order <<<"$case"
+        echo "-- 10 g turn (19-28 s), INS $ins, aided order $order at 0.4 Hz"
+        run "$GPSRX" run "$WORK/t10-$ins/signal.ci8" --nav "$NAV" --ins "$WORK/t10-$ins/ins.csv" --allow-unhealthy \
+            --aided-pll-order "$order" --aided-pll-bw 0.4 --out "$WORK/t10-$ins-$order" --no-plots >/dev/null 2>&1
+        run python3 "$TOOLS/lock_report.py" "$WORK/t10-$ins-$order" --from 19 --to 28
+        run python3 "$TOOLS/track_error.py" "$WORK/t10-$ins-$order" "$WORK/t10-$ins/truth.csv"
+    done
+    echo "-- static, 33-40 dB-Hz (issue 25), unaided 3rd order at 0.4 Hz, 10-60 s"
+    run "$GPSRX" simulate "$ROOT/samples/scenarios/static-cn0-ladder-4msps.toml" -o "$WORK/ladder" >/dev/null
+    run "$GPSRX" run "$WORK/ladder/signal.ci8" --nav "$NAV" --allow-unhealthy --pll-order 3 --pll-bw 0.4 \
+        --out "$WORK/ladder/run" --no-plots >/dev/null 2>&1
+    run python3 "$TOOLS/lock_report.py" "$WORK/ladder/run" --from 10 --to 60
+    run python3 "$TOOLS/track_error.py" "$WORK/ladder/run" "$WORK/ladder/truth.csv"
 }
 
 section_dr() {
