@@ -35,7 +35,14 @@ pub struct CarrierLoop {
     base_hz: f64,
     prev_prompt: Option<Complex64>,
     last: CarrierOutput,
+    /// The signal's C/N0 (Hz) for the Costas gain normalisation, when known.
+    cn0_hz: Option<f64>,
 }
+
+/// The smallest Costas slope the gain normalisation divides by: at most a 20-fold gain (the
+/// slope of `1 - exp(-C/N0 T)` is 0.05 at 17.1 dB-Hz with T = 1 ms), so that a poor C/N0
+/// estimate on a vanishing signal cannot blow the loop up.
+pub const MIN_COSTAS_SLOPE: f64 = 0.5;
 
 impl CarrierLoop {
     /// A carrier loop from a configuration, starting at `initial_doppler_hz` (e.g. from
@@ -54,6 +61,7 @@ impl CarrierLoop {
             filter,
             base_hz: initial_doppler_hz,
             prev_prompt: None,
+            cn0_hz: None,
             last: CarrierOutput {
                 nco_freq_hz: initial_doppler_hz,
                 ..CarrierOutput::default()
@@ -80,7 +88,7 @@ impl CarrierLoop {
         };
         self.prev_prompt = Some(prompt);
         let primary = if self.filter.has_primary() {
-            phase_error_cycles
+            phase_error_cycles * self.costas_gain()
         } else {
             0.0
         };
@@ -93,6 +101,34 @@ impl CarrierLoop {
             freq_error_hz,
         };
         self.last
+    }
+
+    /// Sets the signal's C/N0 (Hz; `None` or a non-finite or negative value: unknown) for the
+    /// Costas gain normalisation ([`CarrierLoop::costas_gain`]).
+    pub fn set_cn0_hz(&mut self, cn0_hz: Option<f64>) {
+        self.cn0_hz = cn0_hz.filter(|c| c.is_finite() && *c >= 0.0);
+    }
+
+    /// The gain the Costas discriminator's output is multiplied by before the loop filter:
+    /// `1 / max(1 - exp(-C/N0 T), MIN_COSTAS_SLOPE)`, 1 with another discriminator or without
+    /// a C/N0.
+    ///
+    /// The `atan(Q/I)` discriminator's mean output at a small phase error `phi` is
+    /// `(1 - exp(-C/N0 T)) phi` (its slope falls with the prompt SNR as the fold at +-pi/2 takes
+    /// more of the noise; derivation with `gpsrx_studies::bandwidth::costas_atan_stats`), so
+    /// unnormalised a loop's gain, and with it its bandwidth, its dynamic stress error and (for
+    /// a 3rd-order loop, conditionally stable: gain above 0.38 by Routh) its stability, depend
+    /// on the C/N0: at 30 dB-Hz and T = 1 ms the loop runs at 63 % of its design gain. Divided
+    /// by the slope it keeps its design (Kaplan & Hegarty sec. 5.3: the loop filter
+    /// coefficients assume unit discriminator gain).
+    pub fn costas_gain(&self) -> f64 {
+        match (self.cfg.pll_discriminator, self.cn0_hz) {
+            (PllDiscriminator::Costas, Some(c)) => {
+                let slope = 1.0 - (-c * self.cfg.t_coh_s).exp();
+                1.0 / slope.max(MIN_COSTAS_SLOPE)
+            }
+            _ => 1.0,
+        }
     }
 
     /// The output of the last update (or the initial Doppler before the first).

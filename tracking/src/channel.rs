@@ -749,12 +749,19 @@ impl Channel {
     }
 
     /// The detectors fed with every 1 ms prompt: the C/N0 ([`Channel::update_cn0`]), the phase
-    /// lock indicator (`cos 2 phi`), the fade detector, and the bit synchroniser's failure
+    /// lock indicator (its blocks aligned to the bits once they are synchronised), the fade
+    /// detector, and the bit synchroniser's failure
     /// (no bit edges within its patience: no usable signal, the channel is lost).
     #[inline]
     fn update_detectors(&mut self, p: Complex64, next_is_edge: bool) {
         self.update_cn0(p, next_is_edge);
         self.pll_lock.update(p);
+        // The carrier loop's Costas gain follows the detector's C/N0 (bit-aligned, unbiased).
+        self.carrier.set_cn0_hz(self.pll_lock.cn0_hz(1e-3));
+        if next_is_edge {
+            // Lock-detector blocks hold whole data bits (no transition cancels a block's sum).
+            self.pll_lock.align_block();
+        }
         self.fade.push(p);
         if matches!(self.bit_sync.state(), BitSyncState::Failed) {
             // No bit edges within the synchroniser's patience: no usable signal. Release the

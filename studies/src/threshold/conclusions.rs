@@ -3,6 +3,7 @@
 
 use super::params::{AGREE_DB, SCAN_TOP_DBHZ};
 use super::result::{Agreement, CellResult};
+use super::theory::loop_gain;
 use crate::report::fmt;
 use std::fmt::Write as _;
 
@@ -84,20 +85,22 @@ fn explain(r: &CellResult, all: &[CellResult]) -> String {
                 .and_then(|x| x.first_failure)
                 .is_some_and(|(_, o)| o.half_cycle_slips > 0);
             if by_stability && (slipped || !by_detector) {
-                let slope = 1.0 - (-(10f64.powf(th.stable_dbhz.unwrap_or(f64::NAN) / 10.0)) * r.cell.t_coh_s()).exp();
+                let gain = loop_gain(th.stable_dbhz.unwrap_or(f64::NAN), r.cell.t_coh_s());
                 let _ = write!(
                     s,
-                    ": the 3rd-order loop is only conditionally stable, and below {} dB-Hz the Costas \
-                     atan slope 1 - exp(-C/N0 T) (< {}) leaves the linearised loop unstable: it \
-                     slips whatever its jitter",
+                    ": the 3rd-order loop is only conditionally stable, and below {} dB-Hz the \
+                     loop gain the Costas atan slope leaves (< {} of the design: the slope \
+                     1 - exp(-C/N0 T) is normalised only down to 0.5) makes the linearised loop \
+                     unstable: it slips whatever its jitter",
                     fmt(th.stable_dbhz.unwrap_or(f64::NAN), 1),
-                    fmt(slope, 2)
+                    fmt(gain, 2)
                 );
             } else if by_detector {
                 let _ = write!(
                     s,
                     ": the receiver's lock detector sets it (its floor, {} dB-Hz, is within {} dB \
-                     of the measurement: its 20 ms blocks are too weak to read lock below it)",
+                     of the measurement: below it the detector's estimate, even averaged over \
+                     its longest memory, is too noisy to read lock 95 % of the time)",
                     fmt(th.detector_dbhz.unwrap_or(f64::NAN), 1),
                     fmt(AGREE_DB, 0)
                 );
@@ -106,8 +109,8 @@ fn explain(r: &CellResult, all: &[CellResult]) -> String {
             }) {
                 let _ = write!(
                     s,
-                    ": the stress error grows as the Costas slope 1 - exp(-C/N0 T) lowers the loop \
-                     gain (theta_e / slope); with it the rule gives {} dB-Hz",
+                    ": the stress error grows as the Costas slope 1 - exp(-C/N0 T) below 0.5 \
+                     lowers the loop gain (theta_e / gain); with it the rule gives {} dB-Hz",
                     fmt(th.rule_slope_dbhz.unwrap_or(f64::NAN), 1)
                 );
             } else if by_realised {
@@ -186,11 +189,12 @@ fn loop_reason(r: &CellResult, a: Agreement) -> String {
     let th = &r.theory;
     match (a, r.loop_dbhz()) {
         (Agreement::Delta(d), Some(l)) if d < 0.0 => format!(
-            ": at {} dB-Hz the Costas slope 1 - exp(-C/N0 T) is {}, the loop's gain and \
-             bandwidth collapse with it and, with nothing to follow, it does not slip; the \
-             rule's linear-loop jitter does not apply",
+            ": at {} dB-Hz the Costas slope 1 - exp(-C/N0 T) leaves the loop {} of its design \
+             gain (the slope is normalised only down to 0.5), its bandwidth collapses with it \
+             and, with nothing to follow, it does not slip; the rule's linear-loop jitter does \
+             not apply",
             fmt(l, 1),
-            fmt(1.0 - (-(10f64.powf(l / 10.0)) * r.cell.t_coh_s()).exp(), 3)
+            fmt(loop_gain(l, r.cell.t_coh_s()), 3)
         ),
         (Agreement::Delta(_), Some(l))
             if th.stable_dbhz.is_some_and(|f| (l - f).abs() <= AGREE_DB) =>
@@ -207,8 +211,8 @@ fn loop_reason(r: &CellResult, a: Agreement) -> String {
             }) =>
         {
             format!(
-                ": the stress error grows as the Costas slope 1 - exp(-C/N0 T) lowers the loop gain \
-                 (theta_e / slope); with it the rule gives {} dB-Hz",
+                ": the stress error grows as the Costas slope 1 - exp(-C/N0 T) below 0.5 lowers \
+                 the loop gain (theta_e / gain); with it the rule gives {} dB-Hz",
                 fmt(th.rule_slope_dbhz.unwrap_or(f64::NAN), 1)
             )
         }

@@ -45,14 +45,14 @@ pub use self::if_check::{
 };
 pub use self::measure::{measure_cell, run_seed, run_seed_raw, Measured};
 pub use self::params::{
-    AGREE_DB, BIT_EDGE_IN_LOCK_BLOCK_MS, HOLD_FRACTION, PRE_ROLL_S, RULE_LIMIT_DEG,
-    SCAN_BOTTOM_DBHZ, SCAN_STEP_DB, SCAN_TOP_DBHZ, WINDOW_S,
+    AGREE_DB, HOLD_FRACTION, PRE_ROLL_S, RULE_LIMIT_DEG, SCAN_BOTTOM_DBHZ, SCAN_STEP_DB,
+    SCAN_TOP_DBHZ, WINDOW_S,
 };
 pub use self::result::{cell_theory, Agreement, CellResult, CellTheory};
-pub use self::sim::{run as run_once, run_with_edge, steady_state_error_cycles, RunOutcome};
+pub use self::sim::{run as run_once, steady_state_error_cycles, RunOutcome};
 pub use self::table::{build_table, COLUMNS};
 pub use self::theory::{
-    allan_jitter_deg, bit_edge_power_share, detector_floor_dbhz, dynamic_stress_deg,
+    allan_jitter_deg, detector_floor_dbhz, detector_relative_error, dynamic_stress_deg, loop_gain,
     rule_threshold_dbhz, rule_with_slope_dbhz, stability_floor_dbhz, RuleInputs,
 };
 
@@ -208,21 +208,24 @@ fn intro_md(quick: bool, seed: u64, runs: usize, wall_s: f64) -> String {
          unbounded error and is not run.\n\n\
          **Measurement**: at the level of 1 ms correlator outputs (prompt `A d sinc exp(j 2 pi e) \
          + n`, unit noise per component, `A = sqrt(2 CN0 1 ms)`, random data bits), the \
-         receiver's own carrier loop (`CarrierLoop`: Costas atan, the cell's filter, NCO held \
-         over bit-aligned intervals of T), started in its steady state. **Lock held** is the \
-         channel's `pll_lock` in each 1 ms period: its `PllLockDetector` (default settings: \
-         20-prompt coherent blocks, `|LPF(NBD, NBS)|/LPF(NBP) >= 0.7`, steady offset <= 0.2 \
-         cycle, 10-test hysteresis) locked and its fade detector quiet; the detector's blocks \
-         start {edge} ms before a bit edge (a channel counts them from its first code period). \
+         receiver's own carrier loop (`CarrierLoop`: Costas atan divided by its slope \
+         `1 - exp(-C/N0 T)` down to 0.5, from the lock detector's C/N0, the cell's filter, NCO \
+         held over bit-aligned intervals of T), started in its steady state. **Lock held** is \
+         the channel's `pll_lock` in each 1 ms period: its `PllLockDetector` (default settings: \
+         bit-aligned 20-prompt coherent blocks, steadiness `|LPF(S^2)|/s >= 0.7` with `s` the \
+         block's signal power estimated without the noise bias, a low-pass adapted to the block \
+         SNR, steady offset <= 0.2 cycle, 10-test hysteresis) locked and its fade detector \
+         quiet. \
          Each C/N0 is one run of {pre:.0} s + {window:.0} s (fixed seeds from `--seed {seed}`); \
          the scan goes down from {top:.0} dB-Hz in {step} dB steps and stops at the first run \
          that holds lock less than {hold:.0} % of the window: `measured_dbhz` is the last that \
          held (`none`: not even at the top). {runs} runs in {wall_s:.0} s.\n\n\
          **Other columns**: `stress_deg` theta_e; `detector_dbhz` the lock detector's floor \
-         (where `exp(-2 sigma^2) g rho/(g rho + 1)` reaches 0.7, `rho` = 20 ms of C/N0, `g` = \
-         {g:.3} the block power a bit transition leaves); `theory_slope_dbhz` the rule with the \
-         stress divided by the Costas atan slope `1 - exp(-C/N0 T)` (a lower loop gain leaves a \
-         larger steady-state error); `stable_dbhz` the C/N0 below which that slope leaves a \
+         (where `exp(-2 sigma^2) - 1.645 eps/sqrt(2)` reaches 0.7, `eps` the relative error of \
+         its estimate at the block SNR `rho` = 20 ms of C/N0); `theory_slope_dbhz` the rule with \
+         the stress divided by the loop gain the normalised Costas slope leaves (below 0.5: \
+         slope/0.5; a lower loop gain leaves a larger steady-state error); `stable_dbhz` the \
+         C/N0 below which that gain leaves a \
          3rd-order loop (only conditionally stable) linearly unstable; `expected_dbhz` the \
          highest of `theory_slope_dbhz`, `stable_dbhz` and `detector_dbhz`; `loop_dbhz` the \
          loop's own threshold by the truth (no half-cycle slip, a 3/8-cycle excursion, in the \
@@ -233,10 +236,8 @@ fn intro_md(quick: bool, seed: u64, runs: usize, wall_s: f64) -> String {
         bns = BN_HZ.map(|b| b.to_string()).join(", "),
         ts = T_COH_MS.map(|t| t.to_string()).join(" and "),
         grid = if quick { "quick" } else { "full" },
-        edge = BIT_EDGE_IN_LOCK_BLOCK_MS,
         pre = PRE_ROLL_S,
         top = SCAN_TOP_DBHZ,
         step = SCAN_STEP_DB,
-        g = bit_edge_power_share(BIT_EDGE_IN_LOCK_BLOCK_MS),
     )
 }

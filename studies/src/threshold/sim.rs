@@ -20,9 +20,9 @@
 //! for the next interval; every 1 ms prompt into the carrier lock detector
 //! ([`PllLockDetector`] with the receiver's default [`PllLockConfig`]) and the fade detector
 //! ([`FadeDetector`]). **Carrier lock** in a period is what the channel reports in its epoch's
-//! `pll_lock`: the lock detector locked and no fade. The detector's 20-prompt blocks start
-//! [`BIT_EDGE_IN_LOCK_BLOCK_MS`] ms before a bit edge (the channel counts them from its first
-//! code period, not from a bit edge).
+//! `pll_lock`: the lock detector locked and no fade. The detector's 20-prompt blocks are
+//! aligned to the bits (as the channel aligns them once the bits are synchronised), and the
+//! carrier loop's Costas gain follows the detector's C/N0, as in the channel.
 //!
 //! The loop starts in its steady state under the dynamics (NCO phase behind by the
 //! steady-state error `theta_ss`, frequency on the signal's, a 3rd-order loop's rate memory
@@ -30,7 +30,7 @@
 //! not pulling in. Nothing restarts a loop that has slipped: it holds lock again only if it
 //! finds it by itself.
 
-use super::params::{BIT_EDGE_IN_LOCK_BLOCK_MS, LOCK_BLOCK_PROMPTS, PRE_ROLL_S, WINDOW_S};
+use super::params::{PRE_ROLL_S, WINDOW_S};
 use super::Cell;
 use gpsrx_tracking::fade_detector::FadeDetector;
 use gpsrx_tracking::loop_filter::{omega0, A2, A3, B3};
@@ -71,18 +71,6 @@ pub fn steady_state_error_cycles(cell: &Cell) -> f64 {
 ///
 /// Errors: the receiver refuses the cell's loop configuration.
 pub fn run(cell: &Cell, cn0_dbhz: f64, seed: u64) -> anyhow::Result<RunOutcome> {
-    run_with_edge(cell, cn0_dbhz, seed, BIT_EDGE_IN_LOCK_BLOCK_MS)
-}
-
-/// [`run`] with the bit edges `bit_edge_ms` ms into the lock detector's blocks (0-19).
-///
-/// Errors: the receiver refuses the cell's loop configuration.
-pub fn run_with_edge(
-    cell: &Cell,
-    cn0_dbhz: f64,
-    seed: u64,
-    bit_edge_ms: u32,
-) -> anyhow::Result<RunOutcome> {
     let cfg = cell.loop_config();
     let t_ms = cell.t_coh_ms.max(1) as usize;
     let [v, a, j] = cell.dynamics.phase_derivatives();
@@ -111,10 +99,8 @@ pub fn run_with_edge(
     let mut fade = FadeDetector::new();
     let mut rng = SimRng::new(seed);
     let amp = (2.0 * 10f64.powf(cn0_dbhz / 10.0) * 1e-3).sqrt();
-    let block = LOCK_BLOCK_PROMPTS as usize;
-    // The detectors see their first prompt this many periods in, so that each of their blocks
-    // has a bit edge BIT_EDGE_IN_LOCK_BLOCK_MS ms into it.
-    let detector_start = (block - bit_edge_ms as usize % block) % block;
+    // Bits start at every 20th period from 0, the detector's blocks with them.
+    let detector_start = 0;
     let window_start = detector_start + (PRE_ROLL_S * 1e3).round() as usize;
     let n_ms = window_start + (WINDOW_S * 1e3).round() as usize;
     let (mut phi, mut f) = (-theta_ss, f0);
@@ -144,6 +130,12 @@ pub fn run_with_edge(
         acc += p;
         if k >= detector_start {
             let locked = lock.update(p);
+            carrier.set_cn0_hz(lock.cn0_hz(1e-3));
+            if (k + 1) % 20 == 0 {
+                // The next period starts a bit: the channel aligns the detector's blocks to the
+                // bits once they are synchronised.
+                lock.align_block();
+            }
             fade.push(p);
             if k >= window_start {
                 counted += 1;

@@ -24,27 +24,33 @@
 //! # The lock detector's floor
 //!
 //! "Lock held" is what the receiver's carrier lock detector reports
-//! ([`gpsrx_tracking::PllLockDetector`]): the steadiness `|LPF(NBD, NBS)| / LPF(NBP)` of
-//! 20-prompt coherent sums at or above 0.7. With the phase error Gaussian of standard deviation
-//! `sigma` (rad) its expected value is `exp(-2 sigma^2) g rho / (g rho + 1)`, `rho = M CN0 T1`
-//! (`M` = 20 prompts of `T1` = 1 ms) and `g` the share of the block's signal power a data-bit
-//! transition leaves ([`super::params::BIT_EDGE_IN_LOCK_BLOCK_MS`]). Below the C/N0 where this
-//! reaches the threshold ([`detector_floor_dbhz`]) the detector reports no lock even for a loop
-//! that holds the phase: a threshold of the receiver, not of the loop.
+//! ([`gpsrx_tracking::PllLockDetector`]): the steadiness `|LPF(S^2)| / s` of bit-aligned
+//! 20-prompt coherent sums `S` (`s` their signal power, estimated without the noise bias) at or
+//! above 0.7. In lock its expected value is `exp(-2 sigma^2)` (`sigma` the phase jitter, rad);
+//! its estimate has the relative error `eps = sqrt(a/(2 - a) (4 rho + 2)/rho^2)`, `rho = M CN0 T1`
+//! (`M` = 20 prompts of `T1` = 1 ms) and `a` the detector's low-pass coefficient (adapted to
+//! `rho`, at least `min_alpha`), of which `eps/sqrt(2)` lies along the signal. Below the C/N0
+//! where `exp(-2 sigma^2) - 1.645 eps/sqrt(2)` reaches the threshold ([`detector_floor_dbhz`])
+//! the detector reports lock less than 95 % of the time even for a loop that holds the phase:
+//! a threshold of the receiver, not of the loop.
 //!
 //! # The stability floor
 //!
 //! The Costas `atan(Q/I)` discriminator's slope falls with the prompt SNR `rho = CN0 T` as
-//! `1 - exp(-rho)` (`crate::bandwidth::costas_atan_stats`), which scales the loop gain. Orders 1
-//! and 2 stay stable at any gain; a 3rd-order loop is only conditionally stable (the analog
+//! `1 - exp(-rho)` (`crate::bandwidth::costas_atan_stats`). The receiver divides the
+//! discriminator by that slope, down to [`MIN_COSTAS_SLOPE`]
+//! ([`gpsrx_tracking::CarrierLoop::costas_gain`]), so the loop keeps its design gain while the
+//! slope is above it and runs at `k = slope / MIN_COSTAS_SLOPE` below ([`loop_gain`]). Orders
+//! 1 and 2 stay stable at any gain; a 3rd-order loop is only conditionally stable (the analog
 //! loop `s^3 + k b3 w s^2 + k a3 w^2 s + k w^3` needs `k > 1/(a3 b3) = 0.38` by Routh), so below
-//! the C/N0 where the slope falls under the digital loop's critical gain
-//! ([`stability_floor_dbhz`]) the linearised loop is unstable and its phase error grows until it
-//! slips, whatever the jitter.
+//! the C/N0 where `k` falls under the digital loop's critical gain ([`stability_floor_dbhz`])
+//! the linearised loop is unstable and its phase error grows until it slips, whatever the
+//! jitter.
 
-use super::params::{BIT_EDGE_IN_LOCK_BLOCK_MS, RULE_LIMIT_DEG};
+use super::params::RULE_LIMIT_DEG;
 use super::Dynamics;
 use crate::bandwidth::stable_with_slope;
+use gpsrx_tracking::carrier_loop::MIN_COSTAS_SLOPE;
 use gpsrx_tracking::loop_filter::omega0;
 use gpsrx_tracking::phase_sim::pll_jitter_deg;
 use gpsrx_tracking::LoopFilter;
@@ -136,47 +142,56 @@ pub fn rule_threshold_dbhz(r: &RuleInputs) -> Option<f64> {
     lowest_root(|c| 3.0 * r.sigma_deg(c) + r.stress_deg - RULE_LIMIT_DEG)
 }
 
-/// The rule with the stress error a loop of reduced gain leaves: the Costas atan slope
-/// `k = 1 - exp(-CN0 T)` (module docs "The stability floor") scales the loop gain, and a
-/// steady-state error is inversely proportional to it, so `3 sigma_PLL + theta_e / k <= 45` deg.
-/// The same as [`rule_threshold_dbhz`] without stress.
+/// The loop gain the receiver's carrier loop runs at, relative to its design, at `cn0_dbhz`
+/// and integration time `t_coh_s`: the Costas slope `1 - exp(-CN0 T)` over the slope it is
+/// normalised by, `max(slope, MIN_COSTAS_SLOPE)` (module docs "The stability floor"; with the
+/// detector's C/N0 taken as exact).
+pub fn loop_gain(cn0_dbhz: f64, t_coh_s: f64) -> f64 {
+    let slope = 1.0 - (-(10f64.powf(cn0_dbhz / 10.0)) * t_coh_s).exp();
+    slope / slope.max(MIN_COSTAS_SLOPE)
+}
+
+/// The rule with the stress error a loop of reduced gain leaves: the gain `k` ([`loop_gain`])
+/// scales the loop, and a steady-state error is inversely proportional to it, so
+/// `3 sigma_PLL + theta_e / k <= 45` deg. The same as [`rule_threshold_dbhz`] without stress.
 pub fn rule_with_slope_dbhz(r: &RuleInputs) -> Option<f64> {
     if !r.stress_deg.is_finite() {
         return None;
     }
-    lowest_root(|c| {
-        let k = 1.0 - (-(10f64.powf(c / 10.0)) * r.t_coh_s).exp();
-        3.0 * r.sigma_deg(c) + r.stress_deg / k - RULE_LIMIT_DEG
-    })
+    lowest_root(|c| 3.0 * r.sigma_deg(c) + r.stress_deg / loop_gain(c, r.t_coh_s) - RULE_LIMIT_DEG)
 }
 
-/// Share of a lock-detector block's signal power left by a data-bit transition `m` ms into the
-/// 20 ms block, averaged over blocks with and without a transition: `1/2 + (1/2)(1 - m/10)^2`.
-pub fn bit_edge_power_share(edge_ms: u32) -> f64 {
-    let r = 1.0 - f64::from(edge_ms) / 10.0;
-    0.5 + 0.5 * r * r
+/// The relative error of the lock detector's steadiness estimate at the block SNR `rho`
+/// (`M CN0 T1`): `sqrt(a/(2 - a) (4 rho + 2)/rho^2)` with the detector's adapted low-pass
+/// coefficient `a = 2x/(1 + x)`, `x = eps^2 rho^2/(4 rho + 2)`, clamped to
+/// `[min_alpha, alpha]` (module docs).
+pub fn detector_relative_error(rho: f64, cfg: &PllLockConfig) -> f64 {
+    let var = (4.0 * rho + 2.0) / (rho * rho);
+    let x = cfg.relative_error * cfg.relative_error / var;
+    let a = (2.0 * x / (1.0 + x)).clamp(cfg.min_alpha, cfg.alpha);
+    (a / (2.0 - a) * var).sqrt()
 }
 
-/// The C/N0 (dB-Hz) below which the receiver's lock detector (default settings) reads below
-/// its threshold on average: `exp(-2 sigma^2) g rho/(g rho + 1) = threshold` (module docs),
-/// `sigma` the rule's `sigma_PLL` in radians; `None` when a steady stress error beyond the
-/// detector's offset limit already fails it.
+/// The C/N0 (dB-Hz) below which the receiver's lock detector (default settings) reports lock
+/// less than 95 % of the time: `exp(-2 sigma^2) - 1.645 eps/sqrt(2) = threshold` (module
+/// docs), `sigma` the rule's `sigma_PLL` in radians; `None` when a steady stress error beyond
+/// the detector's offset limit already fails it.
 pub fn detector_floor_dbhz(r: &RuleInputs) -> Option<f64> {
     let cfg = PllLockConfig::default();
     if r.stress_deg / 360.0 > cfg.max_offset_cycles {
         return None;
     }
-    let g = bit_edge_power_share(BIT_EDGE_IN_LOCK_BLOCK_MS);
     let m_t1 = f64::from(cfg.coherent_sum) * 1e-3;
     lowest_root(|c| {
         let sigma_rad = r.sigma_deg(c).to_radians();
-        let rho = g * m_t1 * 10f64.powf(c / 10.0);
-        cfg.threshold - (-2.0 * sigma_rad * sigma_rad).exp() * rho / (rho + 1.0)
+        let rho = m_t1 * 10f64.powf(c / 10.0);
+        let eps = detector_relative_error(rho, &cfg);
+        cfg.threshold - ((-2.0 * sigma_rad * sigma_rad).exp() - 1.645 * eps / 2f64.sqrt())
     })
 }
 
 /// The lowest C/N0 (dB-Hz) at which the linearised digital loop (`order`, `bn_hz`, `t_coh_s`)
-/// with the Costas atan slope `1 - exp(-CN0 T)` is stable (module docs); `None` when it is
+/// at the gain [`loop_gain`] is stable (module docs); `None` when it is
 /// stable down to -20 dB-Hz (orders 1 and 2) or not even at 100 dB-Hz.
 pub fn stability_floor_dbhz(order: u8, bn_hz: f64, t_coh_s: f64) -> Option<f64> {
     if order < 3 {
@@ -185,10 +200,7 @@ pub fn stability_floor_dbhz(order: u8, bn_hz: f64, t_coh_s: f64) -> Option<f64> 
         return None;
     }
     let filter = LoopFilter::pll(order, bn_hz).ok()?;
-    let stable = |c: f64| {
-        let slope = 1.0 - (-(10f64.powf(c / 10.0)) * t_coh_s).exp();
-        stable_with_slope(&filter, t_coh_s, slope)
-    };
+    let stable = |c: f64| stable_with_slope(&filter, t_coh_s, loop_gain(c, t_coh_s));
     let floor = lowest_root(|c| if stable(c) { -1.0 } else { 1.0 })?;
     (floor > -20.0).then_some(floor)
 }
@@ -263,48 +275,61 @@ mod tests {
         assert!((got - 10.0 * c.log10()).abs() < 1e-4, "{got}");
     }
 
-    /// Without stress the slope changes nothing; with 16 deg (1 g into a 2nd-order 18 Hz loop)
-    /// at T = 1 ms the threshold rises: at the plain rule's 29.8 dB-Hz the slope is 0.62.
+    /// Without stress the gain changes nothing; with 16 deg (1 g into a 2nd-order loop) at
+    /// T = 1 ms: a loop whose threshold lies where the slope is above 0.5 (Bn 18 Hz, the plain
+    /// rule's 29.8 dB-Hz, slope 0.62) keeps its design gain, and a narrower one (Bn 3 Hz,
+    /// plain rule below 28.4 dB-Hz where the slope falls under 0.5) runs at slope/0.5 and
+    /// needs more C/N0.
     #[test]
-    fn the_slope_raises_a_stressed_threshold() {
+    fn the_gain_raises_a_stressed_threshold_below_the_normalisation() {
         let mut r = static_inputs(18.0, 1e-3);
         assert_eq!(rule_with_slope_dbhz(&r), rule_threshold_dbhz(&r));
         r.stress_deg = 16.08;
         let plain = rule_threshold_dbhz(&r).unwrap_or(f64::NAN);
+        assert!((plain - 29.8).abs() < 0.1, "{plain}");
+        assert_eq!(rule_with_slope_dbhz(&r), rule_threshold_dbhz(&r));
+        let mut r = static_inputs(3.0, 1e-3);
+        r.stress_deg = 16.08;
+        let plain = rule_threshold_dbhz(&r).unwrap_or(f64::NAN);
         let sloped = rule_with_slope_dbhz(&r).unwrap_or(f64::NAN);
-        assert!(
-            (plain - 29.8).abs() < 0.1 && sloped > plain + 0.5,
-            "{plain} {sloped}"
-        );
-        let k = 1.0 - (-(10f64.powf(sloped / 10.0)) * 1e-3).exp();
-        let sigma = pll_jitter_deg(18.0, sloped, 1e-3);
+        assert!(plain < 28.4 && sloped > plain + 0.5, "{plain} {sloped}");
+        let k = (1.0 - (-(10f64.powf(sloped / 10.0)) * 1e-3).exp()) / 0.5;
+        assert!(k < 1.0 && (loop_gain(sloped, 1e-3) - k).abs() < 1e-12);
+        let sigma = pll_jitter_deg(3.0, sloped, 1e-3);
         assert!((3.0 * sigma + 16.08 / k - 45.0).abs() < 1e-3);
     }
 
     /// A 3rd-order loop at Bn T = 0.003 is nearly analog: unstable below the Routh gain
-    /// `1/(a3 b3) = 0.379`, i.e. `1 - exp(-c T) = 0.379`, `c = -ln(0.621)/T` = 476 Hz at T = 1 ms,
-    /// 26.8 dB-Hz; a 2nd-order loop has no floor.
+    /// `1/(a3 b3) = 0.379`; the receiver normalises the slope down to 0.5, so the gain is
+    /// `(1 - exp(-c T))/0.5 = 0.379`, `c = -ln(1 - 0.19)/T` = 210 Hz at T = 1 ms, 23.2 dB-Hz
+    /// (26.8 dB-Hz without the normalisation); a 2nd-order loop has no floor.
     #[test]
     fn third_order_loops_have_a_stability_floor() {
-        let want = 10.0 * (-(1.0 - 1.0 / (1.1 * 2.4f64)).ln() / 1e-3).log10();
+        let want = 10.0 * (-(1.0 - 0.5 / (1.1 * 2.4f64)).ln() / 1e-3).log10();
         let got = stability_floor_dbhz(3, 3.0, 1e-3).unwrap_or(f64::NAN);
         assert!((got - want).abs() < 0.3, "{got} vs {want}");
         assert_eq!(stability_floor_dbhz(2, 3.0, 1e-3), None);
         assert_eq!(stability_floor_dbhz(1, 18.0, 1e-3), None);
     }
 
-    /// The detector floor: with no jitter it is where `g rho/(g rho + 1) = 0.7`, i.e.
-    /// `g rho = 7/3`, `c = 7/(3 g 0.02)`; g = 0.625 for an edge 5 ms into the block: 186.7,
-    /// 22.71 dB-Hz. Jitter raises it.
+    /// The detector floor: with no jitter it is where `1 - 1.645 eps/sqrt(2) = 0.7`, i.e.
+    /// `eps = 0.258`; at `rho` = 0.3 the relative error of a single... checked by hand:
+    /// `x = 0.0144 * 0.09 / 3.2 = 4.05e-4`, `a` clamps to 0.004, `eps = sqrt(0.004/1.996 *
+    /// 35.56) = 0.267` (just above), so the floor lies near `rho` = 0.3, 11.8 dB-Hz. Jitter
+    /// raises it.
     #[test]
-    fn detector_floor_is_where_the_block_snr_fails_the_threshold() {
-        assert!((bit_edge_power_share(0) - 1.0).abs() < 1e-12);
-        assert!((bit_edge_power_share(10) - 0.5).abs() < 1e-12);
-        let g = bit_edge_power_share(BIT_EDGE_IN_LOCK_BLOCK_MS);
-        let want = 10.0 * (7.0 / (3.0 * g * 0.02)).log10();
-        // A loop so narrow that its jitter is negligible at the floor.
+    fn detector_floor_is_where_the_estimate_fails_the_threshold() {
+        let cfg = PllLockConfig::default();
+        let eps = detector_relative_error(0.3, &cfg);
+        assert!((eps - 0.267).abs() < 0.001, "{eps}");
         let floor = detector_floor_dbhz(&static_inputs(1e-6, 20e-3)).unwrap_or(f64::NAN);
-        assert!((floor - want).abs() < 0.01, "{floor} vs {want}");
+        let rho = 0.02 * 10f64.powf(floor / 10.0);
+        let at_floor = detector_relative_error(rho, &cfg);
+        assert!(
+            (1.0 - 1.645 * at_floor / 2f64.sqrt() - 0.7).abs() < 1e-6,
+            "{floor}"
+        );
+        assert!((floor - 11.8).abs() < 0.3, "{floor}");
         let wide = detector_floor_dbhz(&static_inputs(18.0, 1e-3)).unwrap_or(f64::NAN);
         assert!(wide > floor + 1.0, "{wide}");
     }

@@ -34,7 +34,8 @@ impl Channel {
     pub(super) fn watch_carrier_lock(&mut self, dur_ms: u64) {
         match self.state {
             ChannelState::Track => {
-                if self.pll_lock.locked() {
+                // The lock the channel reports: the detector's, and no fade.
+                if self.pll_lock.locked() && !self.fade.faded() {
                     self.unlocked_ms = 0;
                     return;
                 }
@@ -146,6 +147,20 @@ mod tests {
             }
             let x: Vec<Complex32> = (start..start + n as u64).map(|k| sig.sample(k)).collect();
             if let Some(e) = ch.process_code_period(&x) {
+                if std::env::var("LOCKDBG").is_ok()
+                    && ((e.t_rx_s * 10.0).round() - e.t_rx_s * 10.0).abs() < 0.011
+                {
+                    eprintln!(
+                        "{:.2} {:?} {} rho {:.2} a {:.4} st {:.2} cn0 {:.1}",
+                        e.t_rx_s,
+                        e.state,
+                        e.pll_lock,
+                        ch.pll_lock.block_snr(),
+                        ch.pll_lock.alpha(),
+                        ch.pll_lock.phase_steadiness(),
+                        e.cn0_dbhz
+                    );
+                }
                 out.push((e.t_rx_s, e.state, e.pll_lock, e.doppler_hz));
             }
         }
