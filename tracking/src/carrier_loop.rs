@@ -42,7 +42,7 @@ pub struct CarrierLoop {
 /// The smallest Costas slope the gain normalisation divides by: at most a 20-fold gain (the
 /// slope of `1 - exp(-C/N0 T)` is 0.05 at 17.1 dB-Hz with T = 1 ms), so that a poor C/N0
 /// estimate on a vanishing signal cannot blow the loop up.
-pub const MIN_COSTAS_SLOPE: f64 = 0.5;
+pub const MIN_COSTAS_SLOPE: f64 = 0.05;
 
 impl CarrierLoop {
     /// A carrier loop from a configuration, starting at `initial_doppler_hz` (e.g. from

@@ -118,7 +118,7 @@ impl Default for PllLockConfig {
         Self {
             coherent_sum: 20,
             alpha: 0.1,
-            min_alpha: 0.004,
+            min_alpha: 0.002,
             relative_error: 0.12,
             threshold: 0.7,
             count: 10,

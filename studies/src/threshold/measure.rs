@@ -1,6 +1,6 @@
 //! The measured threshold of a cell: a scan down in C/N0 until the loop no longer holds lock.
 
-use super::params::{HOLD_FRACTION, SCAN_BOTTOM_DBHZ, SCAN_STEP_DB, SCAN_TOP_DBHZ};
+use super::params::{HOLD_FRACTION, RUNS_PER_STEP, SCAN_BOTTOM_DBHZ, SCAN_STEP_DB, SCAN_TOP_DBHZ};
 use super::sim::{run, RunOutcome};
 use super::Cell;
 
@@ -25,10 +25,11 @@ pub struct Measured {
     pub runs: usize,
 }
 
-/// The noise seed of the run of `cell` at scan step `step` (SplitMix64 of the study seed, the
-/// cell's key and the step: every run has its own noise, the same in every grid).
-pub fn run_seed(seed: u64, cell: &Cell, step: usize) -> u64 {
-    run_seed_raw(seed, cell.key().rotate_left(17).wrapping_add(step as u64))
+/// The noise seed of run `k` of `cell` at scan step `step` (SplitMix64 of the study seed, the
+/// cell's key, the step and `k`: every run has its own noise, the same in every grid).
+pub fn run_seed(seed: u64, cell: &Cell, step: usize, k: usize) -> u64 {
+    let key = cell.key().rotate_left(17).wrapping_add(step as u64);
+    run_seed_raw(seed, key.wrapping_add((k as u64).wrapping_mul(0x9e37_79b9)))
 }
 
 /// SplitMix64 of the study seed and a run's key.
@@ -39,10 +40,10 @@ pub fn run_seed_raw(seed: u64, key: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Scans `cell` from [`SCAN_TOP_DBHZ`] down in steps of [`SCAN_STEP_DB`], one 30 s run per
-/// step ([`run`]): the threshold is the last C/N0 before the first run that holds lock less
-/// than [`HOLD_FRACTION`] of its window (a lucky run below the first failure cannot lower
-/// it). The loop's own threshold (slip-free for that share of the window) is found in the
+/// Scans `cell` from [`SCAN_TOP_DBHZ`] down in steps of [`SCAN_STEP_DB`], [`RUNS_PER_STEP`]
+/// 30 s runs per step ([`run`], pooled by [`RunOutcome::pool`]): the threshold is the last
+/// C/N0 before the first step whose runs hold lock less than [`HOLD_FRACTION`] of their
+/// windows (a lucky step below the first failure cannot lower it). The loop's own threshold (slip-free for that share of the window) is found in the
 /// same runs; the scan goes on until both have failed.
 ///
 /// Errors: the receiver refuses the cell's loop.
@@ -61,8 +62,11 @@ pub fn measure_cell(cell: &Cell, seed: u64) -> anyhow::Result<Measured> {
             break;
         }
         let cn0 = SCAN_TOP_DBHZ - step as f64 * SCAN_STEP_DB;
-        let out = run(cell, cn0, run_seed(seed, cell, step))?;
-        m.runs += 1;
+        let runs = (0..RUNS_PER_STEP)
+            .map(|k| run(cell, cn0, run_seed(seed, cell, step, k)))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let out = RunOutcome::pool(&runs);
+        m.runs += runs.len();
         if m.first_failure.is_none() {
             if out.held_fraction >= HOLD_FRACTION {
                 m.threshold_dbhz = Some(cn0);

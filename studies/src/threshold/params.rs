@@ -5,11 +5,15 @@
 pub const WINDOW_S: f64 = 30.0;
 /// Run before the window, s: the loop starts in its steady state, but the receiver's lock
 /// detector needs at least 10 tests of 20 ms (0.2 s) to declare lock and, at weak signals, its
-/// low-pass up to 250 tests (`1/min_alpha`, 5 s) to settle.
+/// low-pass a running mean of up to 500 tests (`1/min_alpha`, 10 s): lock is declared once
+/// that mean is precise enough, within a few seconds down to about 15 dB-Hz.
 pub const PRE_ROLL_S: f64 = 10.0;
 /// Fraction of the window's 1 ms epochs in which carrier lock must be reported for the C/N0 to
 /// count as held.
 pub const HOLD_FRACTION: f64 = 0.95;
+/// Runs (noise seeds) per C/N0 of the scan: their held shares are pooled, so that one lucky or
+/// unlucky run does not move a threshold.
+pub const RUNS_PER_STEP: usize = 3;
 /// Rule of thumb (Kaplan & Hegarty 2nd ed. sec. 5.6, oracles.md): `3 sigma + theta_e <= 45` deg
 /// for a Costas PLL, i.e. `sigma + theta_e/3 <= 15` deg.
 pub const RULE_LIMIT_DEG: f64 = 45.0;

@@ -56,6 +56,20 @@ pub struct RunOutcome {
     pub rms_error_deg: f64,
 }
 
+impl RunOutcome {
+    /// Several runs of the same cell and C/N0 as one: the mean shares, the summed slips and
+    /// the RMS error over all of them (`runs` not empty; an empty slice gives zeros).
+    pub fn pool(runs: &[RunOutcome]) -> RunOutcome {
+        let n = runs.len().max(1) as f64;
+        RunOutcome {
+            held_fraction: runs.iter().map(|r| r.held_fraction).sum::<f64>() / n,
+            half_cycle_slips: runs.iter().map(|r| r.half_cycle_slips).sum(),
+            slip_free_fraction: runs.iter().map(|r| r.slip_free_fraction).sum::<f64>() / n,
+            rms_error_deg: (runs.iter().map(|r| r.rms_error_deg.powi(2)).sum::<f64>() / n).sqrt(),
+        }
+    }
+}
+
 /// The loop's steady-state phase error under the cell's dynamics, cycles:
 /// `(d^n theta/dt^n)/omega0^n` for a loop of order `n` equal to the residual's degree, else 0
 /// (orders above the degree follow without error; below it the cell is not run).
