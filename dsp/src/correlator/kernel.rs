@@ -220,7 +220,7 @@ impl Correlator {
         };
         let lanes = match (isa, arithmetic, format) {
             (Isa::Scalar, _, _) => "",
-            (Isa::Avx2Fma, Arithmetic::I16, "ci8") if fs_hz >= 1.1e6 => " (16 lanes)",
+            (Isa::Avx2Fma, Arithmetic::I16, "ci8" | "ci16") if fs_hz >= 1.1e6 => " (16 lanes)",
             (Isa::Avx2Fma, _, _) => " (8 lanes)",
             (Isa::Avx512, _, _) => " (16 lanes)",
         };

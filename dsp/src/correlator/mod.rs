@@ -32,9 +32,11 @@ mod simd;
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 #[cfg(target_arch = "x86_64")]
-mod avx2_ci8;
+mod avx2_i16;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
+#[cfg(target_arch = "x86_64")]
+mod int16_lanes;
 
 #[cfg(test)]
 mod kernel_tests;
