@@ -36,6 +36,8 @@ mod avx2_i16;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
 #[cfg(target_arch = "x86_64")]
+mod avx512_i16;
+#[cfg(target_arch = "x86_64")]
 mod int16_lanes;
 
 #[cfg(test)]
