@@ -101,20 +101,27 @@ impl<const L: usize> LanePlan<L> {
             hi_dup: [[0; L]; MAX_TAPS],
             whole: [0; MAX_TAPS],
         };
+        // Each compare lane's position and `o S` (below 32 * 1023 * 2^32 < 2^47: no overflow).
+        let mut pos = [0usize; L];
+        let mut o_s = [0u64; L];
+        for j in 0..L {
+            pos[j] = cmp_position(j);
+            o_s[j] = positions[pos[j]] as u64 * nco.step;
+        }
+        // The last sample of a step is the furthest from its window.
+        let last = (L as u64 - 1) * nco.step;
         let b0 = nco.phases[0];
         for t in 0..n_taps.min(MAX_TAPS) {
             let delta = (nco.phases[t] + CODE_LEN_FIX - b0) % CODE_LEN_FIX;
             plan.whole[t] = (delta >> 32) as usize;
             let frac = delta & 0xFFFF_FFFF;
+            if (frac + last) >> 32 > MAX_OFFSET {
+                return None;
+            }
             for j in 0..L {
-                let p = cmp_position(j);
-                let l = frac.checked_add((positions[p] as u64).checked_mul(nco.step)?)?;
-                let h = l >> 32;
-                if h > MAX_OFFSET {
-                    return None;
-                }
+                let l = frac + o_s[j];
                 plan.thr[t][j] = !(l as u32) ^ flip;
-                plan.hi_dup[t][p] = (h as u16 * 0x0101) as i16;
+                plan.hi_dup[t][pos[j]] = ((l >> 32) as u16 * 0x0101) as i16;
             }
         }
         Some(plan)
