@@ -11,15 +11,17 @@
 #      16-bit code replicas) then 16ic_16i_rotator_dotprodxn (wipe-off and dot products),
 #      complete per channel = 1/(1/resampler + 1/rotator); and its rotator alone (replicas
 #      given for free) for reference. Ours: the best AVX2 kernel of `gpsrx bench` on ci16 (the
-#      one `auto` takes), and our int16 kernel on ci16 for the issue-28 target.
+#      one `auto` takes on an AVX2-only CPU), and our int16 kernel on ci16 for the issue-28 target.
 #    - cf32 (32-bit float complex): GNSS-SDR's float path, 32f_resamplerxn then
 #      32fc_32f_rotator_dotprodxn, complete as above. Ours: avx2+fma/f32 on cf32.
 #    - ci8 (8-bit complex): ours, avx2+fma/i16 on ci8 (16 samples per step). GNSS-SDR has no
 #      8-bit correlator: its ibyte input is widened by a data-type adapter and then runs one
 #      of the paths above, so this row has no GNSS-SDR counterpart and no ratio.
 #    Ours generate the code replicas and the carrier inside the kernel, as tracking calls them.
-#    AVX2 on both sides (GNSS-SDR has no AVX-512 builds of these kernels; ours are capped with
-#    `--correlator avx2`). Both are timed in alternating rounds (REPEATS), best of each: the
+#    AVX2 on both sides (GNSS-SDR has no AVX-512 builds of these kernels; ours are the AVX2
+#    rows of `gpsrx bench --correlators-only`). Where the CPU has AVX-512, our AVX-512 int16
+#    kernel is set against our AVX2 one on ci8 and ci16 (issue 28), and the kernel `auto`
+#    takes per format is printed. Both are timed in alternating rounds (REPEATS), best of each: the
 #    profiler times a kernel in bursts of a few ms per architecture, `gpsrx bench` in 5 ms
 #    stretches, so other load on the machine hurts neither more.
 #
@@ -37,7 +39,8 @@
 # Installs Debian's gnss-sdr (which provides volk_gnsssdr_profile) when missing. Builds gpsrx
 # in release mode (CARGO_TARGET_DIR is honoured) unless GPSRX names a binary. Environment:
 # VLEN [4000] and ITER [2000] for the profiler, REPEATS [3] rounds of the kernels, E2E_RUNS [3],
-# WORK [mktemp -d], GPSRX [build]. Targets of the open issues are printed with the figures.
+# WORK [mktemp -d], GPSRX [build], KERNELS_ONLY [0: 1 stops after the correlators]. Targets of
+# the open issues are printed with the figures.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -114,17 +117,18 @@ for r in $(seq "$REPEATS"); do
         BEST[$k]=$(fmax "$v" "${BEST[$k]:-}")
         line+=" $k $v;"
     done
-    "$GPSRX" bench --correlators-only --correlator avx2 --json >"$WORK/bench-avx2-$r.json" ||
-        die "gpsrx bench --correlators-only --correlator avx2 failed"
-    echo "$line gpsrx: $WORK/bench-avx2-$r.json" >&2
+    "$GPSRX" bench --correlators-only --json >"$WORK/bench-kernels-$r.json" ||
+        die "gpsrx bench --correlators-only failed"
+    echo "$line gpsrx: $WORK/bench-kernels-$r.json" >&2
 done
 
 python3 - "$MACHINE" "${BEST[16i_resamplerxnpuppet_16i]}" "${BEST[16ic_16i_rotator_dotprodxnpuppet]}" \
-    "${BEST[32f_resamplerxnpuppet_32f]}" "${BEST[32fc_32f_rotator_dotprodxnpuppet]}" "$WORK"/bench-avx2-*.json <<'EOF'
+    "${BEST[32f_resamplerxnpuppet_32f]}" "${BEST[32fc_32f_rotator_dotprodxnpuppet]}" "$WORK"/bench-kernels-*.json <<'EOF'
 import json, sys
 machine = sys.argv[1]
 res16, rot16, res32, rot32 = map(float, sys.argv[2:6])
-rows = [r for f in sys.argv[6:] for r in json.load(open(f))["correlators"] if r["taps"] == 3]
+reports = [json.load(open(f)) for f in sys.argv[6:]]
+rows = [r for rep in reports for r in rep["correlators"] if r["taps"] == 3]
 
 def ours(kernel, fmt):
     """Our best 3-tap figure on `fmt` of `kernel`, or of every AVX2 kernel when kernel is None."""
@@ -150,12 +154,25 @@ print(f"  ci16   {k16:<30} {o16:7.0f}   {'16i_resampler + 16ic_16i_rotator':<40}
 print(f"  ci16   {'':<30} {'':>7}   {'16ic_16i_rotator alone (replicas given)':<40} {rot16:8.0f}   {o16 / rot16:.2f}x")
 print(f"  cf32   {k32:<30} {o32:7.0f}   {'32f_resampler + 32fc_32f_rotator':<40} {complete32:8.0f}   {o32 / complete32:.2f}x")
 print(f"  ci8    {k8:<30} {o8:7.0f}   {'none (8-bit input is widened first)':<40} {'-':>8}   -")
-print(f"  (ours on ci16: the best AVX2 kernel, the one `auto` takes; our int16 kernel on ci16: {k16i} {o16i:.0f})")
+print(f"  (ours on ci16: the best AVX2 kernel, the one `auto` takes on an AVX2-only CPU; our int16 kernel on ci16: {k16i} {o16i:.0f})")
 print(f"  issue 28 target, ci16 AVX2 int16 >= 2x 16ic_16i (rotator alone): {o16i / rot16:.2f}x, "
       + ("met" if o16i / rot16 >= 2.0 else "NOT met"))
+if any(r["kernel"] == "avx512/i16" for r in rows):
+    for fmt in ("ci8", "ci16"):
+        w, kw = ours("avx512/i16", fmt)
+        a, ka = ours("avx2+fma/i16", fmt)
+        print(f"  issue 28 target, {fmt}: AVX-512 int16 ({kw}) {w:.0f} >= AVX2 int16 ({ka}) {a:.0f}: "
+              + ("met" if w >= a else "NOT met"))
+auto = ", ".join(f"{a['format']} {a['runs']}" for a in reports[0]["auto"])
+print(f"  auto (the default) takes: {auto}")
 EOF
 
 # ------------------------------------------------------------------ end to end
+if [[ ${KERNELS_ONLY:-0} == 1 ]]; then
+    echo
+    echo "logs and outputs in $WORK (KERNELS_ONLY=1: no end-to-end runs)"
+    exit 0
+fi
 echo >&2
 echo "simulating ${DURATION} s of the 4 MHz ci8 12-satellite scenario into $WORK/sim..." >&2
 "$GPSRX" simulate "$ROOT/samples/scenarios/static-seoul-4msps.toml" --duration "$DURATION" -o "$WORK/sim" >/dev/null

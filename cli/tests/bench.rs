@@ -67,6 +67,27 @@ fn quick_bench_reports_every_kernel_acquisition_and_end_to_end() {
             }
         }
     }
+    // auto: one choice per format, a row of the grid, the kernel the library resolves.
+    let auto = v["auto"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no auto array"));
+    assert_eq!(auto.len(), 3);
+    let resolver = Correlator::best_up_to(
+        gpsrx_dsp::correlator::Isa::Avx512,
+        gpsrx_dsp::correlator::Arithmetic::Auto,
+    );
+    for (a, format) in auto.iter().zip(["ci8", "ci16", "cf32"]) {
+        assert_eq!(a["format"], format);
+        let k = resolver.resolved_for(format, 4e6);
+        assert_eq!(a["kernel"].as_str(), Some(k.name().as_str()));
+        assert_eq!(a["runs"].as_str(), Some(k.kernel_for(format, 4e6).as_str()));
+        assert!(
+            rows.iter().any(|r| r["kernel"] == a["kernel"]
+                && r["format"] == format
+                && r["runs"] == a["runs"]),
+            "auto's {format} kernel {a} is not a row"
+        );
+    }
     positive(&v["reference_msps_per_core"], "reference correlator");
     // The CPU and its instruction sets come with the figures.
     assert!(!v["cpu"].as_str().unwrap_or_default().is_empty());
@@ -147,6 +168,14 @@ fn correlator_ceiling_limits_the_kernels_and_bad_names_are_refused() {
         .count();
     assert_eq!(rows.len(), expected * 3 * 3);
     assert!(rows.iter().all(|r| r["isa"] != "avx512"));
+    // Under the avx2 ceiling auto takes AVX2 kernels (or scalar on a CPU without them).
+    let auto = v["auto"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no auto array"));
+    assert!(auto.iter().all(|a| !a["kernel"]
+        .as_str()
+        .unwrap_or("avx512")
+        .starts_with("avx512")));
     assert_eq!(v["correlator_ceiling"], "avx2");
     assert!(v["acquisition"].is_null() && v["end_to_end"].is_null());
 

@@ -26,9 +26,10 @@ pub enum CorrelatorIsa {
 
 /// The arithmetic of the channels' correlator.
 ///
-/// `auto` takes, per block format, the faster one ([`Arithmetic::Auto`]): int16 on ci8 blocks
-/// where the CPU has AVX2 (the 16-lane AVX2 kernel, about twice the f32 kernels' speed),
-/// f32 on ci16 and cf32. An I16 correlator runs the F32 kernel on cf32 blocks.
+/// `auto` takes, per block format, the faster one ([`Arithmetic::Auto`]): int16 on ci8 and
+/// ci16 blocks where the CPU has AVX2 (the int16-lane kernels, 16 samples per step with AVX2,
+/// 32 with AVX-512 VNNI: about twice the f32 kernels' speed), f32 on cf32. An I16 correlator
+/// runs the F32 kernel on cf32 blocks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum CorrelatorArithmetic {

@@ -9,7 +9,7 @@
 //!   ([`Correlator::available`]: ISA x arithmetic), input format (ci8, ci16, cf32) and tap count
 //!   (1, 3, 5): 1 ms blocks at 4 MHz (4000 samples), code and carrier generated inside the
 //!   kernel, as tracking calls it; the best of many 5 ms stretches (the least disturbed by
-//!   other processes);
+//!   other processes); with the kernel `auto` (the default) takes per format;
 //! - the wall time of a 32-PRN cold search (1 ms coherent x 10 non-coherent, +-5 kHz) at
 //!   4 MHz with [`AcquisitionEngine`] on every core, on simulated samples: the median of a
 //!   few runs;
@@ -25,7 +25,9 @@ use crate::commands::simulate::simulate;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
 use gpsrx_dsp::ca_code::CaCode;
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ};
-use gpsrx_dsp::correlator::{correlate, Correlator, Isa, PackedCode, ReplicaState, SampleSlice};
+use gpsrx_dsp::correlator::{
+    correlate, Arithmetic, Correlator, Isa, PackedCode, ReplicaState, SampleSlice,
+};
 use gpsrx_dsp::Prn;
 use gpsrx_receiver::output::FileSink;
 use gpsrx_receiver::{Assistance, Receiver};
@@ -77,6 +79,18 @@ pub struct CorrelatorRow {
     pub taps: usize,
     /// Input samples per second on one core, millions.
     pub msps_per_core: f64,
+}
+
+/// The kernel `auto` (the default correlator, `--correlator` ceiling applied) runs on one
+/// input format at the benchmark's rate.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct AutoChoice {
+    /// Input format: `ci8`, `ci16` or `cf32`.
+    pub format: String,
+    /// The kernel (a `kernel` of the correlator rows), e.g. `avx512/i16`.
+    pub kernel: String,
+    /// What runs, e.g. `avx512/i16 (32 lanes)` (the `runs` of that row).
+    pub runs: String,
 }
 
 /// The acquisition measurement.
@@ -200,6 +214,8 @@ pub struct BenchReport {
     pub threads: usize,
     /// Correlator throughput per kernel, format and tap count.
     pub correlators: Vec<CorrelatorRow>,
+    /// The kernel `auto` takes per format (one of the rows of `correlators`).
+    pub auto: Vec<AutoChoice>,
     /// The scalar reference `gpsrx_dsp::correlator::correlate` (cf32, 3 taps), Msamples/s.
     pub reference_msps_per_core: f64,
     /// The acquisition measurement (median), ms (None with --correlators-only).
@@ -259,6 +275,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
         }),
         threads,
         correlators,
+        auto: auto_choices(choice.isa.max_isa()),
         reference_msps_per_core,
         acquisition_ms: None,
         acquisition: None,
@@ -437,6 +454,22 @@ fn bench_correlators(timed_s: f64, max_isa: Isa) -> Vec<CorrelatorRow> {
         }
     }
     rows
+}
+
+/// The kernel `auto` runs per format under the ceiling `max_isa`, at the benchmark's rate.
+fn auto_choices(max_isa: Isa) -> Vec<AutoChoice> {
+    let auto = Correlator::best_up_to(max_isa, Arithmetic::Auto);
+    ["ci8", "ci16", "cf32"]
+        .into_iter()
+        .map(|format| {
+            let k = auto.resolved_for(format, BENCH_FS_HZ);
+            AutoChoice {
+                format: format.into(),
+                kernel: k.name(),
+                runs: k.kernel_for(format, BENCH_FS_HZ),
+            }
+        })
+        .collect()
 }
 
 /// The scalar reference correlator, cf32, 3 taps.
@@ -676,17 +709,33 @@ fn print_correlators(out: &mut dyn Write, r: &BenchReport) -> std::io::Result<()
                 .find(|c| &c.kernel == kernel && &c.format == format && c.taps == taps)
                 .map_or("-".to_string(), |c| format!("{:.0}", c.msps_per_core))
         };
+        let is_auto = r
+            .auto
+            .iter()
+            .any(|a| &a.kernel == kernel && &a.format == format);
         writeln!(
             out,
-            "  {:<14} {:<6} {:>9} {:>9} {:>9}   {}",
+            "  {:<14} {:<6} {:>9} {:>9} {:>9}   {}{}",
             kernel,
             format,
             cell(1),
             cell(3),
             cell(5),
-            runs
+            runs,
+            if is_auto { "   <- auto" } else { "" }
         )?;
     }
+    let auto: Vec<String> = r
+        .auto
+        .iter()
+        .map(|a| format!("{} {}", a.format, a.runs))
+        .collect();
+    writeln!(
+        out,
+        "  auto (the default; ceiling {}) takes: {}",
+        r.correlator_ceiling,
+        auto.join(", ")
+    )?;
     writeln!(
         out,
         "  (scalar reference correlate(), cf32, 3 taps: {:.0})",

@@ -7,7 +7,7 @@
 //! (`vpsllvd`), flip the wiped sample's sign by XOR and accumulate. No gathers, no per-sample
 //! branches. The int16 kernel packs the rotator to Q14 int16 pairs and wipes off with `vpmaddwd`.
 
-use super::avx2_ci8;
+use super::avx2_i16;
 use super::kernel::{Arithmetic, SampleSlice};
 use super::packed::PackedCode;
 use super::plan::{code_window, CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
@@ -48,14 +48,10 @@ impl Avx2Kernel {
         if nt == 0 {
             return true;
         }
-        if let (Arithmetic::I16, SampleSlice::Ci8(x)) = (arithmetic, samples) {
-            let nco = CodeNco::new(state, fs_hz, taps);
-            if let Some(plan) = avx2_ci8::Ci8Plan::new(&nco, nt) {
-                let carrier = CarrierNco::new(state, fs_hz);
-                // SAFETY: `self` exists only if the CPU check of `new` passed.
-                unsafe { avx2_ci8::correlate(x, code, &nco, &carrier, &plan, out) };
-                return true;
-            }
+        if arithmetic == Arithmetic::I16
+            && self.correlate_16_lanes(samples, fs_hz, code, state, taps, out)
+        {
+            return true;
         }
         let Some(job) = Job::<L>::new(&samples, fs_hz, code, state, taps, CF32_ORDER) else {
             return false;
@@ -63,6 +59,49 @@ impl Avx2Kernel {
         // SAFETY (every kernel call): `self` exists only if the CPU check of `new` passed; the
         // pointer and length come from one slice of the named format.
         unsafe { dispatch!(arithmetic, samples, nt, &job, out) };
+        true
+    }
+}
+
+impl Avx2Kernel {
+    /// The 16-lane int16 kernel ([`avx2_i16`]) on ci8 or ci16 samples; `false` (nothing
+    /// written) for cf32 or a code step too large for its code window.
+    pub(super) fn correlate_16_lanes(
+        self,
+        samples: SampleSlice<'_>,
+        fs_hz: f64,
+        code: &PackedCode,
+        state: &ReplicaState,
+        taps: &[f64],
+        out: &mut [Complex32],
+    ) -> bool {
+        let nco = CodeNco::new(state, fs_hz, taps);
+        let carrier = CarrierNco::new(state, fs_hz);
+        // SAFETY (both calls): `self` exists only if the CPU check of `new` passed; pointer
+        // and length come from one slice of the named format.
+        match samples {
+            SampleSlice::Ci8(x) => {
+                let Some(plan) = avx2_i16::Plan16::new::<CI8>(&nco, taps.len()) else {
+                    return false;
+                };
+                let sh = avx2_i16::CI8_SHIFT;
+                let p = x.as_ptr().cast();
+                unsafe {
+                    avx2_i16::correlate::<CI8>(p, x.len(), sh, code, &nco, &carrier, &plan, out)
+                };
+            }
+            SampleSlice::Ci16(x) => {
+                let Some(plan) = avx2_i16::Plan16::new::<CI16>(&nco, taps.len()) else {
+                    return false;
+                };
+                let sh = unsafe { avx2_i16::ci16_block_shift(x) };
+                let p = x.as_ptr().cast();
+                unsafe {
+                    avx2_i16::correlate::<CI16>(p, x.len(), sh, code, &nco, &carrier, &plan, out)
+                };
+            }
+            SampleSlice::Cf32(_) => return false,
+        }
         true
     }
 }

@@ -7,12 +7,14 @@
 //!
 //! The AVX-512 intrinsics are stable since Rust 1.89 (the workspace's `rust-version`).
 
+use super::avx2::Avx2Kernel;
 use super::kernel::{Arithmetic, SampleSlice};
 use super::packed::PackedCode;
-use super::plan::{code_window, CarrierNco, CODE_LEN_FIX, RESEED_STEPS};
+use super::plan::{code_window, CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
 use super::scalar::Q14;
 use super::simd::{by_taps, bytes_per_sample, dispatch, step_ptr, tail_copy, Job, CF32, CI16, CI8};
 use super::ReplicaState;
+use super::{avx2_i16, avx512_i16};
 use num_complex::Complex32;
 use std::arch::x86_64::*;
 
@@ -21,18 +23,93 @@ const L: usize = 16;
 const CF32_ORDER: [usize; L] = [0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15];
 
 /// Proof that the CPU runs AVX-512 F and BW (and AVX2, FMA): only [`Avx512Kernel::new`]
-/// makes one.
+/// makes one; `vnni` records whether it also runs AVX-512 VNNI (the 32-lane int16 kernel).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Avx512Kernel(());
+pub(crate) struct Avx512Kernel {
+    vnni: bool,
+    avx2: Avx2Kernel,
+}
 
 impl Avx512Kernel {
     /// The kernel if this CPU has AVX-512 F and BW, AVX2 and FMA.
     pub fn new() -> Option<Self> {
-        (is_x86_feature_detected!("avx512f")
-            && is_x86_feature_detected!("avx512bw")
-            && is_x86_feature_detected!("avx2")
-            && is_x86_feature_detected!("fma"))
-        .then_some(Self(()))
+        let avx2 = Avx2Kernel::new()?;
+        (is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512bw")).then_some(
+            Self {
+                vnni: is_x86_feature_detected!("avx512vnni"),
+                avx2,
+            },
+        )
+    }
+
+    /// Whether the int16 arithmetic runs the 32-lane kernel ([`avx512_i16`], AVX-512 VNNI)
+    /// where the sampling rate allows; without VNNI it runs the AVX2 16-lane one.
+    pub fn has_vnni(self) -> bool {
+        self.vnni
+    }
+
+    /// The int16 kernels on ci8 or ci16: 32 lanes (with VNNI, `fs` above about 2.2 MHz),
+    /// else the AVX2 16-lane kernel (above about 1.1 MHz); `false` (nothing written) if
+    /// neither applies.
+    fn correlate_int16_lanes(
+        self,
+        samples: SampleSlice<'_>,
+        fs_hz: f64,
+        code: &PackedCode,
+        state: &ReplicaState,
+        taps: &[f64],
+        out: &mut [Complex32],
+    ) -> bool {
+        if self.vnni {
+            let nco = CodeNco::new(state, fs_hz, taps);
+            let carrier = CarrierNco::new(state, fs_hz);
+            let nt = taps.len();
+            // SAFETY (every call): `self.vnni` is set only if the CPU has AVX-512 VNNI, and
+            // `self` only exists if it has AVX-512 F, BW, AVX2 and FMA; pointer and length
+            // come from one slice of the named format.
+            match samples {
+                SampleSlice::Ci8(x) => {
+                    if let Some(plan) = avx512_i16::Plan32::new::<CI8>(&nco, nt) {
+                        let (p, sh) = (x.as_ptr().cast(), avx2_i16::CI8_SHIFT);
+                        unsafe {
+                            avx512_i16::correlate::<CI8>(
+                                p,
+                                x.len(),
+                                sh,
+                                code,
+                                &nco,
+                                &carrier,
+                                &plan,
+                                out,
+                            )
+                        };
+                        return true;
+                    }
+                }
+                SampleSlice::Ci16(x) => {
+                    if let Some(plan) = avx512_i16::Plan32::new::<CI16>(&nco, nt) {
+                        let p = x.as_ptr().cast();
+                        unsafe {
+                            let sh = avx2_i16::ci16_block_shift(x);
+                            avx512_i16::correlate::<CI16>(
+                                p,
+                                x.len(),
+                                sh,
+                                code,
+                                &nco,
+                                &carrier,
+                                &plan,
+                                out,
+                            )
+                        };
+                        return true;
+                    }
+                }
+                SampleSlice::Cf32(_) => return false,
+            }
+        }
+        self.avx2
+            .correlate_16_lanes(samples, fs_hz, code, state, taps, out)
     }
 
     /// Runs the kernel for `taps.len()` (1..=8) taps; `false` (nothing written) if the code
@@ -50,6 +127,11 @@ impl Avx512Kernel {
     ) -> bool {
         let nt = taps.len();
         if nt == 0 {
+            return true;
+        }
+        if arithmetic == Arithmetic::I16
+            && self.correlate_int16_lanes(samples, fs_hz, code, state, taps, out)
+        {
             return true;
         }
         let Some(job) = Job::<L>::new(&samples, fs_hz, code, state, taps, CF32_ORDER) else {

@@ -70,6 +70,13 @@ impl Isa {
     }
 }
 
+/// The sampling rate from which the 16-lane int16 kernels surely take a block: 16 samples
+/// within 14 chips at the nominal chip rate (code Doppler and the taps' fractions can move the
+/// real limit by a few kHz; below it they fall back to the 8-lane kernels, as they say).
+const INT16_LANES_16_FS_HZ: f64 = 1.1e6;
+/// The same for the 32-lane AVX-512 int16 kernel: 32 samples within 14 chips.
+const INT16_LANES_32_FS_HZ: f64 = 2.27e6;
+
 /// Arithmetic of a kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Arithmetic {
@@ -81,20 +88,22 @@ pub enum Arithmetic {
     /// (|w| <= 2^22) are summed as they are; ci16 products are first rounded to multiples of
     /// 2^8 (`(w + 128) >> 8`, at most 2^-7 sample units per sample) to stay within 2^22; the
     /// i32 lane sums are flushed to i64 every 256 vector steps, so nothing overflows. The
-    /// AVX2 kernel on ci8 (above about 1.1 MHz) works in 16-bit lanes instead: each product
-    /// `I c`, `Q s` is rounded to 2^-7 sample (`vpmulhrsw`), so a wiped sample is off by at
-    /// most `2^-7 sqrt 2` sample units, as with ci16; then `vpmaddwd` with the +-1 code sums
-    /// exactly. At a constant frequency 3 of every 4 of its carrier vectors are the previous
-    /// one rotated in i16, which bounds its carrier error by `4.1e-4` (relative, instead of
-    /// `4.3e-5`). These roundings are far below the noise of any real recording (2^-7 against
-    /// a noise sigma of about 1 or more sample units, -68 dB: < 1e-3 dB of loss). The scalar I16 kernel uses the
-    /// table carrier in Q14 and i64 sums. Cf32 input has no integer scale to quantise to: with
-    /// it, an I16 correlator runs the F32 kernel of the same ISA.
+    /// int16-lane kernels on ci8 and ci16 (AVX2: 16 samples per step above about 1.1 MHz;
+    /// AVX-512 with VNNI: 32 above about 2.27 MHz) work in 16-bit lanes instead: each product
+    /// `I c`, `Q s` is rounded to `2^-sh` sample (`vpmulhrsw`), `sh = 8` for ci8 and the
+    /// block's headroom for ci16 (so `2^-15` of the block's largest sample), a wiped sample
+    /// off by at most `2^(1 - sh) sqrt 2`; then `vpmaddwd` / `vpdpwssd` with the +-1 code sum
+    /// exactly. At a constant frequency 3 of every 4 of their carrier vectors are the previous
+    /// one rotated in i16, which bounds the carrier error by `4.1e-4` (relative, instead of
+    /// `4.3e-5`). These roundings are far below the noise of any real recording (-68 dB
+    /// against the noise: < 1e-3 dB of loss). The scalar I16 kernel uses the table carrier in
+    /// Q14 and i64 sums. Cf32 input has no integer scale to quantise to: with it, an I16
+    /// correlator runs the F32 kernel of the same ISA.
     I16,
-    /// The faster of the two for each block's format: I16 on ci8 where the CPU has AVX2 (the
-    /// AVX2 16-lane kernel, faster on ci8 than the AVX-512 ones too; its accuracy is I16's),
-    /// F32 on ci16 and cf32 and on a CPU without AVX2. Never listed by
-    /// [`Correlator::available`]: it picks among those.
+    /// The faster of the two for each block: I16 of the correlator's own ISA on ci8 and ci16
+    /// where the int16-lane kernels run (AVX2 or AVX-512, `fs` above about 1.1 MHz: about
+    /// twice the f32 kernels' speed; their accuracy is I16's), F32 on cf32, at lower rates and
+    /// on a CPU without AVX2. Never listed by [`Correlator::available`]: it picks among those.
     Auto,
 }
 
@@ -123,10 +132,6 @@ enum Kernel {
 pub struct Correlator {
     kernel: Kernel,
     arithmetic: Arithmetic,
-    /// The AVX2 kernel when the CPU has it and `kernel`'s ISA is AVX2 or wider: what
-    /// [`Arithmetic::Auto`] runs on ci8.
-    #[cfg(target_arch = "x86_64")]
-    avx2: Option<Avx2Kernel>,
 }
 
 impl Correlator {
@@ -146,8 +151,6 @@ impl Correlator {
             .unwrap_or(Self {
                 kernel: Kernel::Scalar,
                 arithmetic,
-                #[cfg(target_arch = "x86_64")]
-                avx2: None,
             })
     }
 
@@ -162,15 +165,7 @@ impl Correlator {
             #[cfg(not(target_arch = "x86_64"))]
             Isa::Avx2Fma | Isa::Avx512 => None,
         }?;
-        Some(Self {
-            kernel,
-            arithmetic,
-            #[cfg(target_arch = "x86_64")]
-            avx2: match kernel {
-                Kernel::Scalar => None,
-                _ => Avx2Kernel::new(),
-            },
-        })
+        Some(Self { kernel, arithmetic })
     }
 
     /// Every kernel this CPU runs, scalar first.
@@ -207,36 +202,54 @@ impl Correlator {
     }
 
     /// The kernel that actually runs on `format` (`"ci8"`, `"ci16"` or `"cf32"`) at `fs_hz`,
-    /// e.g. `"avx2+fma/i16 (16 lanes)"`: an I16 correlator runs the F32 kernel on cf32, and
-    /// the AVX2 I16 one has a 16-lane kernel for ci8 from about 1.1 MHz.
+    /// e.g. `"avx2+fma/i16 (16 lanes)"`: an I16 correlator runs the F32 kernel on cf32, the
+    /// int16-lane kernels take ci8 and ci16 from about 1.1 MHz (AVX2, 16 lanes; AVX-512 with
+    /// VNNI from about 2.27 MHz, 32 lanes, else the AVX2 one), and [`Arithmetic::Auto`]
+    /// resolves as [`Arithmetic::Auto`] says.
     pub fn kernel_for(&self, format: &str, fs_hz: f64) -> String {
-        let (isa, arithmetic) = match (self.arithmetic, format) {
-            (Arithmetic::I16, "cf32") => (self.isa(), Arithmetic::F32),
-            (Arithmetic::Auto, "ci8") if self.isa() >= Isa::Avx2Fma => {
-                (Isa::Avx2Fma, Arithmetic::I16)
+        let integer = matches!(format, "ci8" | "ci16");
+        let arithmetic = self.resolve_arithmetic(integer, fs_hz);
+        let (isa, lanes) = match (self.isa(), arithmetic) {
+            (Isa::Scalar, _) => (Isa::Scalar, ""),
+            (isa, Arithmetic::I16) if integer && fs_hz >= INT16_LANES_16_FS_HZ => {
+                match self.kernel {
+                    #[cfg(target_arch = "x86_64")]
+                    Kernel::Avx512(k) if k.has_vnni() && fs_hz >= INT16_LANES_32_FS_HZ => {
+                        (Isa::Avx512, " (32 lanes)")
+                    }
+                    _ => (isa.min(Isa::Avx2Fma), " (16 lanes)"),
+                }
             }
-            (Arithmetic::Auto, _) => (self.isa(), Arithmetic::F32),
-            (a, _) => (self.isa(), a),
+            (Isa::Avx2Fma, _) => (Isa::Avx2Fma, " (8 lanes)"),
+            (isa, _) => (isa, " (16 lanes)"),
         };
-        let lanes = match (isa, arithmetic, format) {
-            (Isa::Scalar, _, _) => "",
-            (Isa::Avx2Fma, Arithmetic::I16, "ci8") if fs_hz >= 1.1e6 => " (16 lanes)",
-            (Isa::Avx2Fma, _, _) => " (8 lanes)",
-            (Isa::Avx512, _, _) => " (16 lanes)",
+        let arithmetic = match (arithmetic, format) {
+            (Arithmetic::I16, "cf32") => Arithmetic::F32,
+            (a, _) => a,
         };
         format!("{}/{}{lanes}", isa.name(), arithmetic.name())
     }
 
-    /// The kernel and arithmetic a block of `samples` runs ([`Arithmetic::Auto`] resolved).
-    fn resolve(&self, samples: &SampleSlice<'_>) -> (Kernel, Arithmetic) {
-        match (self.arithmetic, samples) {
-            #[cfg(target_arch = "x86_64")]
-            (Arithmetic::Auto, SampleSlice::Ci8(_)) => match self.avx2 {
-                Some(k) => (Kernel::Avx2(k), Arithmetic::I16),
-                None => (self.kernel, Arithmetic::F32),
-            },
-            (Arithmetic::Auto, _) => (self.kernel, Arithmetic::F32),
-            (a, _) => (self.kernel, a),
+    /// The explicit correlator (no [`Arithmetic::Auto`]) that runs blocks of `format`
+    /// (`"ci8"`, `"ci16"` or `"cf32"`) at `fs_hz`: this one with its arithmetic resolved.
+    pub fn resolved_for(&self, format: &str, fs_hz: f64) -> Correlator {
+        let integer = matches!(format, "ci8" | "ci16");
+        Correlator {
+            kernel: self.kernel,
+            arithmetic: self.resolve_arithmetic(integer, fs_hz),
+        }
+    }
+
+    /// The arithmetic a block runs ([`Arithmetic::Auto`] resolved): `integer` for ci8 / ci16.
+    fn resolve_arithmetic(&self, integer: bool, fs_hz: f64) -> Arithmetic {
+        match self.arithmetic {
+            Arithmetic::Auto
+                if integer && self.isa() >= Isa::Avx2Fma && fs_hz >= INT16_LANES_16_FS_HZ =>
+            {
+                Arithmetic::I16
+            }
+            Arithmetic::Auto => Arithmetic::F32,
+            a => a,
         }
     }
 
@@ -278,7 +291,8 @@ impl Correlator {
             out.fill(Complex32::new(f32::NAN, f32::NAN));
             return;
         }
-        let (kernel, arithmetic) = self.resolve(&samples);
+        let integer = !matches!(samples, SampleSlice::Cf32(_));
+        let (kernel, arithmetic) = (self.kernel, self.resolve_arithmetic(integer, fs_hz));
         for (taps, out) in tap_offsets_chips
             .chunks(MAX_TAPS)
             .zip(out.chunks_mut(MAX_TAPS))

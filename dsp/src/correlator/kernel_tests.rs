@@ -15,7 +15,9 @@
 //!   units, `2^-7 sqrt 2` sample units per sample; the AVX2 16-lane ci8 kernel rounds each
 //!   of the two products of a component to 2^-7 sample (`vpmulhrsw`), also at most
 //!   `2^-7 sqrt 2` per sample, and its carrier, rotated in i16 between f32 steps, is off by
-//!   at most `4.1e-4` relative (avx2_ci8 module doc);
+//!   at most `4.1e-4` relative (avx2_i16 module doc); the int16-lane kernels on ci16 round
+//!   each product to `2^-sh` sample with `sh` the block's headroom (int16_lanes module doc),
+//!   at most `2^(1 - sh) sqrt 2` per sample;
 //! - f32 accumulation: `n 2^-24` relative (worst case, sequential sums).
 
 use super::*;
@@ -112,8 +114,8 @@ fn reference(
 fn carrier_bound(c: &Correlator, fmt: Fmt) -> f64 {
     let base = if c.isa() == Isa::Scalar { 7.7e-4 } else { 2e-4 };
     match (c.isa(), c.arithmetic(), fmt) {
-        // The 16-lane ci8 kernel rotates 3 of 4 carrier vectors in i16 (avx2_ci8 module doc).
-        (Isa::Avx2Fma, Arithmetic::I16, Fmt::Ci8) => base + 4.1e-4,
+        // The int16-lane kernels rotate 3 of 4 carrier vectors in i16 (avx2_i16 module doc).
+        (Isa::Avx2Fma | Isa::Avx512, Arithmetic::I16, Fmt::Ci8 | Fmt::Ci16) => base + 4.1e-4,
         (_, Arithmetic::I16, Fmt::Ci16 | Fmt::Ci8) => base + 4.5e-5,
         _ => base,
     }
@@ -154,16 +156,31 @@ fn random_case(rng: &mut StdRng, n: usize) -> Case {
     }
 }
 
+/// The headroom shift of a ci16 block as the int16-lane kernels take it (int16_lanes module
+/// doc), found by trial: the largest `sh <= 15` with every `|v| < 2^(15 - sh)` (`|v|` of
+/// -32768 read as 32768: then 0).
+fn headroom_shift(x: &[(f64, f64)]) -> i32 {
+    let m = x
+        .iter()
+        .fold(0.0f64, |m, &(r, i)| m.max(r.abs()).max(i.abs()));
+    (0..=15)
+        .rev()
+        .find(|&sh| m < 2f64.powi(15 - sh))
+        .unwrap_or(0)
+}
+
 /// The absolute rounding allowance of the integer kernels that round the wiped samples
-/// (module doc): `2^-7 sqrt 2` sample units per sample.
-fn rounding_allowance(c: &Correlator, fmt: Fmt, n: usize) -> f64 {
-    let rounds = c.arithmetic() == Arithmetic::I16
-        && (fmt == Fmt::Ci16 || (fmt == Fmt::Ci8 && c.isa() == Isa::Avx2Fma));
-    if rounds {
-        n as f64 * 2f64.powi(-7) * 2f64.sqrt()
-    } else {
-        0.0
-    }
+/// (module doc): `2^-7 sqrt 2` sample units per sample, on ci16 with the int16-lane kernels
+/// `2^(1 - sh) sqrt 2` if that is more.
+fn rounding_allowance(c: &Correlator, fmt: Fmt, x: &[(f64, f64)]) -> f64 {
+    let simd = c.isa() != Isa::Scalar;
+    let per_sample = match (c.arithmetic(), fmt) {
+        (Arithmetic::I16, Fmt::Ci16) if simd => 2f64.powi(-7).max(2f64.powi(1 - headroom_shift(x))),
+        (Arithmetic::I16, Fmt::Ci16) => 2f64.powi(-7),
+        (Arithmetic::I16, Fmt::Ci8) if simd => 2f64.powi(-7),
+        _ => 0.0,
+    };
+    x.len() as f64 * per_sample * 2f64.sqrt()
 }
 
 fn check(c: &Correlator, fmt: Fmt, x: SampleSlice<'_>, code: &CaCode, case: &Case) -> f64 {
@@ -182,7 +199,7 @@ fn check(c: &Correlator, fmt: Fmt, x: SampleSlice<'_>, code: &CaCode, case: &Cas
         &mut scalar,
     );
     let rel = carrier_bound(c, fmt) + n as f64 * 6e-8;
-    let ci16_round = rounding_allowance(c, fmt, n);
+    let ci16_round = rounding_allowance(c, fmt, &xf);
     let mut worst = 0.0f64;
     for ((o, sc), &d) in out.iter().zip(&scalar).zip(&case.taps) {
         let ((re, im), edge, _) = reference(&xf, case.fs, code.chips(), &case.state, d);
@@ -314,11 +331,17 @@ fn carrier_free_replica_gives_the_exact_integer_sum() {
                 c.correlate(x, fs, code.chips(), &state, &taps, &mut out);
                 for (o, &(re, im)) in out.iter().zip(&exact) {
                     // Integer sums below 2^24 are exact in f32; ci16 sums are larger, and the
-                    // f32 lane sums round: allow the f32 rounding of the lane sums.
+                    // f32 lane sums round: allow the f32 rounding of the lane sums. The
+                    // int16-lane kernels on full-scale ci16 (headroom shift 0) work in units
+                    // of 2 samples: an odd component is off by 1 (int16_lanes module doc).
                     let tol = if fmt == Fmt::Ci8 && c.arithmetic() == Arithmetic::F32 {
                         0.0
                     } else {
-                        (re.abs() + im.abs() + 32768.0 * n as f64) * 2e-7
+                        let halves = match (c.arithmetic(), headroom_shift(&xf)) {
+                            (Arithmetic::I16, 0) if fmt == Fmt::Ci16 => n as f64,
+                            _ => 0.0,
+                        };
+                        (re.abs() + im.abs() + 32768.0 * n as f64) * 2e-7 + halves
                     };
                     assert!(
                         (f64::from(o.re) - re).abs() <= tol && (f64::from(o.im) - im).abs() <= tol,
@@ -444,36 +467,52 @@ fn meaningless_states_give_nan_not_a_panic() {
     }
 }
 
-/// The AVX2 int16 ci8 correlator, if this CPU runs it.
-fn avx2_i16() -> Option<Correlator> {
-    Correlator::new(Isa::Avx2Fma, Arithmetic::I16)
+/// The SIMD int16 correlators this CPU runs (the int16-lane kernels: AVX2 16 lanes, AVX-512
+/// 32 lanes).
+fn simd_i16() -> Vec<Correlator> {
+    [Isa::Avx2Fma, Isa::Avx512]
+        .into_iter()
+        .filter_map(|isa| Correlator::new(isa, Arithmetic::I16))
+        .collect()
+}
+
+/// ci16 samples with headroom (the ci8 values times 16: shift 4), on which the int16-lane
+/// kernels' carrier-free sums are exact.
+fn ci16_with_headroom(x: &[[i8; 2]]) -> Vec<[i16; 2]> {
+    x.iter()
+        .map(|&[i, q]| [i16::from(i) * 16, i16::from(q) * 16])
+        .collect()
 }
 
 #[test]
-fn avx2_i16_ci8_kernel_matches_the_references_from_1p1_to_40_mhz() {
-    // The 16-lane kernel (16 chips per window) runs from about 1.1 MHz up; below, the 8-lane
-    // kernel. Log-uniform rates over the whole range, every tap count (9 and 10: two chunks),
-    // block lengths around the 16-sample step and past the 4096-sample flush/re-seed.
-    let Some(c) = avx2_i16() else {
-        println!("no AVX2: nothing to test");
-        return;
-    };
+fn int16_lane_kernels_match_the_references_from_1p1_to_40_mhz() {
+    // The 16-lane (AVX2) and 32-lane (AVX-512) kernels (16 chips per window) run from about
+    // 1.1 and 2.27 MHz up; below, the 8- or 16-lane i32 kernels. Log-uniform rates over the
+    // whole range, every tap count (9 and 10: two chunks), block lengths around the vector
+    // steps and past the 8192-sample flush/re-seed, ci8 and full-scale ci16.
+    let kernels = simd_i16();
     let mut rng = StdRng::seed_from_u64(1640);
     let code = CaCode::new(Prn::new(24).unwrap_or_else(|e| panic!("{e}")));
-    let mut worst = 0.0f64;
-    for &n in &[1usize, 15, 16, 17, 255, 4095, 4096, 4113, 9000] {
-        let block = Block::random(&mut rng, n + 3);
-        for taps in 1..=10usize {
-            let mut case = random_case(&mut rng, n);
-            case.fs = (rng.random_range(1.1e6f64.ln()..40e6f64.ln())).exp();
-            case.state.carrier_freq_hz = rng.random_range(-0.3..0.3) * case.fs;
-            case.taps = (0..taps).map(|_| rng.random_range(-2.5..2.5)).collect();
-            let offset = rng.random_range(0..=3usize);
-            let x = block.slice(Fmt::Ci8, offset..offset + n);
-            worst = worst.max(check(&c, Fmt::Ci8, x, &code, &case));
+    for c in &kernels {
+        let mut worst = 0.0f64;
+        for &n in &[
+            1usize, 15, 16, 17, 31, 33, 255, 4095, 4096, 4113, 8192, 8200, 9000,
+        ] {
+            let block = Block::random(&mut rng, n + 3);
+            for taps in 1..=10usize {
+                let mut case = random_case(&mut rng, n);
+                case.fs = (rng.random_range(1.1e6f64.ln()..40e6f64.ln())).exp();
+                case.state.carrier_freq_hz = rng.random_range(-0.3..0.3) * case.fs;
+                case.taps = (0..taps).map(|_| rng.random_range(-2.5..2.5)).collect();
+                let offset = rng.random_range(0..=3usize);
+                for fmt in [Fmt::Ci8, Fmt::Ci16] {
+                    let x = block.slice(fmt, offset..offset + n);
+                    worst = worst.max(check(c, fmt, x, &code, &case));
+                }
+            }
         }
+        println!("{}: worst |err - edge| / sum|x| = {worst:.2e}", c.name());
     }
-    println!("avx2+fma/i16 ci8: worst |err - edge| / sum|x| = {worst:.2e}");
 }
 
 /// `sum_k x[k] code(p(k) >> 32)` with the fixed-point code NCO (no carrier), exact in f64.
@@ -493,48 +532,48 @@ fn integer_sum(x: &[[i8; 2]], fs: f64, code: &CaCode, s: &ReplicaState, d: f64) 
 }
 
 #[test]
-fn avx2_i16_ci8_kernel_and_its_fallback_pick_the_chips_exactly() {
-    // Carrier-free (the Q14 carrier is exactly 2^14, the Q7 products exact): the output must be
-    // the exact integer sum, on both sides of the 16-lane kernel's limit (16 samples within 16
-    // chips, about 1.1 MHz) and at the common front-end rates 4.092 and 16.368 MHz (S a
-    // simple fraction of 2^32: several lanes share a threshold).
-    let Some(c) = avx2_i16() else {
-        return;
-    };
+fn int16_lane_kernels_and_their_fallbacks_pick_the_chips_exactly() {
+    // Carrier-free (the Q14 carrier is exactly 2^14, the products exact at a headroom shift
+    // of 1 or more): the output must be the exact integer sum, on ci8 and on ci16 with
+    // headroom, on both sides of the 16- and 32-lane kernels' limits (about 1.1 and 2.2 MHz)
+    // and at the common front-end rates 4.092 and 16.368 MHz (S a simple fraction of 2^32:
+    // several lanes share a threshold).
     let mut rng = StdRng::seed_from_u64(99);
     let code = CaCode::new(Prn::new(5).unwrap_or_else(|e| panic!("{e}")));
-    for fs in [
-        0.7e6, 1.0e6, 1.07e6, 1.1e6, 1.2e6, 2.046e6, 4.092e6, 16.368e6, 40e6,
-    ] {
-        for _ in 0..6 {
-            let n = rng.random_range(1..5000usize);
-            let block = Block::random(&mut rng, n);
-            let state = ReplicaState {
-                code_phase_chips: rng.random_range(-1023.0..2046.0),
-                code_rate_chips_s: 1.023e6 + [0.0, rng.random_range(-10.0..10.0)][n % 2],
-                carrier_phase_cycles: 0.0,
-                carrier_freq_hz: 0.0,
-                carrier_rate_hz_s: 0.0,
-            };
-            let taps: Vec<f64> = (0..rng.random_range(1..=8))
-                .map(|_| rng.random_range(-3.0..3.0))
-                .collect();
-            let mut out = vec![Complex32::new(0.0, 0.0); taps.len()];
-            c.correlate(
-                SampleSlice::Ci8(&block.ci8),
-                fs,
-                code.chips(),
-                &state,
-                &taps,
-                &mut out,
-            );
-            for (o, &d) in out.iter().zip(&taps) {
-                let (re, im) = integer_sum(&block.ci8, fs, &code, &state, d);
-                assert_eq!(
-                    (f64::from(o.re), f64::from(o.im)),
-                    (re, im),
-                    "fs {fs} n {n} tap {d}"
-                );
+    for c in simd_i16() {
+        for fs in [
+            0.7e6, 1.0e6, 1.07e6, 1.1e6, 1.2e6, 2.046e6, 2.2e6, 2.3e6, 4.092e6, 16.368e6, 40e6,
+        ] {
+            for _ in 0..6 {
+                let n = rng.random_range(1..5000usize);
+                let block = Block::random(&mut rng, n);
+                let ci16 = ci16_with_headroom(&block.ci8);
+                let state = ReplicaState {
+                    code_phase_chips: rng.random_range(-1023.0..2046.0),
+                    code_rate_chips_s: 1.023e6 + [0.0, rng.random_range(-10.0..10.0)][n % 2],
+                    carrier_phase_cycles: 0.0,
+                    carrier_freq_hz: 0.0,
+                    carrier_rate_hz_s: 0.0,
+                };
+                let taps: Vec<f64> = (0..rng.random_range(1..=8))
+                    .map(|_| rng.random_range(-3.0..3.0))
+                    .collect();
+                for (scale, x) in [
+                    (1.0, SampleSlice::Ci8(&block.ci8)),
+                    (16.0, SampleSlice::Ci16(&ci16)),
+                ] {
+                    let mut out = vec![Complex32::new(0.0, 0.0); taps.len()];
+                    c.correlate(x, fs, code.chips(), &state, &taps, &mut out);
+                    for (o, &d) in out.iter().zip(&taps) {
+                        let (re, im) = integer_sum(&block.ci8, fs, &code, &state, d);
+                        assert_eq!(
+                            (f64::from(o.re), f64::from(o.im)),
+                            (re * scale, im * scale),
+                            "{} {x:?} fs {fs} n {n} tap {d}",
+                            c.name()
+                        );
+                    }
+                }
             }
         }
     }
@@ -547,10 +586,10 @@ mod prop {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
 
-        /// The carrier-free sums of the AVX2 int16 kernel on ci8 are exact for any code phase,
-        /// rate, taps and block length.
+        /// The carrier-free sums of the int16-lane kernels on ci8 and on ci16 with headroom
+        /// are exact for any code phase, rate, taps and block length.
         #[test]
-        fn avx2_i16_ci8_carrier_free_sums_are_exact(
+        fn int16_lane_carrier_free_sums_are_exact(
             seed in any::<u64>(),
             n in 1usize..2500,
             fs in 1.0e6f64..40e6,
@@ -558,7 +597,6 @@ mod prop {
             doppler in -10.0f64..10.0,
             taps in proptest::collection::vec(-3.0f64..3.0, 1..=8),
         ) {
-            let Some(c) = avx2_i16() else { return Ok(()) };
             let mut rng = StdRng::seed_from_u64(seed);
             let code = CaCode::new(Prn::new(11).unwrap_or_else(|e| panic!("{e}")));
             let block = Block::random(&mut rng, n);
@@ -569,11 +607,19 @@ mod prop {
                 carrier_freq_hz: 0.0,
                 carrier_rate_hz_s: 0.0,
             };
-            let mut out = vec![Complex32::new(0.0, 0.0); taps.len()];
-            c.correlate(SampleSlice::Ci8(&block.ci8), fs, code.chips(), &state, &taps, &mut out);
-            for (o, &d) in out.iter().zip(&taps) {
-                let (re, im) = integer_sum(&block.ci8, fs, &code, &state, d);
-                prop_assert_eq!((f64::from(o.re), f64::from(o.im)), (re, im));
+            let ci16 = ci16_with_headroom(&block.ci8);
+            for c in simd_i16() {
+                for (scale, x) in [
+                    (1.0, SampleSlice::Ci8(&block.ci8)),
+                    (16.0, SampleSlice::Ci16(&ci16)),
+                ] {
+                    let mut out = vec![Complex32::new(0.0, 0.0); taps.len()];
+                    c.correlate(x, fs, code.chips(), &state, &taps, &mut out);
+                    for (o, &d) in out.iter().zip(&taps) {
+                        let (re, im) = integer_sum(&block.ci8, fs, &code, &state, d);
+                        prop_assert_eq!((f64::from(o.re), f64::from(o.im)), (re * scale, im * scale));
+                    }
+                }
             }
         }
     }
@@ -581,40 +627,68 @@ mod prop {
 
 #[test]
 fn auto_arithmetic_runs_the_faster_kernel_of_each_format() {
-    // Auto = I16 on ci8 with the AVX2 kernel when the CPU has AVX2 (whatever the ISA ceiling
-    // above it), F32 of the correlator's own ISA on ci16 and cf32: bit-identical outputs.
+    // Auto = I16 of the correlator's own ISA on ci8 and ci16 where the int16-lane kernels run
+    // (AVX2 or wider, fs >= 1.1 MHz), F32 otherwise (cf32, lower rates, scalar):
+    // bit-identical outputs to the explicit kernel, and the same name for what runs.
     let mut rng = StdRng::seed_from_u64(404);
     let code = CaCode::new(Prn::new(8).unwrap_or_else(|e| panic!("{e}")));
     let block = Block::random(&mut rng, 3001);
-    let case = random_case(&mut rng, 3001);
-    for isa in Isa::ALL.into_iter().filter(|i| i.is_available()) {
-        let auto = Correlator::best_up_to(isa, Arithmetic::Auto);
-        assert_eq!(auto.isa(), isa);
-        assert_eq!(auto.arithmetic(), Arithmetic::Auto);
-        assert!(!Correlator::available()
-            .iter()
-            .any(|c| c.arithmetic() == Arithmetic::Auto));
-        for fmt in [Fmt::Ci8, Fmt::Ci16, Fmt::Cf32] {
-            let explicit = match fmt {
-                Fmt::Ci8 if isa >= Isa::Avx2Fma => Correlator::new(Isa::Avx2Fma, Arithmetic::I16),
-                _ => Correlator::new(isa, Arithmetic::F32),
+    assert!(!Correlator::available()
+        .iter()
+        .any(|c| c.arithmetic() == Arithmetic::Auto));
+    for fs in [1.0e6, 2.048e6, 4.0e6, 16.368e6] {
+        let mut case = random_case(&mut rng, 3001);
+        case.fs = fs;
+        for isa in Isa::ALL.into_iter().filter(|i| i.is_available()) {
+            let auto = Correlator::best_up_to(isa, Arithmetic::Auto);
+            assert_eq!(auto.isa(), isa);
+            assert_eq!(auto.arithmetic(), Arithmetic::Auto);
+            for fmt in [Fmt::Ci8, Fmt::Ci16, Fmt::Cf32] {
+                let int16 = fmt != Fmt::Cf32 && isa >= Isa::Avx2Fma && fs >= 1.1e6;
+                let arithmetic = if int16 {
+                    Arithmetic::I16
+                } else {
+                    Arithmetic::F32
+                };
+                let explicit = Correlator::new(isa, arithmetic)
+                    .unwrap_or_else(|| panic!("{isa:?} is available"));
+                let x = block.slice(fmt, 0..3001);
+                let mut a = vec![Complex32::new(0.0, 0.0); case.taps.len()];
+                let mut b = a.clone();
+                auto.correlate(x, case.fs, code.chips(), &case.state, &case.taps, &mut a);
+                explicit.correlate(x, case.fs, code.chips(), &case.state, &case.taps, &mut b);
+                assert_eq!(a, b, "{isa:?} {fmt:?} fs {fs}");
+                let name = match fmt {
+                    Fmt::Ci8 => "ci8",
+                    Fmt::Ci16 => "ci16",
+                    Fmt::Cf32 => "cf32",
+                };
+                assert_eq!(auto.resolved_for(name, fs).name(), explicit.name());
+                assert_eq!(auto.kernel_for(name, fs), explicit.kernel_for(name, fs));
             }
-            .unwrap_or_else(|| panic!("{isa:?} is available"));
-            let x = block.slice(fmt, 0..3001);
-            let mut a = vec![Complex32::new(0.0, 0.0); case.taps.len()];
-            let mut b = a.clone();
-            auto.correlate(x, case.fs, code.chips(), &case.state, &case.taps, &mut a);
-            explicit.correlate(x, case.fs, code.chips(), &case.state, &case.taps, &mut b);
-            assert_eq!(a, b, "{isa:?} {fmt:?}");
-            let name = match fmt {
-                Fmt::Ci8 => "ci8",
-                Fmt::Ci16 => "ci16",
-                Fmt::Cf32 => "cf32",
-            };
-            assert_eq!(
-                auto.kernel_for(name, case.fs),
-                explicit.kernel_for(name, case.fs)
-            );
         }
+    }
+}
+
+#[test]
+fn kernel_names_say_how_many_lanes_run() {
+    // The int16-lane kernels: AVX2 16 lanes from 1.1 MHz on ci8 and ci16; AVX-512 32 lanes
+    // from 2.27 MHz where the CPU has VNNI (else the AVX2 16-lane kernel); cf32 runs f32.
+    if let Some(c) = Correlator::new(Isa::Avx2Fma, Arithmetic::I16) {
+        assert_eq!(c.kernel_for("ci16", 4e6), "avx2+fma/i16 (16 lanes)");
+        assert_eq!(c.kernel_for("ci8", 1.0e6), "avx2+fma/i16 (8 lanes)");
+        assert_eq!(c.kernel_for("cf32", 4e6), "avx2+fma/f32 (8 lanes)");
+    }
+    #[cfg(target_arch = "x86_64")]
+    if let Some(c) = Correlator::new(Isa::Avx512, Arithmetic::I16) {
+        let wide = if std::arch::is_x86_feature_detected!("avx512vnni") {
+            "avx512/i16 (32 lanes)"
+        } else {
+            "avx2+fma/i16 (16 lanes)"
+        };
+        assert_eq!(c.kernel_for("ci8", 4e6), wide);
+        assert_eq!(c.kernel_for("ci16", 2.048e6), "avx2+fma/i16 (16 lanes)");
+        assert_eq!(c.kernel_for("ci16", 1.0e6), "avx512/i16 (16 lanes)");
+        assert_eq!(c.kernel_for("cf32", 4e6), "avx512/f32 (16 lanes)");
     }
 }

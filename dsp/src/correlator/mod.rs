@@ -15,9 +15,10 @@
 //!   the carrier with a vectorised rotator seeded exactly (f64) at the start of every call and
 //!   every 256 vector steps, and the code replicas from a bit-packed code ([`PackedCode`]) with
 //!   the same 2^-32-chip code NCO as the reference, so their chips agree with it exactly. The
-//!   AVX2 int16 kernel on ci8 works on 16 samples in 16-bit lanes (`vpmulhrsw` wipe-off, the
-//!   code looked up with `vpshufb` from a byte per chip): about 2.5 times fewer instructions
-//!   than the 8-lane kernels (6.0 per sample with 3 taps).
+//!   int16 kernels on ci8 and ci16 work in 16-bit lanes (`vpmulhrsw` wipe-off, ci16 scaled by
+//!   the block's headroom; the code looked up with `vpshufb` from a byte per chip): 16 samples
+//!   per step with AVX2, 32 with AVX-512 VNNI (`vpdpwssd`), about twice the speed of the f32
+//!   kernels ([`Arithmetic::Auto`] takes them on ci8 and ci16).
 //!
 //! Build a [`Correlator`] once (e.g. [`Correlator::best`]) and a [`PackedCode`] once per PRN,
 //! then call [`Correlator::correlate_packed`] per block: it allocates nothing.
@@ -32,9 +33,13 @@ mod simd;
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 #[cfg(target_arch = "x86_64")]
-mod avx2_ci8;
+mod avx2_i16;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
+#[cfg(target_arch = "x86_64")]
+mod avx512_i16;
+#[cfg(target_arch = "x86_64")]
+mod int16_lanes;
 
 #[cfg(test)]
 mod kernel_tests;

@@ -170,6 +170,9 @@ impl CarrierNco {
         scale: f64,
         stride: usize,
     ) -> Seed<L> {
+        if self.b == 0.0 {
+            return self.seed_constant(k0, order, scale, stride);
+        }
         let k = k0 as f64;
         let l = stride as f64;
         let mut p = cis_neg(self.phase(k)) * scale;
@@ -198,6 +201,44 @@ impl CarrierNco {
             s.p_im[j] = pn[o].im as f32;
             s.d_re[j] = dn[o].re as f32;
             s.d_im[j] = dn[o].im as f32;
+        }
+        s
+    }
+}
+
+impl CarrierNco {
+    /// [`CarrierNco::seed_stride`] at a constant frequency: `P_j = P_0 e^j` by four
+    /// interleaved recurrences (`P_{j+4} = P_j e^4`: a quarter of the serial chain of complex
+    /// products, which is what the seeding time is), every `D_j` the same.
+    fn seed_constant<const L: usize>(
+        &self,
+        k0: usize,
+        order: &[usize; L],
+        scale: f64,
+        stride: usize,
+    ) -> Seed<L> {
+        let p0 = cis_neg(self.phase(k0 as f64)) * scale;
+        let e = cis_neg(self.a);
+        let e2 = e * e;
+        let e4 = e2 * e2;
+        let d = cis_neg(stride as f64 * self.a);
+        let mut pn = [Complex64::new(0.0, 0.0); L];
+        let mut head = [p0, p0 * e, p0 * e2, p0 * e2 * e];
+        for chunk in pn.chunks_mut(4) {
+            for (pj, h) in chunk.iter_mut().zip(head.iter_mut()) {
+                *pj = *h;
+                *h *= e4;
+            }
+        }
+        let mut s = Seed {
+            p_re: [0.0; L],
+            p_im: [0.0; L],
+            d_re: [d.re as f32; L],
+            d_im: [d.im as f32; L],
+        };
+        for (j, &o) in order.iter().enumerate() {
+            s.p_re[j] = pn[o].re as f32;
+            s.p_im[j] = pn[o].im as f32;
         }
         s
     }

@@ -1,9 +1,11 @@
-//! The AVX2 int16 kernel for ci8 samples: 16 samples per vector step, in 16-bit lanes.
+//! The AVX2 int16 kernel for ci8 and ci16 samples: 16 samples per vector step, in 16-bit
+//! lanes (positions, code plan and scale: [`super::int16_lanes`]).
 //!
-//! Per step of 16 samples (one 32-byte load):
-//! - **Carrier** `c + j s ~ 2^14 exp(-j 2 pi phi)` in i16 lanes (Q14), sample order. The f32
-//!   rotator of [`super::plan`] (16 lanes as two vectors of 8, re-seeded exactly every 256
-//!   steps) gives it, converted and packed to i16 with `vpackssdw`, every step when the
+//! Per step of 16 samples (ci8: one 32-byte load; ci16: two, gathered into I and Q vectors
+//! with two `vpshufb` and two `vpunpck{l,h}qdq`, then shifted left by the block's headroom):
+//! - **Carrier** `c + j s ~ 2^14 exp(-j 2 pi phi)` in i16 lanes (Q14), in position order. The
+//!   f32 rotator of [`super::plan`] (16 lanes as two vectors of 8, re-seeded exactly every
+//!   256 steps) gives it, converted and packed to i16 with `vpackssdw`, every step when the
 //!   frequency ramps; at a constant frequency it steps [`GROUP`] = 4 vector steps at a time
 //!   and the 3 steps in between rotate the previous carrier by `E = exp(-j 2 pi 16 a)` in
 //!   Q15 with `vpmulhrsw` (6 ops instead of 14). Error of the i16 carrier, in units of
@@ -12,140 +14,156 @@
 //!   2^-15 = 0.56`, a component of 1 saturating to 32767): `<= 0.71 + 3 * 1.98 = 6.7`, i.e.
 //!   `4.1e-4` of the carrier's modulus (against `4.3e-5` for the rounding alone; still
 //!   -68 dB, nothing next to a sample's noise).
-//! - **Wipe-off** in i16 lanes. Each 16-bit lane of the load holds one sample,
+//! - **Wipe-off** in i16 lanes. ci8: each 16-bit lane of the load holds one sample,
 //!   `Q << 8 | I as u8`, so `I << 8` (`vpsllw`) and `Q << 8` (`vpand 0xFF00`) are the samples
-//!   times 2^8 with no shuffle, and `vpmulhrsw` (`(a b + 2^14) >> 15`) gives
-//!   `round(I c / 2^7)` etc.: `wr = I c - Q s`, `wi = I s + Q c` in units of 2^-7 sample
-//!   (Q7), each of the two products rounded to the nearest unit, so the wiped sample is off
-//!   by at most `2^-7` per component (`2^-7 sqrt 2` in modulus) besides the Q14 carrier.
-//!   `|w| <= 181 * 2^7 < 2^15`: no lane saturates.
-//! - **Code**, exactly as the 2^-32-chip NCO of [`super::plan`] picks the chips. Tap `t`'s
-//!   phase is the first tap's `B` plus a constant `Delta_t = W_t 2^32 + f_t` (both advance by
-//!   the same step, modulo the same period), so lane `j` of tap `t` reads chip
-//!   `floor(B / 2^32) + W_t + h_tj + carry_tj` with `l_tj = f_t + o_j S`, `h_tj = l_tj >> 32`
-//!   and `carry_tj = [B_lo + (l_tj mod 2^32) >= 2^32] = [B_lo >u !l_tj]`: one broadcast of
-//!   `B_lo` serves every tap, and the carry is one signed compare per 8 lanes after flipping
-//!   the sign bits. `vpackssdw` of the two compare masks lands in sample order, and a byte
-//!   subtract adds the carry to both bytes of the duplicated offset `h_tj * 0x0101`. A
-//!   `vpshufb` into the 16 code bytes at chip `floor(B / 2^32) + W_t` (`0x00` / `0xFF`,
-//!   [`PackedCode::chip_bytes`], broadcast to both 128-bit halves) then `| 1` gives the +-1
-//!   replica in i16 lanes; `vpmaddwd` with `wr` and `wi` multiplies and sums sample pairs
-//!   into 8 i32 lanes each.
+//!   times 2^8 with no shuffle. `vpmulhrsw` (`(a b + 2^14) >> 15`) gives `round(I c 2^(sh-1))`
+//!   etc.: `wr = I c - Q s`, `wi = I s + Q c` in units of `2^(1 - sh)` sample (2^-7 for ci8),
+//!   each of the two products rounded to the nearest unit.
+//! - **Code**: the 16 code bytes at the tap's chip, `vpshufb` by each lane's offset plus its
+//!   carry (two signed compares of 8 i32 lanes against the plan's thresholds, packed with
+//!   `vpackssdw`: they land where the carrier lanes do), `| 1`: the +-1 replica in i16 lanes;
+//!   `vpmaddwd` with `wr` and `wi` multiplies and sums sample pairs into 8 i32 lanes each.
 //! - Lane sums grow by at most `2 * 2^15` per step: flushed to i64 every 256 steps (with the
 //!   rotator's re-seed), far below 2^31.
 //!
-//! Needs every `h_tj <= 14` (16 chips cover the 16 lanes: `f_t + 15 S < 15 * 2^32`, a code
-//! step below 14/15 chip per sample, `fs` above about 1.1 MHz); otherwise [`Ci8Plan::new`]
+//! Needs 16 samples within 15 chips (`fs` above about 1.1 MHz); otherwise [`Plan16::new`]
 //! says no and the caller runs the 8-lane kernel.
 
+use super::int16_lanes::{
+    abs_shift, ci16_positions, ci8_positions, pack_position, rotator_order, w_unit, LanePlan,
+};
 use super::packed::PackedCode;
 use super::plan::{CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
 use super::scalar::Q14;
-use super::simd::{step_ptr, tail_copy};
-use super::MAX_TAPS;
+use super::simd::{step_ptr, tail_copy, CI16, CI8};
 use num_complex::Complex32;
 use std::arch::x86_64::*;
 
 const L: usize = 16;
-/// Sample of each rotator / compare lane: vector A is lanes 0..8, vector B lanes 8..16;
-/// `vpackssdw(A, B)` interleaves their 128-bit halves, so the packed i16 lanes come out in
-/// sample order 0..16.
-const ORDER: [usize; L] = [0, 1, 2, 3, 8, 9, 10, 11, 4, 5, 6, 7, 12, 13, 14, 15];
-/// The largest chip offset `h_tj` a 16-byte code window allows (the carry adds one).
-const MAX_OFFSET: u64 = 14;
 /// Vector steps per f32 rotator step at a constant frequency (module doc).
 const GROUP: usize = 4;
-/// Wiped samples are in units of 2^-7 sample.
-const W_UNIT: f64 = 1.0 / 128.0;
 
-/// The per-call code constants of every tap (module doc): compare thresholds
-/// `!l_tj ^ 2^31` (vectors A and B), duplicated offsets `h_tj * 0x0101` in sample order, and
-/// the whole-chip offset `W_t`.
-pub(super) struct Ci8Plan {
-    thr: [[i32; L]; MAX_TAPS],
-    hi_dup: [[i16; L]; MAX_TAPS],
-    whole: [usize; MAX_TAPS],
+/// The code plan of the 16-lane kernel and the lane order of its samples.
+pub(super) struct Plan16 {
+    code: LanePlan<L>,
+    /// The sample each rotator lane (A then B) is seeded at.
+    rotator: [usize; L],
 }
 
-impl Ci8Plan {
-    /// The plan for the taps of `nco` (`n_taps` of them), or `None` if some lane lies 16 or
-    /// more chips past its tap's window.
-    pub(super) fn new(nco: &CodeNco, n_taps: usize) -> Option<Self> {
-        let mut plan = Self {
-            thr: [[0; L]; MAX_TAPS],
-            hi_dup: [[0; L]; MAX_TAPS],
-            whole: [0; MAX_TAPS],
+impl Plan16 {
+    /// The plan for the taps of `nco` (`n_taps`) on samples of format `F` (ci8 or ci16), or
+    /// `None` if some lane lies 16 or more chips past its tap's window.
+    pub(super) fn new<const F: u8>(nco: &CodeNco, n_taps: usize) -> Option<Self> {
+        let positions = if F == CI16 {
+            ci16_positions::<L>()
+        } else {
+            ci8_positions::<L>()
         };
-        let b0 = nco.phases[0];
-        for t in 0..n_taps.min(MAX_TAPS) {
-            let delta = (nco.phases[t] + CODE_LEN_FIX - b0) % CODE_LEN_FIX;
-            plan.whole[t] = (delta >> 32) as usize;
-            let frac = delta & 0xFFFF_FFFF;
-            for (j, &o) in ORDER.iter().enumerate() {
-                let l = frac.checked_add((o as u64).checked_mul(nco.step)?)?;
-                let h = l >> 32;
-                if h > MAX_OFFSET {
-                    return None;
-                }
-                plan.thr[t][j] = (!(l as u32) ^ 0x8000_0000) as i32;
-                plan.hi_dup[t][o] = (h as u16 * 0x0101) as i16;
-            }
-        }
-        Some(plan)
+        // Compare lane j (vectors A, B) lands on the position vpackssdw puts it.
+        let code = LanePlan::new(nco, n_taps, &positions, pack_position::<L>, 0x8000_0000)?;
+        Some(Self {
+            code,
+            rotator: rotator_order(&positions),
+        })
     }
 }
 
-/// Runs the kernel for `out.len()` (1..=8) taps with the plan from [`Ci8Plan::new`].
+/// Runs the kernel for `out.len()` (1..=8) taps on the `n` samples of format `F` at `data`
+/// with the plan from [`Plan16::new`] (of the same format).
 ///
 /// # Safety
-/// The CPU must support AVX2 and FMA.
+/// The CPU must support AVX2 and FMA; `data` must hold `n` samples of format `F`.
 #[target_feature(enable = "avx2,fma")]
-pub(super) unsafe fn correlate(
-    x: &[[i8; 2]],
+#[allow(clippy::too_many_arguments)]
+pub(super) unsafe fn correlate<const F: u8>(
+    data: *const u8,
+    n: usize,
+    sh: u32,
     code: &PackedCode,
     nco: &CodeNco,
     carrier: &CarrierNco,
-    plan: &Ci8Plan,
+    plan: &Plan16,
     out: &mut [Complex32],
 ) {
-    let job = Ci8Job {
+    let job = Job16 {
         code,
         nco,
         carrier,
         plan,
+        sh,
     };
-    let (p, n) = (x.as_ptr().cast::<u8>(), x.len());
-    // SAFETY: p holds n ci8 samples; the CPU check is the caller's.
+    let (p, n) = (data, n);
+    // SAFETY: p holds n samples of format F; the CPU check is the caller's.
     unsafe {
         match (out.len(), carrier.chirps()) {
-            (1, false) => run::<1, false>(p, n, &job, out),
-            (2, false) => run::<2, false>(p, n, &job, out),
-            (3, false) => run::<3, false>(p, n, &job, out),
-            (4, false) => run::<4, false>(p, n, &job, out),
-            (5, false) => run::<5, false>(p, n, &job, out),
-            (6, false) => run::<6, false>(p, n, &job, out),
-            (7, false) => run::<7, false>(p, n, &job, out),
-            (_, false) => run::<8, false>(p, n, &job, out),
-            (1, true) => run::<1, true>(p, n, &job, out),
-            (2, true) => run::<2, true>(p, n, &job, out),
-            (3, true) => run::<3, true>(p, n, &job, out),
-            (4, true) => run::<4, true>(p, n, &job, out),
-            (5, true) => run::<5, true>(p, n, &job, out),
-            (6, true) => run::<6, true>(p, n, &job, out),
-            (7, true) => run::<7, true>(p, n, &job, out),
-            (_, true) => run::<8, true>(p, n, &job, out),
+            (1, false) => run::<F, 1, false>(p, n, &job, out),
+            (2, false) => run::<F, 2, false>(p, n, &job, out),
+            (3, false) => run::<F, 3, false>(p, n, &job, out),
+            (4, false) => run::<F, 4, false>(p, n, &job, out),
+            (5, false) => run::<F, 5, false>(p, n, &job, out),
+            (6, false) => run::<F, 6, false>(p, n, &job, out),
+            (7, false) => run::<F, 7, false>(p, n, &job, out),
+            (_, false) => run::<F, 8, false>(p, n, &job, out),
+            (1, true) => run::<F, 1, true>(p, n, &job, out),
+            (2, true) => run::<F, 2, true>(p, n, &job, out),
+            (3, true) => run::<F, 3, true>(p, n, &job, out),
+            (4, true) => run::<F, 4, true>(p, n, &job, out),
+            (5, true) => run::<F, 5, true>(p, n, &job, out),
+            (6, true) => run::<F, 6, true>(p, n, &job, out),
+            (7, true) => run::<F, 7, true>(p, n, &job, out),
+            (_, true) => run::<F, 8, true>(p, n, &job, out),
         }
     }
 }
 
-struct Ci8Job<'a> {
+/// The headroom shift of a ci16 block ([`super::int16_lanes`]), vectorised with AVX2.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn ci16_block_shift(x: &[[i16; 2]]) -> u32 {
+    // 4 vectors of 8 samples per iteration, 4 independent OR chains.
+    let full = x.len() / 32;
+    let p = x.as_ptr().cast::<__m256i>();
+    let mut acc = [_mm256_setzero_si256(); 4];
+    for i in 0..full {
+        for (j, a) in acc.iter_mut().enumerate() {
+            // SAFETY: vector 4i + j (samples 32i + 8j..+8) lies inside the slice: 32 (i + 1)
+            // <= len.
+            *a = _mm256_or_si256(
+                *a,
+                _mm256_abs_epi16(unsafe { _mm256_loadu_si256(p.add(4 * i + j)) }),
+            );
+        }
+    }
+    let mut lanes = [0u16; 16];
+    let all = _mm256_or_si256(
+        _mm256_or_si256(acc[0], acc[1]),
+        _mm256_or_si256(acc[2], acc[3]),
+    );
+    // SAFETY: `lanes` holds 16 u16.
+    unsafe { _mm256_storeu_si256(lanes.as_mut_ptr().cast(), all) };
+    let m = lanes.iter().fold(0u16, |m, &v| m | v);
+    abs_shift(
+        x[32 * full..]
+            .iter()
+            .flatten()
+            .fold(m, |m, &v| m | v.unsigned_abs()),
+    )
+}
+
+/// The shift of format `F`'s samples: 8 for ci8 (module doc of [`super::int16_lanes`]).
+pub(super) const CI8_SHIFT: u32 = 8;
+
+struct Job16<'a> {
     code: &'a PackedCode,
     nco: &'a CodeNco,
     carrier: &'a CarrierNco,
-    plan: &'a Ci8Plan,
+    plan: &'a Plan16,
+    sh: u32,
 }
 
-/// The f32 rotator of 16 lanes (vectors A and B), seeded in [`ORDER`] and scaled by 2^14.
+/// The f32 rotator of 16 lanes (vectors A and B), seeded in the plan's order, scaled by 2^14.
 struct Rotator16 {
     p: [__m256; 4],
     d: [__m256; 4],
@@ -154,8 +172,8 @@ struct Rotator16 {
 impl Rotator16 {
     #[inline]
     #[target_feature(enable = "avx2,fma")]
-    fn seed(c: &CarrierNco, k0: usize, stride: usize) -> Self {
-        let s = c.seed_stride::<L>(k0, &ORDER, f64::from(Q14), stride);
+    fn seed(c: &CarrierNco, k0: usize, order: &[usize; L], stride: usize) -> Self {
+        let s = c.seed_stride::<L>(k0, order, f64::from(Q14), stride);
         // SAFETY: each array holds 16 f32: two vectors of 8.
         unsafe {
             let v = |a: &[f32; L], h: usize| _mm256_loadu_ps(a.as_ptr().add(8 * h));
@@ -166,7 +184,7 @@ impl Rotator16 {
         }
     }
 
-    /// The carrier of this step as i16 lanes in sample order: `(c, s)`.
+    /// The carrier of this step as i16 lanes in position order: `(c, s)`.
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn carrier_i16(&self) -> (__m256i, __m256i) {
@@ -194,28 +212,54 @@ impl Rotator16 {
     }
 }
 
-/// Wipes the carrier `(c, s)` off 16 ci8 samples `x`: `(wr, wi)` in Q7 (module doc).
+/// 16 samples of format `F` at `p` as `(I 2^sh, Q 2^sh)` in i16 lanes, position order.
+///
+/// # Safety
+/// `p` points to 16 readable samples of format `F`.
 #[inline]
 #[target_feature(enable = "avx2,fma")]
-fn wipe(x: __m256i, c: __m256i, s: __m256i) -> (__m256i, __m256i) {
-    let xi = _mm256_slli_epi16::<8>(x);
-    let xq = _mm256_and_si256(x, _mm256_set1_epi16(0xFF00_u16 as i16));
+unsafe fn load<const F: u8>(p: *const u8, sh: __m128i) -> (__m256i, __m256i) {
+    // SAFETY: 32 (ci8) or 64 (ci16) readable bytes at p.
+    unsafe {
+        if F == CI16 {
+            // Word 2m of a 128-bit lane: I (then Q) of the first vector's sample m, word
+            // 2m + 1: of the second's.
+            let a = _mm256_sll_epi16(_mm256_loadu_si256(p.cast()), sh);
+            let b = _mm256_sll_epi16(_mm256_loadu_si256(p.add(32).cast()), sh);
+            (
+                _mm256_blend_epi16::<0xAA>(a, _mm256_slli_epi32::<16>(b)),
+                _mm256_blend_epi16::<0xAA>(_mm256_srli_epi32::<16>(a), b),
+            )
+        } else {
+            let x = _mm256_loadu_si256(p.cast());
+            (
+                _mm256_slli_epi16::<8>(x),
+                _mm256_and_si256(x, _mm256_set1_epi16(0xFF00_u16 as i16)),
+            )
+        }
+    }
+}
+
+/// Wipes the carrier `(c, s)` off `(xi, xq)`: `(wr, wi)` in units of `2^(1 - sh)` sample.
+#[inline]
+#[target_feature(enable = "avx2,fma")]
+fn wipe(xi: __m256i, xq: __m256i, c: __m256i, s: __m256i) -> (__m256i, __m256i) {
     (
         _mm256_sub_epi16(_mm256_mulhrs_epi16(xi, c), _mm256_mulhrs_epi16(xq, s)),
         _mm256_add_epi16(_mm256_mulhrs_epi16(xi, s), _mm256_mulhrs_epi16(xq, c)),
     )
 }
 
-/// The +-1 replica (i16 lanes, sample order) of tap `t` when the first tap's phase has low
+/// The +-1 replica (i16 lanes, position order) of tap `t` when the first tap's phase has low
 /// half `bx ^ 2^31` (broadcast) and chip `chip`.
 ///
 /// # Safety
 /// `chip < 1023`.
 #[inline]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn replica(job: &Ci8Job<'_>, t: usize, chip: usize, bx: __m256i) -> __m256i {
-    let plan = job.plan;
-    // SAFETY: thr[t] holds 16 i32 (two vectors), hi_dup[t] 16 i16; chip + W_t < 2046 and the
+unsafe fn replica(job: &Job16<'_>, t: usize, chip: usize, bx: __m256i) -> __m256i {
+    let plan = &job.plan.code;
+    // SAFETY: thr[t] holds 16 u32 (two vectors), hi_dup[t] 16 i16; chip + W_t < 2046 and the
     // byte code holds 2064 bytes, so the 16 bytes at chip + W_t are readable.
     unsafe {
         let thr = plan.thr[t].as_ptr();
@@ -288,20 +332,22 @@ impl CodePhase {
 /// tap's sums.
 ///
 /// # Safety
-/// `p` points to 16 readable ci8 samples.
+/// `p` points to 16 readable samples of format `F`.
 #[inline]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn step<const NT: usize>(
+#[allow(clippy::too_many_arguments)]
+unsafe fn step<const F: u8, const NT: usize>(
     p: *const u8,
+    sh: __m128i,
     c: __m256i,
     s: __m256i,
-    job: &Ci8Job<'_>,
+    job: &Job16<'_>,
     phase: &CodePhase,
     acc: &mut [[__m256i; NT]; 2],
 ) {
-    // SAFETY: the caller guarantees 16 samples (32 bytes) at p.
-    let x = unsafe { _mm256_loadu_si256(p.cast()) };
-    let (wr, wi) = wipe(x, c, s);
+    // SAFETY: the caller guarantees 16 samples at p.
+    let (xi, xq) = unsafe { load::<F>(p, sh) };
+    let (wr, wi) = wipe(xi, xq, c, s);
     let chip = (phase.base >> 32) as usize;
     let [acc_re, acc_im] = acc;
     for (t, (re, im)) in acc_re.iter_mut().zip(acc_im.iter_mut()).enumerate() {
@@ -333,28 +379,31 @@ fn step_rotation(carrier: &CarrierNco) -> (__m256i, __m256i) {
     (_mm256_set1_epi16(q15(re)), _mm256_set1_epi16(q15(im)))
 }
 
-/// The kernel body for `NT` taps, the rotator's rate compiled in or out.
+/// The kernel body for format `F` and `NT` taps, the rotator's rate compiled in or out.
 ///
 /// Without a rate the f32 rotator steps [`GROUP`] vector steps at a time and the carrier of
 /// the steps in between is rotated in i16 ([`rotate_i16`]); with a rate every step takes the
 /// f32 rotator's carrier.
 ///
 /// # Safety
-/// `data` must hold `n` ci8 samples; `out.len() >= NT`; the CPU supports AVX2 and FMA.
+/// `data` must hold `n` samples of format `F`; `out.len() >= NT`; the CPU supports AVX2 and
+/// FMA.
 #[inline]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn run<const NT: usize, const CHIRP: bool>(
+unsafe fn run<const F: u8, const NT: usize, const CHIRP: bool>(
     data: *const u8,
     n: usize,
-    job: &Ci8Job<'_>,
+    job: &Job16<'_>,
     out: &mut [Complex32],
 ) {
+    let bps = if F == CI8 { 2 } else { 4 };
     let (full, total) = (n / L, n.div_ceil(L));
     // SAFETY: forwarded from the caller.
-    let tail = unsafe { tail_copy::<L>(data, n, 2) };
+    let tail = unsafe { tail_copy::<L>(data, n, bps) };
     let (q_re, q_im) = job.carrier.chirp::<L>();
     let (qr, qi) = (_mm256_set1_ps(q_re), _mm256_set1_ps(q_im));
     let (ec, es) = step_rotation(job.carrier);
+    let sh = _mm_cvtsi32_si128(job.sh as i32);
     let mut phase = CodePhase::new(job.nco.phases[0], job.nco.step * L as u64);
     let zero = _mm256_setzero_si256();
     let mut acc = [[zero; NT]; 2];
@@ -363,7 +412,7 @@ unsafe fn run<const NT: usize, const CHIRP: bool>(
     while s < total {
         let end = total.min(s + RESEED_STEPS);
         let stride = if CHIRP { L } else { GROUP * L };
-        let mut rot = Rotator16::seed(job.carrier, s * L, stride);
+        let mut rot = Rotator16::seed(job.carrier, s * L, &job.plan.rotator, stride);
         while s < end {
             let (mut c, mut sn) = rot.carrier_i16();
             rot.advance::<CHIRP>(qr, qi);
@@ -371,8 +420,8 @@ unsafe fn run<const NT: usize, const CHIRP: bool>(
             loop {
                 // SAFETY: step_ptr yields 16 readable samples (slice or tail buffer).
                 unsafe {
-                    let p = step_ptr::<L>(data, s, full, 2, &tail);
-                    step::<NT>(p, c, sn, job, &phase, &mut acc);
+                    let p = step_ptr::<L>(data, s, full, bps, &tail);
+                    step::<F, NT>(p, sh, c, sn, job, &phase, &mut acc);
                 }
                 phase.advance();
                 s += 1;
@@ -388,10 +437,11 @@ unsafe fn run<const NT: usize, const CHIRP: bool>(
             (acc[0][t], acc[1][t]) = (zero, zero);
         }
     }
+    let unit = w_unit(job.sh);
     for t in 0..NT {
         out[t] = Complex32::new(
-            (sums[t].0 as f64 * W_UNIT) as f32,
-            (sums[t].1 as f64 * W_UNIT) as f32,
+            (sums[t].0 as f64 * unit) as f32,
+            (sums[t].1 as f64 * unit) as f32,
         );
     }
 }
