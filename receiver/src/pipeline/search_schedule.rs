@@ -67,8 +67,16 @@ pub const HOT_DOPPLER_HZ: f64 = 250.0;
 pub const HOT_DOPPLER_RATE_HZ_S: f64 = 25.0;
 /// Longest wait between two searches of a satellite predicted visible, s.
 pub const PREDICTED_WAIT_S: f64 = 2.0;
-/// Wait after the most sensitive search of an unpredicted satellite failed, s.
+/// Wait between two cheap searches (level 0, about 36 dB-Hz) of a satellite nothing is
+/// predicted of, once its most sensitive search failed, s: a satellite rising above the
+/// horizon comes up at about 35-42 dB-Hz in open sky, and 32 of these searches cost about 1 %
+/// of a full round.
 pub const UNKNOWN_WAIT_S: f64 = 15.0;
+/// Wait before a satellite nothing is predicted of is searched up to the most sensitive level
+/// again, once that search failed, s. Between, it gets only the cheap search every
+/// [`UNKNOWN_WAIT_S`]: at 4 MHz one most sensitive search of one PRN costs as much as about
+/// 50 cheap ones, and most of the 32 PRNs are below the horizon.
+pub const DEEP_WAIT_S: f64 = 300.0;
 /// Wait of a satellite whose most sensitive search awaits a prediction
 /// ([`Visibility::Pending`]), s.
 pub const PENDING_WAIT_S: f64 = 1.0;
@@ -174,6 +182,9 @@ struct PrnState {
     searches: u32,
     /// Sample index before which it is not searched.
     not_before: u64,
+    /// Sample index before which, unpredicted, it is not searched past level 0 again
+    /// ([`DEEP_WAIT_S`]; 0: its first escalation is still to come).
+    deep_not_before: u64,
 }
 
 /// A candidate for the next batch: priority (lower first), its level, target and cost.
@@ -387,14 +398,20 @@ impl Scheduler {
                 continue;
             }
             let hot = batch.hot.get(i).copied().unwrap_or(false);
+            let predicted = matches!(visibility(t.prn), Visibility::Visible { .. });
             let wait_s = if hot {
                 HOT_INTERVAL_S
-            } else if batch.level < max_level {
+            } else if batch.level < max_level && (predicted || now >= s.deep_not_before) {
                 s.level = batch.level + 1;
                 0.0
-            } else if matches!(visibility(t.prn), Visibility::Visible { .. }) {
+            } else if predicted {
                 PREDICTED_WAIT_S
             } else {
+                // Unpredicted: the cheap search now and then, the deep ones rarely.
+                if batch.level == max_level {
+                    s.deep_not_before = now + (DEEP_WAIT_S * self.fs_hz) as u64;
+                }
+                s.level = 0;
                 UNKNOWN_WAIT_S
             };
             s.not_before = now + (wait_s * self.fs_hz) as u64;
