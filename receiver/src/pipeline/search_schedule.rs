@@ -293,16 +293,17 @@ impl Scheduler {
             .filter_map(|p| self.candidate(p, now, engines, live(p), visibility(p)))
             .collect();
         candidates.sort_by_key(|c| c.priority);
-        let (level, free) = candidates.first().map(|c| (c.level, c.free))?;
+        let (level, free, hot_first) = candidates.first().map(|c| (c.level, c.free, c.hot))?;
         let engine = engines.get(level)?;
         let len = engine.samples_wanted() as u64;
         if window < len {
             return None;
         }
         let mut spent = if free { 0.0 } else { fixed_cost_s(engine) };
-        if !free {
+        if !free && !hot_first {
             // Wait until the batch can hold a few PRNs: each batch pays for its block
-            // spectra, which a batch of one at 10 ms x 50 spends 40 % of its cost on.
+            // spectra, which a batch of one at 10 ms x 50 spends 40 % of its cost on (a
+            // satellite just lost does not wait).
             let least: f64 = candidates
                 .iter()
                 .filter(|c| c.level == level && !c.free)
