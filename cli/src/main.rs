@@ -12,6 +12,7 @@ use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    return_large_blocks_to_the_system();
     let cli = Cli::parse();
     let filter = tracing_subscriber::EnvFilter::try_from_env("GPSRX_LOG").unwrap_or_else(|_| {
         tracing_subscriber::EnvFilter::new(if cli.verbose { "debug" } else { "info" })
@@ -49,3 +50,21 @@ fn main() -> ExitCode {
         }
     }
 }
+
+/// Large blocks (1 MiB and more: the block spectra and grids of a search, the sample window)
+/// are mapped and unmapped on their own, so memory a search frees goes back to the system
+/// between searches. glibc's default raises its mapping threshold to the size of each large
+/// block freed (up to 32 MiB) and keeps the next ones in its per-thread heaps: the 10 ms x 50
+/// search's 32 MB of spectra then stayed resident for the whole run (measured: 60 s of 4 MHz
+/// ci8, peak resident memory 121 MB with the default, 77 MB with this).
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn return_large_blocks_to_the_system() {
+    // SAFETY: mallopt only sets an allocator parameter; called first thing in `main`.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 1 << 20);
+    }
+}
+
+/// Other platforms' allocators are left as they are.
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn return_large_blocks_to_the_system() {}

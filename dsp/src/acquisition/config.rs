@@ -289,12 +289,6 @@ impl Layout {
         })
     }
 
-    /// Entries of one block's decimated spectrum at one fractional Doppler offset: D residues
-    /// of `spec_len` bins.
-    pub(crate) fn spectrum_stride(&self) -> usize {
-        self.decimation * self.spec_len
-    }
-
     /// Where the `jj`-th bin of residue `r` of the decimated spectrum (signed bin
     /// `j = jj` or `jj - spec_len` for the upper half, as in an FFT) lies in a spectrum of
     /// `len` bins decimated by `d`: bin `(d j + r) mod len`. With `len = d spec_len` this is

@@ -2,7 +2,10 @@
 //! power grid from them.
 
 use super::engine::{AcquisitionEngine, Scratch};
+use super::input::copy_cf32;
+use super::spectra::{quantize, Spectra};
 use crate::constants::F_L1_HZ;
+use crate::correlator::SampleSlice;
 use crate::Prn;
 use num_complex::Complex32;
 use rayon::prelude::*;
@@ -14,9 +17,9 @@ impl AcquisitionEngine {
     /// contiguous.
     pub(super) fn block_spectra(
         &self,
-        samples: &[Complex32],
+        samples: SampleSlice<'_>,
         pass: usize,
-        spectra: &mut Vec<Complex32>,
+        spectra: &mut Spectra,
     ) {
         let l = &self.layout;
         let n = l.block_len;
@@ -25,48 +28,48 @@ impl AcquisitionEngine {
             .iter()
             .map(|&ms| l.block_start_sample(ms))
             .collect();
-        let stride = l.spectrum_stride();
-        spectra.resize(starts.len() * q_total * stride, Complex32::new(0.0, 0.0));
-        spectra
-            .par_chunks_mut(stride)
-            .enumerate()
-            .for_each(|(i, out)| {
-                let (blk, q) = (i / q_total, i % q_total);
-                let src = &samples[starts[blk]..starts[blk] + n];
-                let mut s = self.take_scratch();
-                let tmp = &mut s.buf[..n];
-                if q == 0 {
-                    tmp.copy_from_slice(src);
+        let (d, m) = (l.decimation, l.spec_len);
+        spectra.resize(starts.len() * q_total * d, m);
+        let slices: Vec<_> = spectra.slices_mut().collect();
+        let mut groups: Vec<Vec<_>> = Vec::with_capacity(starts.len() * q_total);
+        let mut it = slices.into_iter();
+        for _ in 0..starts.len() * q_total {
+            groups.push(it.by_ref().take(d).collect());
+        }
+        groups.into_par_iter().enumerate().for_each(|(i, out)| {
+            let (blk, q) = (i / q_total, i % q_total);
+            let mut s = self.take_scratch();
+            let tmp = &mut s.buf[..n];
+            copy_cf32(samples, starts[blk], tmp);
+            if q > 0 {
+                for (t, w) in tmp.iter_mut().zip(&self.wipeoffs[q - 1]) {
+                    *t *= w;
+                }
+            }
+            self.fwd.process_with_scratch(tmp, &mut s.fft);
+            s.slice.resize(m, Complex32::new(0.0, 0.0));
+            for (r, (dst, scale)) in out.into_iter().enumerate() {
+                let tmp = &s.buf[..n];
+                if d * m == n {
+                    for (j, o) in s.slice.iter_mut().enumerate() {
+                        *o = tmp[d * j + r];
+                    }
                 } else {
-                    let w = &self.wipeoffs[q - 1];
-                    for ((t, x), w) in tmp.iter_mut().zip(src).zip(w) {
-                        *t = x * w;
+                    for (j, o) in s.slice.iter_mut().enumerate() {
+                        *o = tmp[l.decimated_bin(j, r, d, n)];
                     }
                 }
-                self.fwd.process_with_scratch(tmp, &mut s.fft);
-                let d = l.decimation;
-                let m = l.spec_len;
-                for r in 0..d {
-                    let dst = &mut out[r * m..(r + 1) * m];
-                    if d * m == n {
-                        for (j, o) in dst.iter_mut().enumerate() {
-                            *o = tmp[d * j + r];
-                        }
-                    } else {
-                        for (j, o) in dst.iter_mut().enumerate() {
-                            *o = tmp[l.decimated_bin(j, r, d, n)];
-                        }
-                    }
-                }
-                self.give_scratch(s);
-            });
+                *scale = quantize(&s.slice, dst);
+            }
+            self.give_scratch(s);
+        });
     }
 
     /// Non-coherent power grid of one PRN into `s.grid` from the `spectra` of `pass` (rows =
     /// Doppler bins `b0..=b1`, columns = code lags referred to the first sample).
     pub(super) fn fill_grid(
         &self,
-        spectra: &[Complex32],
+        spectra: &Spectra,
         prn: Prn,
         b0: i64,
         b1: i64,
@@ -74,13 +77,8 @@ impl AcquisitionEngine {
         s: &mut Scratch,
     ) {
         let l = &self.layout;
-        let (stride, sl, m, lags, q_total) = (
-            l.spectrum_stride(),
-            l.spec_len,
-            l.inv_len,
-            l.n_lags,
-            l.subdivision,
-        );
+        let (d, sl, m, lags, q_total) =
+            (l.decimation, l.spec_len, l.inv_len, l.n_lags, l.subdivision);
         let (kp, kn) = (l.keep_pos, l.keep_neg);
         let rows = (b1 - b0 + 1) as usize;
         s.grid.clear();
@@ -107,8 +105,8 @@ impl AcquisitionEngine {
             let f_hz = bin as f64 * l.doppler_step_hz;
             let grid_row = &mut s.grid[row * lags..(row + 1) * lags];
             for (b, &ms) in starts.iter().enumerate() {
-                let base = (b * q_total + q) * stride + r * sl;
-                let src = &spectra[base..base + sl];
+                let (src, scale) = spectra.slice((b * q_total + q) * d + r);
+                let power_scale = scale * scale;
                 // Y[j] = X[D (j + a) + r] conj(C[j]) / len: the Doppler shift is a rotation;
                 // the lowest kp non-negative and kn negative frequencies j (relative to the
                 // Doppler) are kept, zeros between them when the inverse FFT is longer.
@@ -126,10 +124,10 @@ impl AcquisitionEngine {
                 let rs = ((shift / l.lag_samples).round() as i64).rem_euclid(m as i64) as usize;
                 let first = lags.min(m - rs);
                 for (g, y) in grid_row[..first].iter_mut().zip(&buf[rs..rs + first]) {
-                    *g += y.norm_sqr();
+                    *g += power_scale * y.norm_sqr();
                 }
                 for (g, y) in grid_row[first..].iter_mut().zip(&buf[..lags - first]) {
-                    *g += y.norm_sqr();
+                    *g += power_scale * y.norm_sqr();
                 }
             }
         }
@@ -142,21 +140,21 @@ impl AcquisitionEngine {
     /// this is the noise of the prompts of the refinement, which correlate at the input rate,
     /// whatever the front-end filter (white noise gives 1/(fraction of the replica's power in
     /// the band), about 1.05 at +-2.048 MHz).
-    pub(super) fn band_noise_ratio(&self, spectra: &[Complex32], bin: i64) -> f64 {
+    pub(super) fn band_noise_ratio(&self, spectra: &Spectra, bin: i64) -> f64 {
         let l = &self.layout;
         if l.inv_len >= l.spec_len {
             return 1.0;
         }
-        let (stride, sl, q_total) = (l.spectrum_stride(), l.spec_len, l.subdivision);
+        let (d, sl, q_total) = (l.decimation, l.spec_len, l.subdivision);
         let q = bin.rem_euclid(q_total as i64) as usize;
         let k = (bin - q as i64) / q_total as i64;
         let (r, a) = l.residue_rotation(k);
         let (mut all, mut kept) = (0.0f64, 0.0f64);
         for b in 0..l.block_start_ms.first().map_or(0, Vec::len) {
-            let base = (b * q_total + q) * stride + r * sl;
-            let src = &spectra[base..base + sl];
+            let (src, scale) = spectra.slice((b * q_total + q) * d + r);
             for (j, w) in self.replica_power.iter().enumerate() {
-                let p = f64::from(src[(j + a) % sl].norm_sqr() * w);
+                let [re, im] = src[(j + a) % sl].map(f32::from);
+                let p = f64::from((re * re + im * im) * scale * scale * w);
                 all += p;
                 if j < l.keep_pos || j >= sl - l.keep_neg {
                     kept += p;
@@ -172,11 +170,11 @@ impl AcquisitionEngine {
 }
 
 /// `dst[t] = src[(start + t) mod src.len()] * rep[t]` (`start < src.len()`,
-/// `dst.len() <= src.len()`), in at most two contiguous runs. The loops are compiled a second
-/// time for AVX2 + FMA and that version is taken when the CPU has them (the build targets
-/// baseline x86-64, whose SSE2 complex products ran at half the speed: 14 % of a weak-signal
-/// run's time was here).
-fn mul_rotated(dst: &mut [Complex32], src: &[Complex32], start: usize, rep: &[Complex32]) {
+/// `dst.len() <= src.len()`), the stored integers `src` read as complex f32, in at most two
+/// contiguous runs. The loops are compiled a second time for AVX2 + FMA and that version is
+/// taken when the CPU has them (the build targets baseline x86-64, whose SSE2 complex
+/// products ran at half the speed: 14 % of a weak-signal run's time was here).
+fn mul_rotated(dst: &mut [Complex32], src: &[[i16; 2]], start: usize, rep: &[Complex32]) {
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU supports AVX2 and FMA (checked above).
@@ -186,9 +184,7 @@ fn mul_rotated(dst: &mut [Complex32], src: &[Complex32], start: usize, rep: &[Co
     mul_rotated_portable(dst, src, start, rep);
 }
 
-/// [`mul_rotated`] with AVX2 and FMA: four complex products per instruction group,
-/// `a b = (a_re b_re - a_im b_im, a_im b_re + a_re b_im)` as `fmaddsub(a, dup(b_re),
-/// swap(a) dup(b_im))`.
+/// [`mul_rotated`] with AVX2 and FMA.
 ///
 /// # Safety
 /// The CPU must support AVX2 and FMA.
@@ -196,7 +192,7 @@ fn mul_rotated(dst: &mut [Complex32], src: &[Complex32], start: usize, rep: &[Co
 #[target_feature(enable = "avx2,fma")]
 unsafe fn mul_rotated_avx2(
     dst: &mut [Complex32],
-    src: &[Complex32],
+    src: &[[i16; 2]],
     start: usize,
     rep: &[Complex32],
 ) {
@@ -211,30 +207,35 @@ unsafe fn mul_rotated_avx2(
     }
 }
 
-/// `dst[t] = a[t] b[t]` for equal lengths, AVX2 + FMA.
+/// `dst[t] = a[t] b[t]` for equal lengths, `a` integers, AVX2 + FMA: four complex products
+/// per instruction group, `a b = (a_re b_re - a_im b_im, a_im b_re + a_re b_im)` as
+/// `fmaddsub(a, dup(b_re), swap(a) dup(b_im))`, `a` widened from i16 first.
 ///
 /// # Safety
 /// The CPU must support AVX2 and FMA; `a` and `b` at least as long as `dst`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn mul_avx2(dst: &mut [Complex32], a: &[Complex32], b: &[Complex32]) {
+unsafe fn mul_avx2(dst: &mut [Complex32], a: &[[i16; 2]], b: &[Complex32]) {
     use std::arch::x86_64::{
-        _mm256_fmaddsub_ps, _mm256_loadu_ps, _mm256_movehdup_ps, _mm256_moveldup_ps, _mm256_mul_ps,
-        _mm256_permute_ps, _mm256_storeu_ps,
+        __m128i, _mm256_cvtepi16_epi32, _mm256_cvtepi32_ps, _mm256_fmaddsub_ps, _mm256_loadu_ps,
+        _mm256_movehdup_ps, _mm256_moveldup_ps, _mm256_mul_ps, _mm256_permute_ps, _mm256_storeu_ps,
+        _mm_loadu_si128,
     };
     let n = dst.len().min(a.len()).min(b.len());
     let lanes = n / 4 * 4;
     let (pd, pa, pb) = (
         dst.as_mut_ptr().cast::<f32>(),
-        a.as_ptr().cast::<f32>(),
+        a.as_ptr().cast::<i16>(),
         b.as_ptr().cast::<f32>(),
     );
     let mut k = 0;
     while k < lanes {
-        // SAFETY: k + 4 <= n complex values (8 floats) in each slice; Complex32 is two f32
-        // (repr(C)), unaligned loads and stores.
+        // SAFETY: k + 4 <= n complex values in each slice (8 i16 of `a`: 16 bytes; 8 floats
+        // of `b` and `dst`); Complex32 is two f32 (repr(C)), [i16; 2] two i16; unaligned
+        // loads and stores.
         unsafe {
-            let va = _mm256_loadu_ps(pa.add(2 * k));
+            let ai = _mm_loadu_si128(pa.add(2 * k).cast::<__m128i>());
+            let va = _mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(ai));
             let vb = _mm256_loadu_ps(pb.add(2 * k));
             let b_re = _mm256_moveldup_ps(vb);
             let b_im = _mm256_movehdup_ps(vb);
@@ -245,20 +246,61 @@ unsafe fn mul_avx2(dst: &mut [Complex32], a: &[Complex32], b: &[Complex32]) {
         k += 4;
     }
     for t in lanes..n {
-        dst[t] = a[t] * b[t];
+        dst[t] = widen(a[t]) * b[t];
     }
+}
+
+/// A stored integer pair as complex f32.
+#[inline(always)]
+fn widen([re, im]: [i16; 2]) -> Complex32 {
+    Complex32::new(f32::from(re), f32::from(im))
 }
 
 /// The body of [`mul_rotated`], inlined into each compiled version.
 #[inline(always)]
-fn mul_rotated_portable(dst: &mut [Complex32], src: &[Complex32], start: usize, rep: &[Complex32]) {
+fn mul_rotated_portable(dst: &mut [Complex32], src: &[[i16; 2]], start: usize, rep: &[Complex32]) {
     let first = dst.len().min(src.len() - start);
     let (d0, d1) = dst.split_at_mut(first);
     let (r0, r1) = rep.split_at(first);
     for ((y, x), c) in d0.iter_mut().zip(&src[start..]).zip(r0) {
-        *y = x * c;
+        *y = widen(*x) * c;
     }
     for ((y, x), c) in d1.iter_mut().zip(src).zip(r1) {
-        *y = x * c;
+        *y = widen(*x) * c;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotated_products_of_stored_integers_match_the_portable_loop() {
+        // Every length up to two vector steps and every start: the AVX2 path (when the CPU
+        // has it) against the scalar body, exactly (the same f32 products).
+        let src: Vec<[i16; 2]> = (0..13i32)
+            .map(|k| {
+                [
+                    (k * 9377 % 65535 - 32767) as i16,
+                    (k * 25391 % 65535 - 32767) as i16,
+                ]
+            })
+            .collect();
+        let rep: Vec<Complex32> = (0..13)
+            .map(|k| Complex32::new(0.5 + k as f32, -0.25 * k as f32))
+            .collect();
+        for len in 0..=src.len() {
+            for start in 0..src.len() {
+                let mut fast = vec![Complex32::new(0.0, 0.0); len];
+                let mut slow = fast.clone();
+                mul_rotated(&mut fast, &src, start, &rep[..len]);
+                mul_rotated_portable(&mut slow, &src, start, &rep[..len]);
+                assert_eq!(fast, slow, "len {len} start {start}");
+                for (t, y) in slow.iter().enumerate() {
+                    let want = widen(src[(start + t) % src.len()]) * rep[t];
+                    assert!((y - want).norm() <= 1e-4 * want.norm().max(1.0));
+                }
+            }
+        }
     }
 }

@@ -5,10 +5,11 @@ use super::config::{AcqConfig, AcqError, Layout};
 use super::detect::{analyse, mark_cross_correlations, triangle_offset, Peak};
 use super::refine::{amplitude, cn0_dbhz, correlate_periods, fine_doppler};
 use super::replica::{fractional_wipeoffs, replica_spectra};
+use super::spectra::Spectra;
 use super::stats::detection_threshold;
 use super::{AcqGrid, AcqResult, SearchTarget};
 use crate::constants::{CA_CHIP_RATE_HZ, CA_CODE_LENGTH};
-use crate::correlator::{Correlator, PackedCode};
+use crate::correlator::{Correlator, PackedCode, SampleSlice};
 use crate::{CaCode, Prn};
 use num_complex::{Complex32, Complex64};
 use rayon::prelude::*;
@@ -25,6 +26,8 @@ pub(super) struct Scratch {
     pub(super) grid: Vec<f32>,
     /// Grid rows in the order they are filled: (slice set, row, Doppler bin).
     pub(super) rows: Vec<(usize, usize, i64)>,
+    /// One decimated slice of a block spectrum, before it is stored.
+    pub(super) slice: Vec<Complex32>,
     epl: [Vec<Complex64>; 3],
     fine: Vec<Complex32>,
     floors: Vec<f64>,
@@ -62,7 +65,7 @@ pub struct AcquisitionEngine {
     pub(super) packed: Vec<PackedCode>,
     pub(super) wipeoffs: Vec<Vec<Complex32>>,
     pub(super) scratch_pool: Mutex<Vec<Scratch>>,
-    pub(super) spectra_pool: Mutex<Vec<Vec<Complex32>>>,
+    pub(super) spectra_pool: Mutex<Vec<Spectra>>,
 }
 
 impl fmt::Debug for AcquisitionEngine {
@@ -169,7 +172,43 @@ impl AcquisitionEngine {
         samples: &[Complex32],
         targets: &[SearchTarget],
     ) -> Result<Vec<AcqResult>, AcqError> {
-        self.check_len(samples)?;
+        self.search_slice(SampleSlice::Cf32(samples), targets)
+    }
+
+    /// [`AcquisitionEngine::search`] of samples in the format they are held in (complex f32
+    /// or 8- or 16-bit integers): each block is converted to f32 when its spectrum is taken,
+    /// and the prompts of a detection's refinement from its first `refine_ms` + 2 code
+    /// periods, so no f32 copy of the whole search is made. The working memory of the
+    /// search (block spectra, grids) is released when it returns: it is as large as the
+    /// samples (10 ms x 50 at 4 MHz: 32 MB of spectra, a 3 MB grid per thread), and a
+    /// background search runs every few seconds at most.
+    pub fn search_slice(
+        &self,
+        samples: SampleSlice<'_>,
+        targets: &[SearchTarget],
+    ) -> Result<Vec<AcqResult>, AcqError> {
+        let result = self.search_held(samples, targets);
+        self.release_memory();
+        result
+    }
+
+    /// Frees the scratch and spectra the pools keep between searches.
+    pub fn release_memory(&self) {
+        if let Ok(mut p) = self.scratch_pool.lock() {
+            *p = Vec::new();
+        }
+        if let Ok(mut p) = self.spectra_pool.lock() {
+            *p = Vec::new();
+        }
+    }
+
+    /// The body of [`AcquisitionEngine::search_slice`] (the pools stay warm).
+    fn search_held(
+        &self,
+        samples: SampleSlice<'_>,
+        targets: &[SearchTarget],
+    ) -> Result<Vec<AcqResult>, AcqError> {
+        self.check_len(samples.len())?;
         let rows = targets
             .iter()
             .map(|t| self.bins_for(t))
@@ -206,10 +245,23 @@ impl AcquisitionEngine {
                     self.give_scratch(s);
                 });
         }
-        spectra.clear();
         if let Ok(mut pool) = self.spectra_pool.lock() {
             pool.push(spectra);
         }
+        // The refinement's prompts: `refine_ms` code periods from the code phase (less than
+        // a period in), as f32.
+        let refine_len =
+            ((f64::from(self.config.refine_ms) + 2.0) * self.layout.period_samples).ceil() as usize;
+        let any_detected = best
+            .iter()
+            .zip(&thresholds)
+            .any(|(k, &th)| k.as_ref().is_some_and(|k| k.peak.metric >= th));
+        let refine_samples = if any_detected {
+            super::input::head_cf32(samples, refine_len)
+        } else {
+            std::borrow::Cow::Borrowed(&[][..])
+        };
+        let samples: &[Complex32] = &refine_samples;
         let mut results: Vec<AcqResult> = targets
             .par_iter()
             .zip(best.par_iter())
@@ -238,10 +290,10 @@ impl AcquisitionEngine {
     /// The search grid of one target (first pass: blocks from the first sample), for plots and
     /// for checking the statistics.
     pub fn grid(&self, samples: &[Complex32], target: &SearchTarget) -> Result<AcqGrid, AcqError> {
-        self.check_len(samples)?;
+        self.check_len(samples.len())?;
         let (b0, b1) = self.bins_for(target)?;
-        let mut spectra = Vec::new();
-        self.block_spectra(samples, 0, &mut spectra);
+        let mut spectra = Spectra::default();
+        self.block_spectra(SampleSlice::Cf32(samples), 0, &mut spectra);
         let mut s = self.take_scratch();
         self.fill_grid(&spectra, target.prn, b0, b1, 0, &mut s);
         let step = self.layout.doppler_step_hz;
@@ -257,12 +309,12 @@ impl AcquisitionEngine {
         Ok(grid)
     }
 
-    fn check_len(&self, samples: &[Complex32]) -> Result<(), AcqError> {
-        if samples.len() < self.layout.samples_needed {
+    fn check_len(&self, got: usize) -> Result<(), AcqError> {
+        if got < self.layout.samples_needed {
             return Err(AcqError::NotEnoughSamples {
                 needed: self.layout.samples_needed,
                 needed_ms: self.layout.samples_needed as f64 / self.fs_hz * 1e3,
-                got: samples.len(),
+                got,
             });
         }
         Ok(())
@@ -340,7 +392,7 @@ impl AcquisitionEngine {
     /// at its peak is taken while the pass's spectra are at hand, when the peak is a detection.
     fn pass_peak(
         &self,
-        spectra: &[Complex32],
+        spectra: &Spectra,
         prn: Prn,
         (b0, b1): (i64, i64),
         pass: usize,

@@ -124,8 +124,10 @@ mod config;
 mod correlate;
 mod detect;
 mod engine;
+mod input;
 mod refine;
 mod replica;
+mod spectra;
 pub mod stats;
 
 pub use config::{

@@ -9,8 +9,9 @@
 //! 1. lost in the last [`HOT_FOR_S`]: around their last Doppler, every [`HOT_INTERVAL_S`];
 //! 2. predicted visible ([`Visibility::Visible`]: from `--nav` or decoded ephemerides and a
 //!    position), in their predicted Doppler window, never left more than [`PREDICTED_WAIT_S`];
-//! 3. the others over the whole Doppler range, the least recently searched first, waiting
-//!    [`UNKNOWN_WAIT_S`] once the most sensitive search has failed. Satellites predicted below
+//! 3. the others over the whole Doppler range, the least recently searched first; once the
+//!    most sensitive search has failed, only the cheap one (level 0) every [`UNKNOWN_WAIT_S`],
+//!    and the escalation again after [`DEEP_WAIT_S`]. Satellites predicted below
 //!    the horizon are not searched, and while a prediction is about to come
 //!    ([`Visibility::Pending`]: ephemerides at hand, no fix yet) the most sensitive search
 //!    waits for it (most of the 32 PRNs are below the horizon).
@@ -67,38 +68,58 @@ pub const HOT_DOPPLER_HZ: f64 = 250.0;
 pub const HOT_DOPPLER_RATE_HZ_S: f64 = 25.0;
 /// Longest wait between two searches of a satellite predicted visible, s.
 pub const PREDICTED_WAIT_S: f64 = 2.0;
-/// Wait after the most sensitive search of an unpredicted satellite failed, s.
+/// Wait between two cheap searches (level 0, about 36 dB-Hz) of a satellite nothing is
+/// predicted of, once its most sensitive search failed, s: a satellite rising above the
+/// horizon comes up at about 35-42 dB-Hz in open sky, and 32 of these searches cost about 1 %
+/// of a full round.
 pub const UNKNOWN_WAIT_S: f64 = 15.0;
+/// Wait before a satellite nothing is predicted of is searched up to the most sensitive level
+/// again, once that search failed, s. Between, it gets only the cheap search every
+/// [`UNKNOWN_WAIT_S`]: at 4 MHz one most sensitive search of one PRN costs as much as about
+/// 50 cheap ones, and most of the 32 PRNs are below the horizon.
+pub const DEEP_WAIT_S: f64 = 300.0;
 /// Wait of a satellite whose most sensitive search awaits a prediction
 /// ([`Visibility::Pending`]), s.
 pub const PENDING_WAIT_S: f64 = 1.0;
 /// Seconds of signal between two scheduling decisions.
 pub const TICK_S: f64 = 0.1;
 /// Modelled CPU time of a search per sample, Doppler bin and pass, s, for 1 ms coherent
-/// blocks, and divided by the coherent milliseconds for longer ones (measured per PRN over
-/// +-5 kHz at 2.6 MHz on the 2-core development machine: 1 ms x 10 1.2 ms, 10 ms x 10 25 ms,
-/// 10 ms x 40 94 ms).
-pub const COST_S_PER_SAMPLE_BIN: f64 = 2.2e-9;
+/// blocks, and divided by the coherent milliseconds for longer ones: the inverse FFTs, one per
+/// block, bin and PRN. Measured as process CPU time (every thread of the pool) per PRN over
+/// +-5 kHz on the 2-core AMD EPYC development machine, on 8-bit noise held as ci8
+/// (`cargo bench -p gpsrx-benches --bench search_cost`): 1 ms x 10 1.7 ms at 4 MHz, 10 ms x 13
+/// 13 ms at 2.6 and 21 ms at 4 MHz, 10 ms x 50 45 ms and 72 ms.
+pub const COST_S_PER_SAMPLE_BIN: f64 = 1.9e-9;
 /// Modelled CPU time of the block spectra of a search (the forward FFTs every search makes
-/// whatever its targets), s per sample and pass (10 ms x 40 at 2.6 MHz: about 50 ms).
-pub const COST_S_PER_SAMPLE_FFT: f64 = 2.4e-8;
+/// whatever its targets, with the allocation of the spectra), s per sample and pass (10 ms x
+/// 50: about 34 ms at 2.6 MHz, 56 ms at 4 MHz; see [`COST_S_PER_SAMPLE_BIN`]).
+pub const COST_S_PER_SAMPLE_FFT: f64 = 2.7e-8;
 /// Largest modelled cost of one batch, s (a block waits for its search).
 pub const MAX_BATCH_S: f64 = 0.5;
+/// A charged batch waits until the budget can pay for this many of its level's due PRNs
+/// (or all of them when fewer are due), so the block spectra every batch computes are
+/// shared: the forward FFTs re-used across PRNs.
+pub const MIN_BATCH_PRNS: usize = 4;
 
 /// Capacity of the bucket, CPU s: a first round of searches at the start (every PRN up to
 /// 10 ms x 13, most of them 10 ms x 50, at 2.6-4 MHz). It was 2 s with the two-pass levels,
 /// whose searches cost 1/0.62 as much: the same round at the same sensitivity.
 pub const BURST_S: f64 = 1.25;
 
-/// The default refill, CPU s per second of signal (0.03 with the two-pass levels: the same
-/// searches at the same times, see [`BURST_S`]).
-pub const DEFAULT_PER_SIGNAL_S: f64 = 0.02;
+/// The default refill, CPU s per second of signal: half a percent of a core. Once the first
+/// round is done it pays for the cheap search of about 20 absent PRNs every
+/// [`UNKNOWN_WAIT_S`] and their deep round every [`DEEP_WAIT_S`] (about 0.003 + 0.007 at
+/// 4 MHz; the rounds come later than that when it runs short). It was 0.02, which spent 1.2 s
+/// of CPU in a 60 s run on 10 ms x 50 searches of absent PRNs (half the searches' cost, a
+/// third of the run's).
+pub const DEFAULT_PER_SIGNAL_S: f64 = 0.005;
 
 /// The CPU time searches may spend. Searches of a satellite lost in the last [`HOT_FOR_S`] at
 /// the configured level (narrow and cheap: re-acquisition) are not charged.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SearchBudget {
-    /// Refill per second of signal, CPU s (0.02: searching costs at most 2 % of a core).
+    /// Refill per second of signal, CPU s (0.005: searching costs at most 0.5 % of a core
+    /// after the first round).
     pub per_signal_s: f64,
     /// Capacity of the bucket, CPU s (spent at once at the start: a first full round).
     pub burst_s: f64,
@@ -174,6 +195,9 @@ struct PrnState {
     searches: u32,
     /// Sample index before which it is not searched.
     not_before: u64,
+    /// Sample index before which, unpredicted, it is not searched past level 0 again
+    /// ([`DEEP_WAIT_S`]; 0: its first escalation is still to come).
+    deep_not_before: u64,
 }
 
 /// A candidate for the next batch: priority (lower first), its level, target and cost.
@@ -269,13 +293,28 @@ impl Scheduler {
             .filter_map(|p| self.candidate(p, now, engines, live(p), visibility(p)))
             .collect();
         candidates.sort_by_key(|c| c.priority);
-        let (level, free) = candidates.first().map(|c| (c.level, c.free))?;
+        let (level, free, hot_first) = candidates.first().map(|c| (c.level, c.free, c.hot))?;
         let engine = engines.get(level)?;
         let len = engine.samples_wanted() as u64;
         if window < len {
             return None;
         }
         let mut spent = if free { 0.0 } else { fixed_cost_s(engine) };
+        if !free && !hot_first {
+            // Wait until the batch can hold a few PRNs: each batch pays for its block
+            // spectra, which a batch of one at 10 ms x 50 spends 40 % of its cost on (a
+            // satellite just lost does not wait).
+            let least: f64 = candidates
+                .iter()
+                .filter(|c| c.level == level && !c.free)
+                .take(MIN_BATCH_PRNS)
+                .map(|c| c.cost_s)
+                .sum();
+            // (A full bucket is enough, however expensive the PRNs at a high rate.)
+            if (spent + least).min(self.budget.burst_s) > self.tokens_s {
+                return None;
+            }
+        }
         let mut targets = Vec::new();
         let mut hot = Vec::new();
         for c in candidates.into_iter().filter(|c| c.level == level) {
@@ -387,14 +426,20 @@ impl Scheduler {
                 continue;
             }
             let hot = batch.hot.get(i).copied().unwrap_or(false);
+            let predicted = matches!(visibility(t.prn), Visibility::Visible { .. });
             let wait_s = if hot {
                 HOT_INTERVAL_S
-            } else if batch.level < max_level {
+            } else if batch.level < max_level && (predicted || now >= s.deep_not_before) {
                 s.level = batch.level + 1;
                 0.0
-            } else if matches!(visibility(t.prn), Visibility::Visible { .. }) {
+            } else if predicted {
                 PREDICTED_WAIT_S
             } else {
+                // Unpredicted: the cheap search now and then, the deep ones rarely.
+                if batch.level == max_level {
+                    s.deep_not_before = now + (DEEP_WAIT_S * self.fs_hz) as u64;
+                }
+                s.level = 0;
                 UNKNOWN_WAIT_S
             };
             s.not_before = now + (wait_s * self.fs_hz) as u64;
@@ -559,17 +604,27 @@ mod tests {
     fn unfound_satellites_are_searched_ever_harder_within_the_budget() {
         // Eight satellites tracked, the 24 other PRNs searched with nothing known of them.
         let wanted: Vec<Prn> = (9..=32).filter_map(|p| Prn::new(p).ok()).collect();
+        let seconds = 120.0;
         let log = run_for(
-            60.0,
+            seconds,
             &|_| Visibility::Unknown,
             SearchBudget::default(),
             &wanted,
         );
         for (i, l) in log.iter().enumerate().skip(8) {
             let levels: Vec<usize> = l.iter().map(|x| x.0).collect();
-            // Every PRN reaches the most sensitive search within a minute, in order.
+            // Every PRN reaches the most sensitive search within two minutes, in order (the
+            // burst pays for most of the round, the refill for the rest).
             assert!(levels.len() >= 3, "PRN {}: {levels:?}", i + 1);
             assert_eq!(&levels[..3], &[0, 1, 2], "PRN {}", i + 1);
+            // Then only the cheap search, every UNKNOWN_WAIT_S, until DEEP_WAIT_S is over.
+            let deep_at = l[2].1;
+            for w in l[2..].windows(2) {
+                assert_eq!(w[1].0, 0, "PRN {}: {levels:?}", i + 1);
+                let gap_s = (w[1].1 - w[0].1) as f64 / FS;
+                assert!(gap_s >= UNKNOWN_WAIT_S - 0.01, "PRN {}: {gap_s} s", i + 1);
+            }
+            assert!(((seconds * FS) as u64) < deep_at + (DEEP_WAIT_S * FS) as u64);
         }
         // The modelled CPU time spent stays within the budget: the burst + the refill.
         let engines = engines();
@@ -591,8 +646,46 @@ mod tests {
             .map(|&(lvl, _)| fixed_cost_s(&engines[lvl]))
             .sum();
         let spent = spent + fixed;
-        let allowed = BURST_S + DEFAULT_PER_SIGNAL_S * 60.0;
+        let allowed = BURST_S + DEFAULT_PER_SIGNAL_S * seconds;
         assert!(spent <= allowed + 1e-9, "spent {spent} s of {allowed} s");
+    }
+
+    #[test]
+    fn an_absent_satellite_is_searched_deep_again_only_after_the_deep_wait() {
+        // Four PRNs nothing is known of, never found, over 1.5 DEEP_WAIT_S with a budget
+        // that never runs short: per PRN the round 0, 1, 2, then level 0 alone every
+        // UNKNOWN_WAIT_S, then the round again once DEEP_WAIT_S has passed since the first
+        // deep search failed.
+        let wanted: Vec<Prn> = (1..=4).filter_map(|p| Prn::new(p).ok()).collect();
+        let seconds = 1.5 * DEEP_WAIT_S;
+        let log = run_for(
+            seconds,
+            &|_| Visibility::Unknown,
+            SearchBudget::per_signal(1.0),
+            &wanted,
+        );
+        for (i, l) in log.iter().enumerate().take(4) {
+            let levels: Vec<usize> = l.iter().map(|x| x.0).collect();
+            let deep: Vec<u64> = l.iter().filter(|x| x.0 == 2).map(|x| x.1).collect();
+            assert_eq!(deep.len(), 2, "PRN {}: {levels:?}", i + 1);
+            let apart_s = (deep[1] - deep[0]) as f64 / FS;
+            assert!(
+                (DEEP_WAIT_S..DEEP_WAIT_S + UNKNOWN_WAIT_S + 1.0).contains(&apart_s),
+                "PRN {}: deep searches {apart_s} s apart",
+                i + 1
+            );
+            // Between them: cheap searches only, every UNKNOWN_WAIT_S.
+            let between = l.iter().filter(|x| x.1 > deep[0] && x.1 < deep[1]);
+            let cheap: Vec<usize> = between.map(|x| x.0).collect();
+            let want = (DEEP_WAIT_S / UNKNOWN_WAIT_S) as usize;
+            assert!(
+                cheap.len() + 2 >= want && cheap.len() <= want + 2,
+                "PRN {}: {cheap:?}",
+                i + 1
+            );
+            assert_eq!(&cheap[cheap.len() - 2..], &[0, 1], "PRN {}", i + 1);
+            assert!(cheap[..cheap.len() - 1].iter().all(|&x| x == 0));
+        }
     }
 
     #[test]

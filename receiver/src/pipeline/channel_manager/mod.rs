@@ -356,8 +356,11 @@ impl ChannelManager {
         let outcome = match (engine, search) {
             (Some(engine), Some(s)) => {
                 let search = || {
-                    let samples = window.get_cf32(s.first, s.len).unwrap_or_default();
-                    engine.search(&samples, &s.targets)
+                    // Read where the window holds them (converted block by block).
+                    let samples = window
+                        .get(s.first, s.len)
+                        .unwrap_or(gpsrx_dsp::SampleSlice::Cf32(&[]));
+                    engine.search_slice(samples, &s.targets)
                 };
                 let (results, ()) = rayon::join(search, run_all);
                 let results = results
