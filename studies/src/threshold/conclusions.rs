@@ -90,7 +90,7 @@ fn explain(r: &CellResult, all: &[CellResult]) -> String {
                     s,
                     ": the 3rd-order loop is only conditionally stable, and below {} dB-Hz the \
                      loop gain the Costas atan slope leaves (< {} of the design: the slope \
-                     1 - exp(-C/N0 T) is normalised only down to 0.5) makes the linearised loop \
+                     1 - exp(-C/N0 T) is normalised only down to 0.05) makes the linearised loop \
                      unstable: it slips whatever its jitter",
                     fmt(th.stable_dbhz.unwrap_or(f64::NAN), 1),
                     fmt(gain, 2)
@@ -109,7 +109,7 @@ fn explain(r: &CellResult, all: &[CellResult]) -> String {
             }) {
                 let _ = write!(
                     s,
-                    ": the stress error grows as the Costas slope 1 - exp(-C/N0 T) below 0.5 \
+                    ": the stress error grows as the Costas slope 1 - exp(-C/N0 T) below 0.05 \
                      lowers the loop gain (theta_e / gain); with it the rule gives {} dB-Hz",
                     fmt(th.rule_slope_dbhz.unwrap_or(f64::NAN), 1)
                 );
@@ -190,7 +190,7 @@ fn loop_reason(r: &CellResult, a: Agreement) -> String {
     match (a, r.loop_dbhz()) {
         (Agreement::Delta(d), Some(l)) if d < 0.0 => format!(
             ": at {} dB-Hz the Costas slope 1 - exp(-C/N0 T) leaves the loop {} of its design \
-             gain (the slope is normalised only down to 0.5), its bandwidth collapses with it \
+             gain (the slope is normalised only down to 0.05), its bandwidth collapses with it \
              and, with nothing to follow, it does not slip; the rule's linear-loop jitter does \
              not apply",
             fmt(l, 1),
@@ -211,7 +211,7 @@ fn loop_reason(r: &CellResult, a: Agreement) -> String {
             }) =>
         {
             format!(
-                ": the stress error grows as the Costas slope 1 - exp(-C/N0 T) below 0.5 lowers \
+                ": the stress error grows as the Costas slope 1 - exp(-C/N0 T) below 0.05 lowers \
                  the loop gain (theta_e / gain); with it the rule gives {} dB-Hz",
                 fmt(th.rule_slope_dbhz.unwrap_or(f64::NAN), 1)
             )

@@ -209,7 +209,7 @@ fn intro_md(quick: bool, seed: u64, runs: usize, wall_s: f64) -> String {
          **Measurement**: at the level of 1 ms correlator outputs (prompt `A d sinc exp(j 2 pi e) \
          + n`, unit noise per component, `A = sqrt(2 CN0 1 ms)`, random data bits), the \
          receiver's own carrier loop (`CarrierLoop`: Costas atan divided by its slope \
-         `1 - exp(-C/N0 T)` down to 0.5, from the lock detector's C/N0, the cell's filter, NCO \
+         `1 - exp(-C/N0 T)` down to 0.05, from the lock detector's C/N0, the cell's filter, NCO \
          held over bit-aligned intervals of T), started in its steady state. **Lock held** is \
          the channel's `pll_lock` in each 1 ms period: its `PllLockDetector` (default settings: \
          bit-aligned 20-prompt coherent blocks, steadiness `|LPF(S^2)|/s >= 0.7` with `s` the \
@@ -223,8 +223,8 @@ fn intro_md(quick: bool, seed: u64, runs: usize, wall_s: f64) -> String {
          **Other columns**: `stress_deg` theta_e; `detector_dbhz` the lock detector's floor \
          (where `exp(-2 sigma^2) - 1.645 eps/sqrt(2)` reaches 0.7, `eps` the relative error of \
          its estimate at the block SNR `rho` = 20 ms of C/N0); `theory_slope_dbhz` the rule with \
-         the stress divided by the loop gain the normalised Costas slope leaves (below 0.5: \
-         slope/0.5; a lower loop gain leaves a larger steady-state error); `stable_dbhz` the \
+         the stress divided by the loop gain the normalised Costas slope leaves (below 0.05: \
+         slope/0.05; a lower loop gain leaves a larger steady-state error); `stable_dbhz` the \
          C/N0 below which that gain leaves a \
          3rd-order loop (only conditionally stable) linearly unstable; `expected_dbhz` the \
          highest of `theory_slope_dbhz`, `stable_dbhz` and `detector_dbhz`; `loop_dbhz` the \

@@ -286,9 +286,16 @@ mod tests {
         assert_eq!((end.1, end.2), (ChannelState::Track, true), "{end:?}");
         // The loop's NCO frequency over the last second (one 1 ms report of a 1 Hz loop at
         // 31 dB-Hz is off by a few tenths of a hertz).
-        let last: Vec<f64> = eps.iter().filter(|e| e.0 > end.0 - 1.0).map(|e| e.3).collect();
+        let last: Vec<f64> = eps
+            .iter()
+            .filter(|e| e.0 > end.0 - 1.0)
+            .map(|e| e.3)
+            .collect();
         let mean = last.iter().sum::<f64>() / last.len().max(1) as f64;
-        assert!((mean - (DOPPLER_HZ + 5.0)).abs() < 0.2, "{mean} Hz, end {end:?}");
+        assert!(
+            (mean - (DOPPLER_HZ + 5.0)).abs() < 0.2,
+            "{mean} Hz, end {end:?}"
+        );
     }
 
     /// Without the signal (and with the C/N0 loss switched off) the recovery cannot lock:
