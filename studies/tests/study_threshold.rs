@@ -26,12 +26,14 @@ fn quick_threshold_study_writes_the_table_the_csv_and_the_plots() {
     assert!(rows.len() >= 12, "{} cells", rows.len());
     let num = |r: &HashMap<&str, &str>, c: &str| r[c].parse::<f64>().unwrap_or(f64::NAN);
     // The 2nd-order static loops at T = 20 ms: the loop itself (slip-free by the truth) holds
-    // to within 3 dB of the rule of thumb; the receiver's lock reading is never below the lock
-    // detector's floor less 1 dB (it cannot read lock where its blocks are too weak).
+    // to within 3 dB of the rule of thumb with the digital loop's realised bandwidth (18 Hz for
+    // a 10 Hz design at Bn T = 0.2); the receiver's lock reading is never below the lock
+    // detector's floor less 1 dB (it cannot read lock where its estimate is too noisy).
     let mut checked = 0;
     for r in &rows {
         if r["dynamics"] == "static" && r["order"] == "2" && r["t_coh_ms"] == "20" {
-            let (l, t) = (num(r, "loop_dbhz"), num(r, "theory_dbhz"));
+            let l = num(r, "loop_dbhz");
+            let t = num(r, "theory_dbhz").max(num(r, "theory_real_dbhz"));
             assert!((l - t).abs() <= 3.0, "{r:?}");
             assert!(
                 num(r, "measured_dbhz") >= num(r, "detector_dbhz") - 1.0,
