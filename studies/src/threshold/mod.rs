@@ -45,8 +45,8 @@ pub use self::if_check::{
 };
 pub use self::measure::{measure_cell, run_seed, run_seed_raw, Measured};
 pub use self::params::{
-    AGREE_DB, HOLD_FRACTION, PRE_ROLL_S, RULE_LIMIT_DEG, SCAN_BOTTOM_DBHZ, SCAN_STEP_DB,
-    SCAN_TOP_DBHZ, WINDOW_S,
+    AGREE_DB, HOLD_FRACTION, PRE_ROLL_S, RULE_LIMIT_DEG, RUNS_PER_STEP, SCAN_BOTTOM_DBHZ,
+    SCAN_STEP_DB, SCAN_TOP_DBHZ, WINDOW_S,
 };
 pub use self::result::{cell_theory, Agreement, CellResult, CellTheory};
 pub use self::sim::{run as run_once, steady_state_error_cycles, RunOutcome};
