@@ -11,6 +11,7 @@ use super::{
     THRESHOLD_SIGMA_DEG, TOLERANCE,
 };
 use crate::steady_state::stability_limit_bn_t;
+use gpsrx_tracking::carrier_loop::MIN_COSTAS_SLOPE;
 use gpsrx_tracking::config::MAX_BN_T;
 use gpsrx_tracking::loop_filter::{A3, B3};
 use std::fmt::Write as _;
@@ -138,8 +139,10 @@ pub(super) fn low_snr_failure(results: &[CellResult]) -> String {
         .iter()
         .map(|&cn0| {
             let g = 1.0 - (-lin(cn0) * 1e-3).exp();
+            // The loop gain after the receiver's slope normalisation.
+            let k = g / g.max(MIN_COSTAS_SLOPE);
             let (l, n) = order3_t1_locked(results, cn0);
-            let stability = if g > g_min {
+            let stability = if k > g_min {
                 "linearly stable"
             } else {
                 "linearly unstable"
@@ -148,8 +151,8 @@ pub(super) fn low_snr_failure(results: &[CellResult]) -> String {
                 format!("{cn0} dB-Hz: g = {g:.2} (no 3rd-order 1 ms cell ran)")
             } else {
                 format!(
-                    "{cn0} dB-Hz: g = {g:.2}, every 3rd-order 1 ms loop {stability}, {l} of {n} \
-                     held lock"
+                    "{cn0} dB-Hz: g = {g:.2}, loop gain {k:.2}, every 3rd-order 1 ms loop \
+                     {stability}, {l} of {n} held lock"
                 )
             }
         })
@@ -178,8 +181,10 @@ pub(super) fn low_snr_failure(results: &[CellResult]) -> String {
          the `atan(Q/I)` discriminator's mean slope is `g = 1 - exp(-C/N0 T)` and its output \
          saturates at +-90 deg, so the formula's squaring loss `1 + 1/(2 T C/N0)` no longer \
          describes it (`phase_jitter_loop_deg` uses the discriminator's own statistics); a \
-         3rd-order loop's analog characteristic polynomial `s^3 + g(b3 w s^2 + a3 w^2 s + w^3)` \
-         needs `g a3 b3 > 1`, g > {g_min:.2} (Routh). At 1 ms: {}.",
+         3rd-order loop's analog characteristic polynomial `s^3 + k(b3 w s^2 + a3 w^2 s + w^3)` \
+         needs a loop gain `k a3 b3 > 1`, k > {g_min:.2} (Routh); the receiver divides the \
+         discriminator by `g` down to {MIN_COSTAS_SLOPE} (`CarrierLoop::costas_gain`), so \
+         `k = g / max(g, {MIN_COSTAS_SLOPE})`. At 1 ms: {}.",
         per_cn0.join("; ")
     );
     s
