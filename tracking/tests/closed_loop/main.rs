@@ -5,6 +5,7 @@
 
 mod aided;
 mod bandwidth;
+mod costas_gain;
 mod dll;
 mod dynamics;
 mod estimators;
