@@ -730,21 +730,47 @@ impl SampleSource for IntSource<'_> {
     }
 }
 
+/// A run of the 8 s recording as integer samples of `format` at 2.048 MHz: offered to the
+/// receiver as stored (`offer_integers`) or converted to f32 first, with the correlator
+/// `arithmetic`.
+fn run_held(
+    sim: &Simulator,
+    format: IntegerFormat,
+    offer_integers: bool,
+    arithmetic: gpsrx_tracking::CorrelatorArithmetic,
+) -> (gpsrx_receiver::RunSummary, MemorySink) {
+    let mut sink = MemorySink::new();
+    let summary = receiver_with(2.048e6, |c| c.tracking.correlator_arithmetic = arithmetic)
+        .run(&mut IntSource::new(sim, format, offer_integers), &mut sink)
+        .unwrap_or_else(|e| panic!("{e}"));
+    (summary, sink)
+}
+
+/// Two runs of the same samples give the same events and fixes, the fixes within `tol_m`.
+fn assert_same_fixes(
+    (a, sa): (&gpsrx_receiver::RunSummary, &MemorySink),
+    (b, sb): (&gpsrx_receiver::RunSummary, &MemorySink),
+    tol_m: f64,
+) {
+    assert_eq!(a.fixes, b.fixes);
+    assert_eq!(a.tracked_prns, b.tracked_prns);
+    assert_eq!(sa.events, sb.events);
+    for (x, y) in sa.fixes.iter().zip(&sb.fixes) {
+        assert_eq!(x.t_stream_s, y.t_stream_s);
+        assert!((x.fix.time.tow_s - y.fix.time.tow_s).abs() < 1e-9);
+        let d: f64 = (0..3)
+            .map(|i| (x.fix.ecef_m[i] - y.fix.ecef_m[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(d < tol_m, "fixes {d} m apart at {:.1} s", x.t_stream_s);
+    }
+}
+
 #[test]
 fn ci8_samples_held_as_stored_give_the_fixes_of_the_same_samples_in_f32() {
     use gpsrx_tracking::CorrelatorArithmetic;
     let sim = simulator(8.0);
-    let fs = 2.048e6;
-    let run = |offer_integers: bool, arithmetic: CorrelatorArithmetic| {
-        let mut sink = MemorySink::new();
-        let summary = receiver_with(fs, |c| c.tracking.correlator_arithmetic = arithmetic)
-            .run(
-                &mut IntSource::new(&sim, IntegerFormat::Ci8, offer_integers),
-                &mut sink,
-            )
-            .unwrap_or_else(|e| panic!("{e}"));
-        (summary, sink)
-    };
+    let run = |offer, arithmetic| run_held(&sim, IntegerFormat::Ci8, offer, arithmetic);
     let (a, as_f32) = run(false, CorrelatorArithmetic::F32);
     // The same f32 kernel on the ci8 held as stored: the same sums in another lane order.
     let (b, as_stored) = run(true, CorrelatorArithmetic::F32);
@@ -752,20 +778,8 @@ fn ci8_samples_held_as_stored_give_the_fixes_of_the_same_samples_in_f32() {
     // 4.1e-4): the same fixes to a few centimetres, far below their metre-level noise.
     let (c, as_i16) = run(true, CorrelatorArithmetic::Auto);
     assert!(a.fixes > 5, "{} fixes", a.fixes);
-    for (other, summary, tol_m) in [(&as_stored, &b, 1e-3), (&as_i16, &c, 0.25)] {
-        assert_eq!(a.fixes, summary.fixes);
-        assert_eq!(a.tracked_prns, summary.tracked_prns);
-        assert_eq!(as_f32.events, other.events);
-        for (x, y) in as_f32.fixes.iter().zip(&other.fixes) {
-            assert_eq!(x.t_stream_s, y.t_stream_s);
-            assert!((x.fix.time.tow_s - y.fix.time.tow_s).abs() < 1e-9);
-            let d: f64 = (0..3)
-                .map(|i| (x.fix.ecef_m[i] - y.fix.ecef_m[i]).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            assert!(d < tol_m, "fixes {d} m apart at {:.1} s", x.t_stream_s);
-        }
-    }
+    assert_same_fixes((&a, &as_f32), (&b, &as_stored), 1e-3);
+    assert_same_fixes((&a, &as_f32), (&c, &as_i16), 0.25);
     for (f, (h, v)) in as_i16.fixes.iter().zip(fix_errors(&sim, &as_i16)) {
         let (h_max, v_max) = fix_bounds();
         assert!(
@@ -783,29 +797,9 @@ fn ci16_samples_held_as_stored_give_the_fixes_of_the_same_samples_in_f32() {
     // same fixes to a few centimetres, as the f32 kernel on the same samples read as f32.
     use gpsrx_tracking::CorrelatorArithmetic;
     let sim = simulator(8.0);
-    let fs = 2.048e6;
-    let run = |offer_integers: bool, arithmetic: CorrelatorArithmetic| {
-        let mut sink = MemorySink::new();
-        let summary = receiver_with(fs, |c| c.tracking.correlator_arithmetic = arithmetic)
-            .run(
-                &mut IntSource::new(&sim, IntegerFormat::Ci16, offer_integers),
-                &mut sink,
-            )
-            .unwrap_or_else(|e| panic!("{e}"));
-        (summary, sink)
-    };
+    let run = |offer, arithmetic| run_held(&sim, IntegerFormat::Ci16, offer, arithmetic);
     let (a, as_f32) = run(false, CorrelatorArithmetic::F32);
     let (b, as_i16) = run(true, CorrelatorArithmetic::Auto);
     assert!(a.fixes > 5, "{} fixes", a.fixes);
-    assert_eq!(a.fixes, b.fixes);
-    assert_eq!(a.tracked_prns, b.tracked_prns);
-    assert_eq!(as_f32.events, as_i16.events);
-    for (x, y) in as_f32.fixes.iter().zip(&as_i16.fixes) {
-        assert_eq!(x.t_stream_s, y.t_stream_s);
-        let d: f64 = (0..3)
-            .map(|i| (x.fix.ecef_m[i] - y.fix.ecef_m[i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        assert!(d < 0.25, "fixes {d} m apart at {:.1} s", x.t_stream_s);
-    }
+    assert_same_fixes((&a, &as_f32), (&b, &as_i16), 0.25);
 }
