@@ -253,10 +253,10 @@ impl PllLockDetector {
         let a = self.alpha.max(1.0 / f64::from(self.tests));
         self.lpf.smooth(&block, a);
         self.recent[self.tests as usize % RECENT_TESTS] = block;
-        if self.power_changed() {
+        if let Some(recent) = self.power_changed() {
             // The long memory would hold a lost signal for seconds (or be slow to follow a
             // stronger one): restart it as the running mean of the recent tests.
-            self.lpf = self.recent_mean();
+            self.lpf = recent;
             self.tests = RECENT_TESTS as u32;
         }
         self.alpha = self.adapted_alpha();
@@ -286,19 +286,20 @@ impl PllLockDetector {
         }
     }
 
-    /// The signal power has changed (lost, faded or risen): the block SNR of the last
-    /// [`RECENT_TESTS`] tests lies more than four standard deviations from the long memory's.
-    /// One test's `|S|^2` has variance `u^2 (1 + 2 rho)`, so the recent mean's SNR has the
-    /// standard deviation `sqrt((1 + 2 rho)/K)`, taken at the larger of the two.
-    fn power_changed(&self) -> bool {
+    /// The mean of the last [`RECENT_TESTS`] tests when the signal power has changed (lost,
+    /// faded or risen): their block SNR lies more than four standard deviations from the long
+    /// memory's. One test's `|S|^2` has variance `u^2 (1 + 2 rho)`, so the recent mean's SNR
+    /// has the standard deviation `sqrt((1 + 2 rho)/K)`, taken at the larger of the two.
+    fn power_changed(&self) -> Option<BlockMoments> {
         let long = self.block_snr();
         if (self.tests as usize) < 2 * RECENT_TESTS || !long.is_finite() {
-            return false;
+            return None;
         }
-        let recent = self.recent_mean().snr(self.cfg.coherent_sum);
-        let rho = long.max(recent);
+        let recent = self.recent_mean();
+        let rho_recent = recent.snr(self.cfg.coherent_sum);
+        let rho = long.max(rho_recent);
         let std = ((1.0 + 2.0 * rho) / RECENT_TESTS as f64).sqrt();
-        (recent - long).abs() > 4.0 * std
+        ((rho_recent - long).abs() > 4.0 * std).then_some(recent)
     }
 
     /// The C/N0 (Hz) the block SNR gives, `rho / (M t_prompt_s)`, with prompts of
