@@ -21,20 +21,17 @@ impl LoopNoiseGains {
     /// Runs `filter` (as configured, from rest) for an impulse `n_0 = 1` with discriminator slope
     /// `slope`, for `150 / (Bn T slope)` updates (at most 8 million), long after the response of
     /// a stable loop has decayed (the slowest mode, order 3, decays by `exp(-22)` by then).
-    pub fn new(mut filter: LoopFilter, bn_hz: f64, t_s: f64, slope: f64) -> Self {
-        let n = ((150.0 / (bn_hz * t_s * slope.max(0.05))).ceil() as usize).clamp(1000, 8_000_000);
-        let mut phase = Vec::with_capacity(n);
-        let mut freq = Vec::with_capacity(n);
-        let (mut phi, mut u) = (0.0, 0.0);
-        for k in 0..n {
-            phase.push(phi);
-            freq.push(u);
-            let noise = if k == 0 { 1.0 } else { 0.0 };
-            let e = noise - slope * (phi + 0.5 * u * t_s);
-            phi += u * t_s;
-            u = filter.update(e, 0.0, t_s);
-        }
+    pub fn new(filter: LoopFilter, bn_hz: f64, t_s: f64, slope: f64) -> Self {
+        let (phase, freq) = impulse_response(filter, bn_hz, t_s, slope).unzip();
         Self { t_s, phase, freq }
+    }
+
+    /// [`LoopNoiseGains::phase_gain`] without keeping the response (for long responses in a
+    /// search).
+    pub fn phase_gain_of(filter: LoopFilter, bn_hz: f64, t_s: f64, slope: f64) -> f64 {
+        impulse_response(filter, bn_hz, t_s, slope)
+            .map(|(phi, _)| phi * phi)
+            .sum()
     }
 
     /// `var(phi)` per unit noise variance: `sum h_phi^2`.
@@ -78,6 +75,26 @@ impl LoopNoiseGains {
             .sum::<f64>()
             / (2.0 * t)
     }
+}
+
+/// The NCO phase and frequency `(phi_k, u_k)` of the loop's impulse response (struct docs) for
+/// `150 / (Bn T slope)` updates, clamped to [1000, 8 million].
+fn impulse_response(
+    mut filter: LoopFilter,
+    bn_hz: f64,
+    t_s: f64,
+    slope: f64,
+) -> impl Iterator<Item = (f64, f64)> {
+    let n = ((150.0 / (bn_hz * t_s * slope.max(0.05))).ceil() as usize).clamp(1000, 8_000_000);
+    let (mut phi, mut u) = (0.0, 0.0);
+    (0..n).map(move |k| {
+        let out = (phi, u);
+        let noise = if k == 0 { 1.0 } else { 0.0 };
+        let e = noise - slope * (phi + 0.5 * u * t_s);
+        phi += u * t_s;
+        u = filter.update(e, 0.0, t_s);
+        out
+    })
 }
 
 /// How long the start-up transients of a linearised loop (discriminator slope `slope`) take to

@@ -44,6 +44,7 @@ pub(super) fn feedforward(
         0.0,
         truth(0.0).pos_m,
         Some(CLOCK_DRIFT_S_S * SPEED_OF_LIGHT_MPS),
+        None,
     );
     Ok(ff)
 }

@@ -4,7 +4,9 @@
 use super::params::{AGREE_DB, SCAN_TOP_DBHZ};
 use super::result::{Agreement, CellResult};
 use super::theory::loop_gain;
+use crate::bandwidth::costas_atan_stats;
 use crate::report::fmt;
+use std::f64::consts::PI;
 use std::fmt::Write as _;
 
 fn cell_name(r: &CellResult) -> String {
@@ -157,6 +159,7 @@ fn explain(r: &CellResult, all: &[CellResult]) -> String {
     if !matches!(r.vs_rule(), Some(Agreement::TheoryNone)) {
         let _ = write!(s, "; {}", failure_words(r));
     }
+    s += &atan_words(r);
     match r.loop_vs_rule() {
         Some(Agreement::Delta(d)) => {
             let _ = write!(
@@ -182,6 +185,35 @@ fn explain(r: &CellResult, all: &[CellResult]) -> String {
         );
     }
     s
+}
+
+/// What the rule with the receiver's own discriminator noise says of a cell, in words.
+fn atan_words(r: &CellResult) -> String {
+    match (r.vs_atan_rule(), r.theory.rule_atan_dbhz) {
+        (Some(Agreement::Delta(d)), Some(a)) => {
+            let t = r.cell.t_coh_s();
+            let rho = 10f64.powf(a / 10.0) * t;
+            let stats = costas_atan_stats(a, t);
+            let kaplan = (1.0 + 1.0 / (2.0 * rho)) / (2.0 * rho) / (4.0 * PI * PI);
+            format!(
+                "; the rule with the atan discriminator's own noise through the digital loop \
+                 gives {} dB-Hz ({} dB from the measurement{}): there (prompt SNR {} dB) the \
+                 atan's variance per unit slope is {}x that of Kaplan's squaring loss, and the \
+                 digital loop's phase noise gain that of Bn = {} Hz",
+                fmt(a, 1),
+                fmt(d, 1),
+                if d.abs() <= AGREE_DB {
+                    ", within 3 dB"
+                } else {
+                    ", still more than 3 dB"
+                },
+                fmt(10.0 * rho.log10(), 1),
+                fmt(stats.noise_var / (stats.slope * stats.slope) / kaplan, 2),
+                fmt(r.theory.realised_bn_hz, 2)
+            )
+        }
+        _ => String::new(),
+    }
 }
 
 /// Why a loop's own threshold is far from the rule, from its numbers.
@@ -216,9 +248,37 @@ fn loop_reason(r: &CellResult, a: Agreement) -> String {
                 fmt(th.rule_slope_dbhz.unwrap_or(f64::NAN), 1)
             )
         }
+        (Agreement::Delta(_), Some(l))
+            if th.rule_atan_dbhz.is_some_and(|x| (l - x).abs() <= AGREE_DB) =>
+        {
+            format!(
+                ": within {} dB of the rule with the atan noise, {} dB-Hz",
+                fmt(AGREE_DB, 0),
+                fmt(th.rule_atan_dbhz.unwrap_or(f64::NAN), 1)
+            )
+        }
         (Agreement::Delta(_), Some(_)) => ": above the rule, unexplained by the floors".into(),
         _ => String::new(),
     }
+}
+
+/// `measured minus theory over the K cells with both thresholds: mean M dB, from LO to HI dB`
+/// (empty without any).
+fn spread_words(deltas: &[f64]) -> String {
+    if deltas.is_empty() {
+        return String::new();
+    }
+    let mean = deltas.iter().sum::<f64>() / deltas.len() as f64;
+    let lo = deltas.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = deltas.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    format!(
+        "measured minus theory over the {} cells with both thresholds: mean {} dB, from {} to {} \
+         dB",
+        deltas.len(),
+        fmt(mean, 1),
+        fmt(lo, 1),
+        fmt(hi, 1)
+    )
 }
 
 /// The conclusions of `results` (Markdown).
@@ -244,11 +304,33 @@ pub fn conclusions_md(results: &[CellResult]) -> String {
             _ => None,
         })
         .collect();
+    let agree_atan = run
+        .iter()
+        .filter(|r| r.vs_atan_rule().is_some_and(|a| a.agrees()))
+        .count();
+    let atan_deltas: Vec<f64> = run
+        .iter()
+        .filter_map(|r| match r.vs_atan_rule() {
+            Some(Agreement::Delta(d)) => Some(d),
+            _ => None,
+        })
+        .collect();
     let mut s = String::from("## Conclusions\n\n");
     let _ = writeln!(
         s,
-        "- **{agree} of {n} cells ({:.0} %) hold lock to within {} dB of the rule of thumb** \
-         ({both_none} of them with no threshold in either); {agree_exp} of {n} ({:.0} %) are within \
+        "- **{agree_atan} of {n} cells ({:.0} %) hold lock to within {} dB of the rule of thumb \
+         with the receiver's own discriminator noise** (`theory_atan_dbhz`: `3 sigma + theta_e \
+         <= 45` deg with the atan discriminator's exact variance and slope through the \
+         linearised digital loop); {}.",
+        pct(agree_atan, n),
+        fmt(AGREE_DB, 0),
+        spread_words(&atan_deltas),
+    );
+    let _ = writeln!(
+        s,
+        "- **{agree} of {n} cells ({:.0} %) hold lock to within {} dB of the rule of thumb with \
+         Kaplan's thermal formula** (`theory_dbhz`; {both_none} of them with no threshold in \
+         either); {agree_exp} of {n} ({:.0} %) are within \
          {} dB of the expected threshold (`expected_dbhz`: the highest of the rule with the stress \
          over the Costas slope, the 3rd-order stability floor and the lock detector's floor).",
         pct(agree, n),
@@ -257,22 +339,19 @@ pub fn conclusions_md(results: &[CellResult]) -> String {
         fmt(AGREE_DB, 0),
     );
     if !deltas.is_empty() {
-        let mean = deltas.iter().sum::<f64>() / deltas.len() as f64;
-        let lo = deltas.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = deltas.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let _ = writeln!(
-            s,
-            "- Measured minus rule over the {} cells with both thresholds: mean {} dB, from {} to \
-             {} dB.",
-            deltas.len(),
-            fmt(mean, 1),
-            fmt(lo, 1),
-            fmt(hi, 1)
-        );
+        let _ = writeln!(s, "- Against Kaplan's rule, {}.", spread_words(&deltas));
     }
     let loop_agree = run
         .iter()
         .filter(|r| r.loop_vs_rule().is_some_and(|a| a.agrees()))
+        .count();
+    let loop_agree_atan = run
+        .iter()
+        .filter(|r| {
+            r.measured
+                .map(|m| Agreement::of(m.loop_threshold_dbhz, r.theory.rule_atan_dbhz))
+                .is_some_and(|a| a.agrees())
+        })
         .count();
     let loop_agree_exp = run
         .iter()
@@ -297,17 +376,19 @@ pub fn conclusions_md(results: &[CellResult]) -> String {
         .collect();
     let _ = writeln!(
         s,
-        "- **The loops themselves** (slip-free against the truth for {:.0} % of the window, whatever the lock detector says): {loop_agree} of {n} ({:.0} %) within {} dB of the rule, \
+        "- **The loops themselves** (slip-free against the truth for {:.0} % of the window, whatever the lock detector says): {loop_agree_atan} of {n} ({:.0} %) within {} dB of the rule with the atan noise; {loop_agree} of {n} ({:.0} %) within {} dB of Kaplan's rule, \
          {loop_agree_exp} of {n} within {} dB of the rule with the slope and stability floor or \
          below it (holding better than theory){}.",
         100.0 * super::params::HOLD_FRACTION,
+        pct(loop_agree_atan, n),
+        fmt(AGREE_DB, 0),
         pct(loop_agree, n),
         fmt(AGREE_DB, 0),
         fmt(AGREE_DB, 0),
         if loop_off.is_empty() {
             String::new()
         } else {
-            format!("; more than 3 dB from the plain rule: {}", loop_off.join("; "))
+            format!("; more than 3 dB from Kaplan's rule: {}", loop_off.join("; "))
         }
     );
     let rejected: Vec<&CellResult> = results.iter().filter(|r| r.rejected.is_some()).collect();
@@ -339,7 +420,7 @@ pub fn conclusions_md(results: &[CellResult]) -> String {
     } else {
         let _ = writeln!(
             s,
-            "\nCells more than {} dB from the rule:\n",
+            "\nCells more than {} dB from Kaplan's rule:\n",
             fmt(AGREE_DB, 0)
         );
         for r in off {
@@ -399,6 +480,10 @@ mod tests {
         ];
         let a = conclusions_md(&good);
         assert!(a.contains("2 of 2 cells (100 %)"), "{a}");
+        assert!(
+            a.contains("2 of 2 cells (100 %) hold lock to within 3 dB of the rule of thumb with the receiver's own"),
+            "{a}"
+        );
         assert!(a.contains("Every cell run is within 3 dB"), "{a}");
         let bad = vec![
             result(2, 18.0, Some(rule + 0.5)),
@@ -407,6 +492,11 @@ mod tests {
         let b = conclusions_md(&bad);
         assert_ne!(a, b);
         assert!(b.contains("1 of 2 cells (50 %)"), "{b}");
+        assert!(
+            b.contains("1 of 2 cells (50 %) hold lock to within 3 dB of the rule of thumb with the receiver's own"),
+            "{b}"
+        );
+        assert!(b.contains("still more than 3 dB"), "{b}");
         assert!(
             b.contains("order 3, Bn 18.0 Hz, T 1 ms, static: measured"),
             "{b}"

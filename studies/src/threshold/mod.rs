@@ -4,13 +4,15 @@
 //! (unaided and INS-aided), against the theoretical threshold (the rule of thumb
 //! `3 sigma + theta_e <= 45` deg for a Costas PLL, Kaplan & Hegarty 2nd ed. sec. 5.6).
 //!
-//! - theory ([`rule_threshold_dbhz`], [`detector_floor_dbhz`], [`stability_floor_dbhz`],
-//!   [`rule_with_slope_dbhz`]): the rule of thumb and the floors, solved for C/N0.
+//! - theory ([`rule_threshold_dbhz`], [`rule_atan_dbhz`], [`detector_floor_dbhz`],
+//!   [`stability_floor_dbhz`], [`rule_with_slope_dbhz`]): the rule of thumb (with Kaplan's
+//!   thermal formula and with the receiver's own discriminator noise) and the floors, solved
+//!   for C/N0.
 //! - sim ([`run_once`]): one 30 s run at the level of 1 ms correlator outputs with the
 //!   receiver's carrier loop, lock detector and fade detector; "lock held" is the channel's
 //!   `pll_lock`.
-//! - measure ([`measure_cell`]): the scan down in C/N0 (0.5 dB steps, one run per step, fixed
-//!   seeds).
+//! - measure ([`measure_cell`]): the scan down in C/N0 (0.5 dB steps, [`RUNS_PER_STEP`] runs
+//!   pooled per step, fixed seeds).
 //! - grid ([`full_grid`], [`quick_grid`]) and [`Dynamics`]: the cells; [`CellResult`],
 //!   [`build_table`], the plots and [`conclusions_md`]: the report. Besides `study.csv` the
 //!   study writes the same table as `threshold.csv`.
@@ -52,8 +54,9 @@ pub use self::result::{cell_theory, Agreement, CellResult, CellTheory};
 pub use self::sim::{run as run_once, steady_state_error_cycles, RunOutcome};
 pub use self::table::{build_table, COLUMNS};
 pub use self::theory::{
-    allan_jitter_deg, detector_floor_dbhz, detector_relative_error, dynamic_stress_deg, loop_gain,
-    rule_threshold_dbhz, rule_with_slope_dbhz, stability_floor_dbhz, RuleInputs,
+    allan_jitter_deg, atan_thermal_jitter_deg, detector_floor_dbhz, detector_relative_error,
+    dynamic_stress_deg, loop_gain, rule_atan_dbhz, rule_threshold_dbhz, rule_with_slope_dbhz,
+    stability_floor_dbhz, RuleInputs,
 };
 
 use super::report::{StudyReport, Table};
@@ -198,7 +201,14 @@ fn intro_md(quick: bool, seed: u64, runs: usize, wall_s: f64) -> String {
          (`sigma_A = 0`; the theory takes 144 or 160 `sigma_y f_L / Bn` deg for a real one), no \
          vibration, and the dynamic stress `theta_e = 360 (d^n theta/dt^n)/omega0^n` deg of an \
          order-n loop (omega0 = Bn/0.25, Bn/0.53, Bn/0.7845), solved for C/N0 by bisection \
-         (`theory_dbhz`).\n\n\
+         (`theory_dbhz`). Kaplan's squaring loss `1 + 1/(2 T CN0)` is that of the product \
+         (`I Q`) discriminator; the receiver's is `atan(Q/I)`, whose output folds into \
+         (-90, 90] deg and is noisier below about 0 dB of prompt SNR (2.0x the formula's \
+         variance per unit slope at C/N0 T = 0.5, 3.0x at 0.06), so `theory_atan_dbhz` is the \
+         same rule with `sigma_t` from the atan's exact variance and slope (numerical integration \
+         over the prompt phase density, checked against a Monte Carlo run of the receiver's \
+         discriminator) through the linearised digital loop's phase noise gain, and the stress \
+         over the normalised loop gain.\n\n\
          **Dynamics** (what the loop must follow after the feed-forward): `static`; `accel 1 g` \
          (unaided, constant LOS acceleration, orders 2-3); `jerk 10 g/s` (unaided, constant LOS \
          jerk, the entry of a turn that reaches 10 g in 1 s, order 3); `INS bias 1 mg` (aided \
@@ -216,9 +226,9 @@ fn intro_md(quick: bool, seed: u64, runs: usize, wall_s: f64) -> String {
          block's signal power estimated without the noise bias, a low-pass adapted to the block \
          SNR, steady offset <= 0.2 cycle, 10-test hysteresis) locked and its fade detector \
          quiet. \
-         Each C/N0 is one run of {pre:.0} s + {window:.0} s (fixed seeds from `--seed {seed}`); \
-         the scan goes down from {top:.0} dB-Hz in {step} dB steps and stops at the first run \
-         that holds lock less than {hold:.0} % of the window: `measured_dbhz` is the last that \
+         Each C/N0 is {per} runs of {pre:.0} s + {window:.0} s with their held shares pooled \
+         (fixed seeds from `--seed {seed}`); the scan goes down from {top:.0} dB-Hz in {step} dB \
+         steps and stops at the first C/N0 that holds lock less than {hold:.0} % of the window: `measured_dbhz` is the last that \
          held (`none`: not even at the top). {runs} runs in {wall_s:.0} s.\n\n\
          **Other columns**: `stress_deg` theta_e; `detector_dbhz` the lock detector's floor \
          (where `exp(-2 sigma^2) - 1.645 eps/sqrt(2)` reaches 0.7, `eps` the relative error of \
@@ -237,6 +247,7 @@ fn intro_md(quick: bool, seed: u64, runs: usize, wall_s: f64) -> String {
         ts = T_COH_MS.map(|t| t.to_string()).join(" and "),
         grid = if quick { "quick" } else { "full" },
         pre = PRE_ROLL_S,
+        per = RUNS_PER_STEP,
         top = SCAN_TOP_DBHZ,
         step = SCAN_STEP_DB,
     )

@@ -85,6 +85,11 @@ fn static_series(results: &[CellResult], t_coh_ms: u32) -> Vec<Series> {
         reference: true,
     });
     series.push(Series {
+        name: format!("rule with atan noise (order {lowest})"),
+        points: points(results, lowest, t_coh_ms, d, |r| r.theory.rule_atan_dbhz),
+        reference: true,
+    });
+    series.push(Series {
         name: "lock detector floor".into(),
         points: points(results, lowest, t_coh_ms, d, |r| r.theory.detector_dbhz),
         reference: true,
@@ -125,6 +130,13 @@ fn dynamics_series(results: &[CellResult], t_coh_ms: u32) -> Vec<Series> {
             series.push(Series {
                 name: format!("{label} rule"),
                 points: t,
+                reference: true,
+            });
+            series.push(Series {
+                name: format!("{label} rule, atan noise"),
+                points: points(results, order, t_coh_ms, dynamics, |r| {
+                    r.theory.rule_atan_dbhz
+                }),
                 reference: true,
             });
         }

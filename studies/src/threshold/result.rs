@@ -3,7 +3,7 @@
 use super::measure::Measured;
 use super::params::{AGREE_DB, F_L1_HZ};
 use super::theory::{
-    allan_jitter_deg, detector_floor_dbhz, dynamic_stress_deg, rule_threshold_dbhz,
+    allan_jitter_deg, detector_floor_dbhz, dynamic_stress_deg, rule_atan_dbhz, rule_threshold_dbhz,
     rule_with_slope_dbhz, stability_floor_dbhz, RuleInputs,
 };
 use super::Cell;
@@ -23,6 +23,9 @@ pub struct CellTheory {
     pub realised_bn_hz: f64,
     /// The rule of thumb with the realised Bn, dB-Hz.
     pub rule_realised_dbhz: Option<f64>,
+    /// The rule with the receiver's own (`atan`) discriminator noise through the digital loop
+    /// and the stress over the normalised gain, dB-Hz (`theory::rule_atan_dbhz`).
+    pub rule_atan_dbhz: Option<f64>,
     /// The receiver's lock-detector floor with the rule's jitter, dB-Hz.
     pub detector_dbhz: Option<f64>,
     /// The C/N0 below which the linearised loop with the Costas slope is unstable, dB-Hz
@@ -60,6 +63,9 @@ pub fn cell_theory(cell: &Cell) -> CellTheory {
     let realised_bn_hz = LoopFilter::pll(cell.order, cell.bn_hz)
         .map(|f| LoopNoiseGains::new(f, cell.bn_hz, cell.t_coh_s(), 1.0).noise_bandwidth_hz())
         .unwrap_or(f64::NAN);
+    let phase_gain = LoopFilter::pll(cell.order, cell.bn_hz)
+        .map(|f| LoopNoiseGains::phase_gain_of(f, cell.bn_hz, cell.t_coh_s(), 1.0))
+        .unwrap_or(f64::NAN);
     CellTheory {
         stress_deg,
         rule_dbhz: rule_threshold_dbhz(&inputs),
@@ -69,6 +75,7 @@ pub fn cell_theory(cell: &Cell) -> CellTheory {
             bn_hz: realised_bn_hz,
             ..inputs
         }),
+        rule_atan_dbhz: rule_atan_dbhz(&inputs, phase_gain),
         detector_dbhz: detector_floor_dbhz(&inputs),
         stable_dbhz: stability_floor_dbhz(cell.order, cell.bn_hz, cell.t_coh_s()),
     }
@@ -136,6 +143,12 @@ impl CellResult {
     /// The loop's own (slip-free) threshold, dB-Hz.
     pub fn loop_dbhz(&self) -> Option<f64> {
         self.measured.and_then(|m| m.loop_threshold_dbhz)
+    }
+
+    /// Measured against the rule with the receiver's own discriminator noise.
+    pub fn vs_atan_rule(&self) -> Option<Agreement> {
+        self.measured
+            .map(|m| Agreement::of(m.threshold_dbhz, self.theory.rule_atan_dbhz))
     }
 
     /// The loop's own threshold against the rule of thumb.

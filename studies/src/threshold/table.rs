@@ -5,7 +5,7 @@ use crate::report::{fmt, Table};
 
 /// The columns: the issue's `order`, `bn_hz`, `t_coh_ms`, `dynamics`, `measured_dbhz`,
 /// `theory_dbhz` (the rule of thumb), then the comparison and the other theories.
-pub const COLUMNS: [&str; 21] = [
+pub const COLUMNS: [&str; 24] = [
     "order",
     "bn_hz",
     "t_coh_ms",
@@ -16,6 +16,9 @@ pub const COLUMNS: [&str; 21] = [
     "theory_dbhz",
     "delta_db",
     "within_3db",
+    "theory_atan_dbhz",
+    "atan_delta_db",
+    "within_3db_atan",
     "detector_dbhz",
     "theory_slope_dbhz",
     "stable_dbhz",
@@ -74,6 +77,7 @@ pub fn build_table(results: &[CellResult]) -> Table {
         let c = &r.cell;
         let (delta, within) = agreement(r.vs_rule());
         let (_, within_exp) = agreement(r.vs_expected());
+        let (atan_delta, atan_within) = agreement(r.vs_atan_rule());
         let (loop_delta, loop_within) = agreement(r.loop_vs_rule());
         let run = r.rejected.is_none();
         t.push(vec![
@@ -91,6 +95,9 @@ pub fn build_table(results: &[CellResult]) -> Table {
             level(r.theory.rule_dbhz),
             delta,
             within,
+            level(r.theory.rule_atan_dbhz),
+            atan_delta,
+            atan_within,
             level(r.theory.detector_dbhz),
             level(r.theory.rule_slope_dbhz),
             r.theory

@@ -34,6 +34,19 @@
 //! the detector reports lock less than 95 % of the time even for a loop that holds the phase:
 //! a threshold of the receiver, not of the loop.
 //!
+//! # The discriminator's own noise
+//!
+//! Kaplan's thermal term carries the squaring loss `1 + 1/(2 T CN0)` of the product (`I Q`)
+//! Costas discriminator, derived for a linearised loop at moderate SNR. The receiver's
+//! discriminator is `atan(Q/I)`, whose output folds into `(-pi/2, pi/2]`: below about 0 dB of
+//! prompt SNR its variance per unit of slope grows faster than that (at `rho = CN0 T` = 0.5,
+//! 2.0x the formula's; at 0.06, 3.0x), so the rule with the discriminator's exact statistics
+//! through the linearised digital loop ([`rule_atan_dbhz`]) lies above Kaplan's, the more so
+//! the lower the prompt SNR at the threshold (and, through the digital loop's phase noise gain,
+//! the larger `Bn T`).
+//! Curran, Lachapelle and Murphy (IEEE TAES 48(2), 2012) make the same point for
+//! discriminator-specific PLL thresholds. The study reports both.
+//!
 //! # The stability floor
 //!
 //! The Costas `atan(Q/I)` discriminator's slope falls with the prompt SNR `rho = CN0 T` as
@@ -49,7 +62,7 @@
 
 use super::params::RULE_LIMIT_DEG;
 use super::Dynamics;
-use crate::bandwidth::stable_with_slope;
+use crate::bandwidth::{costas_atan_stats, stable_with_slope};
 use gpsrx_tracking::carrier_loop::MIN_COSTAS_SLOPE;
 use gpsrx_tracking::loop_filter::omega0;
 use gpsrx_tracking::phase_sim::pll_jitter_deg;
@@ -161,6 +174,38 @@ pub fn rule_with_slope_dbhz(r: &RuleInputs) -> Option<f64> {
     lowest_root(|c| 3.0 * r.sigma_deg(c) + r.stress_deg / loop_gain(c, r.t_coh_s) - RULE_LIMIT_DEG)
 }
 
+/// Thermal phase jitter of the receiver's own carrier loop, deg, at `cn0_dbhz`: the Costas
+/// `atan(Q/I)` discriminator's output variance `v(rho)` (cycles^2, exact for Gaussian noise and
+/// random data bits: `crate::bandwidth::costas_atan_stats`) divided by its squared slope
+/// `(1 - exp(-rho))^2` (the receiver's normalisation, taken as ideal), through the linearised
+/// digital loop: `sigma = 360 sqrt(v / slope^2 * sum h^2)`, `sum h^2` its phase noise gain
+/// (`phase_gain`, [`LoopNoiseGains::phase_gain_of`] at slope 1; `~ 2 Bn T`). At high prompt
+/// SNR `v -> 1/(2 rho)/(2 pi)^2` and this is Kaplan's coherent term `Bn/CN0`; at low SNR the
+/// atan's output folds into `(-pi/2, pi/2]` and its variance exceeds the formula's squaring
+/// loss `1 + 1/(2 rho)`, which is that of the product (`I Q`) discriminator (module docs "The
+/// discriminator's own noise").
+pub fn atan_thermal_jitter_deg(cn0_dbhz: f64, t_coh_s: f64, phase_gain: f64) -> f64 {
+    let stats = costas_atan_stats(cn0_dbhz, t_coh_s);
+    if stats.slope <= 0.0 {
+        return f64::INFINITY;
+    }
+    360.0 * (stats.noise_var / (stats.slope * stats.slope) * phase_gain).sqrt()
+}
+
+/// The rule of thumb with the receiver's own thermal jitter ([`atan_thermal_jitter_deg`] with
+/// the loop's `phase_gain`) in place of Kaplan's formula, and the stress over the normalised
+/// loop gain as in [`rule_with_slope_dbhz`]: `3 sigma + theta_e / k <= 45` deg, dB-Hz.
+pub fn rule_atan_dbhz(r: &RuleInputs, phase_gain: f64) -> Option<f64> {
+    if !r.stress_deg.is_finite() || !phase_gain.is_finite() {
+        return None;
+    }
+    lowest_root(|c| {
+        let t = atan_thermal_jitter_deg(c, r.t_coh_s, phase_gain);
+        let sigma = (t * t + r.allan_deg.powi(2) + r.vibration_deg.powi(2)).sqrt();
+        3.0 * sigma + r.stress_deg / loop_gain(c, r.t_coh_s) - RULE_LIMIT_DEG
+    })
+}
+
 /// The relative error of the lock detector's steadiness estimate at the block SNR `rho`
 /// (`M CN0 T1`): `sqrt(a/(2 - a) (4 rho + 2)/rho^2)` with the detector's adapted low-pass
 /// coefficient `a = 2x/(1 + x)`, `x = eps^2 rho^2/(4 rho + 2)`, clamped to
@@ -209,6 +254,7 @@ pub fn stability_floor_dbhz(order: u8, bn_hz: f64, t_coh_s: f64) -> Option<f64> 
 mod tests {
     use super::super::params::F_L1_HZ;
     use super::*;
+    use std::f64::consts::PI;
 
     fn static_inputs(bn_hz: f64, t_coh_s: f64) -> RuleInputs {
         RuleInputs {
@@ -259,6 +305,63 @@ mod tests {
             dynamic_stress_deg(2, 18.0, &Dynamics::JerkUnaided { g_per_s: 1.0 }),
             f64::INFINITY
         );
+    }
+
+    /// The atan jitter against a Monte Carlo run of the receiver's own discriminator
+    /// (`gpsrx_tracking::discriminator::costas_atan` on `A d e^{j phi} + n`, `A = sqrt(2 rho)`,
+    /// random bits, unit noise per component, 400,000 draws, fixed seed): its variance at
+    /// `phi = 0` and its slope from `phi = +-0.05` rad agree with `costas_atan_stats`, so the
+    /// per-update noise `var/slope^2` exceeds the formula's `(1 + 1/(2 rho))/(2 rho)` by 2.0x at
+    /// `rho` = 0.5 and 3x at 0.06 (module docs); at high SNR the two agree (`rho` = 100, 1 %).
+    #[test]
+    fn atan_noise_matches_a_monte_carlo_run_of_the_receivers_discriminator() {
+        use gpsrx_tracking::discriminator::costas_atan;
+        use num_complex::Complex64;
+        use rand::{Rng, SeedableRng};
+        use rand_distr::StandardNormal;
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(7);
+        let n = 400_000;
+        for (rho, want_ratio) in [(0.5, 1.98), (0.06, 3.0), (100.0, 1.0)] {
+            let a = (2.0_f64 * rho).sqrt();
+            let mut draw = |phi: f64| -> (f64, f64) {
+                let (mut m, mut m2) = (0.0, 0.0);
+                for _ in 0..n {
+                    let d = if rng.random::<bool>() { 1.0 } else { -1.0 };
+                    let p = Complex64::from_polar(a * d, phi)
+                        + Complex64::new(rng.sample(StandardNormal), rng.sample(StandardNormal));
+                    let x = costas_atan(p);
+                    m += x;
+                    m2 += x * x;
+                }
+                (m / n as f64, m2 / n as f64)
+            };
+            let (_, var) = draw(0.0);
+            // The slope from the mean at +-0.1 rad; at rho = 0.06 (slope 0.058) 400,000 draws
+            // leave it 30 % uncertain, so only the variance is checked there.
+            let slope = (draw(0.1).0 - draw(-0.1).0) / (0.2 / (2.0 * PI));
+            // rho = CN0 T with T = 1 ms.
+            let cn0_dbhz = 10.0 * (rho / 1e-3).log10();
+            let stats = costas_atan_stats(cn0_dbhz, 1e-3);
+            assert!(
+                (var / stats.noise_var - 1.0).abs() < 0.02,
+                "rho {rho}: {var} {stats:?}"
+            );
+            assert!(
+                rho < 0.1 || (slope / stats.slope - 1.0).abs() < 0.08,
+                "rho {rho}: {slope} {stats:?}"
+            );
+            let formula = (1.0 + 1.0 / (2.0 * rho)) / (2.0 * rho) / (4.0 * PI * PI);
+            let ratio = stats.noise_var / stats.slope.powi(2) / formula;
+            assert!(
+                (ratio - want_ratio).abs() < 0.05 * want_ratio,
+                "rho {rho}: {ratio}"
+            );
+            // Through a loop of phase gain g the jitter is 360 sqrt(var/slope^2 g).
+            let g = 0.0008;
+            let got = atan_thermal_jitter_deg(cn0_dbhz, 1e-3, g);
+            let want = 360.0 * (stats.noise_var / stats.slope.powi(2) * g).sqrt();
+            assert!((got - want).abs() < 1e-9 * want);
+        }
     }
 
     /// A stress of 45 deg leaves nothing for the jitter: no threshold; 30 deg leaves
