@@ -80,7 +80,7 @@ fn feedforward_doppler_matches_truth_for_a_perfect_ins() {
     // The clock drift, as a fix's velocity solution would give it (m/s).
     let drift_mps = 4.0e-8 * 299_792_458.0;
     let (_, rx0) = sim.receiver_truth(0.5);
-    ff.set_fix(0.5, rx0.pos_m, Some(drift_mps));
+    ff.set_fix(0.5, rx0.pos_m, Some(drift_mps), None);
     let drift_hz = 4.0e-8 * 1575.42e6;
     let h = 0.5e-3;
     let (mut worst, mut n, mut max_abs) = (0.0f64, 0, 0.0f64);
@@ -121,7 +121,7 @@ fn feedforward_doppler_matches_truth_for_a_perfect_ins() {
     let fixes = (5.0 * gpsrx_receiver::pipeline::aiding::DRIFT_SMOOTHING_S / 0.1).ceil() as u32;
     for k in 1..=fixes {
         let t = 0.5 + 0.1 * f64::from(k);
-        ff.set_fix(t, rx0.pos_m, Some(drift_mps + 1e-9 * 299_792_458.0));
+        ff.set_fix(t, rx0.pos_m, Some(drift_mps + 1e-9 * 299_792_458.0), None);
     }
     let step = ff.clock_drift_fed_forward_s_s() - before;
     assert!(
@@ -372,6 +372,58 @@ fn aided_0p4_hz_loops_keep_every_satellite_through_a_10g_turn_with_a_1_or_2_mg_i
             "{bias_mg} mg: unaided 0.4 Hz loops lose lock ({fu})"
         );
     }
+}
+
+/// A 2nd-order aided loop has no Doppler-rate integrator: an INS biased by 2 mg per axis
+/// (up to 3.5 mg, a 0.18 Hz/s Doppler ramp on a diagonal line of sight) would leave it a static
+/// phase offset of `B / (lambda w0^2)` = 0.31 cycle at Bn 0.4 Hz, past the Costas loop's
+/// 0.25-cycle slip point (before the calibration: 4 of 8 satellites held through the 10 g turn
+/// of `turn-10g-ins-2mg.toml`). The receiver follows the INS velocity error from the fixes
+/// outside the manoeuvre and takes the drift out of the feed-forward, so the loops hold
+/// through a 10 g turn.
+#[test]
+fn a_2nd_order_aided_loop_holds_a_2_mg_ins_once_its_drift_is_calibrated() {
+    let (turn_at, turn_s) = (24.0, 4.0);
+    let dir = tmp();
+    let mut sc = turn_scenario_with(31.0, turn_at, turn_s, 250.0, 10.0);
+    let b = 2.0 * 9.80665e-3;
+    let ins_toml = format!("accel_bias_enu_mps2 = [{b}, {b}, {b}]\nrate_hz = 100.0");
+    let (data_path, ins_path) = simulate_with_ins(&mut sc, &ins_toml, dir.path());
+    let nav = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/data/brdc0010.22n");
+    let out = dir.path().join("aided");
+    let fixes = run(
+        &data_path,
+        &out,
+        &[
+            "--nav",
+            nav.to_str().unwrap_or_default(),
+            "--allow-unhealthy",
+            "--ins",
+            ins_path.to_str().unwrap_or_default(),
+            "--aided-pll-order",
+            "2",
+            "--aided-pll-bw",
+            "0.4",
+        ],
+    );
+    let t0 = 538194.0 + turn_at;
+    let t1 = t0 + turn_s + 1.0;
+    let rows = channel_rows(&out, t0, t1);
+    let locked = rows.iter().filter(|(s, l)| s == "track" && *l).count();
+    let fa = locked as f64 / rows.len().max(1) as f64;
+    let in_turn = fixes
+        .iter()
+        .filter(|f| (t0..=t1).contains(&f.time.tow_s))
+        .count();
+    eprintln!(
+        "2 mg, 2nd order 0.4 Hz: phase-locked rows in the turn {fa:.3} of {}; fixes {in_turn}",
+        rows.len()
+    );
+    assert!(
+        fa > 0.97,
+        "calibrated 2nd-order loops keep phase lock ({fa})"
+    );
+    assert!(in_turn >= 50, "fixes in the turn: {in_turn}");
 }
 
 /// Issue 13: an INS whose time base is 1 s late (the output stamped `t` is the INS solution of

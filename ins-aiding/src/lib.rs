@@ -7,6 +7,8 @@
 //! - [`error_model`]: INS error models (accelerometer bias, velocity random walk, scale factor,
 //!   latency, band limit) that turn a truth trajectory into a simulated INS output;
 //! - [`band_limiter`]: the first-order band limiter `alpha / (s + alpha)` of seed 004 eq. 8;
+//! - [`velocity_calibration`]: [`InsVelocityCalibration`], the INS velocity error (offset and
+//!   drift) followed from the GNSS velocity fixes, so the feed-forward carries no INS drift;
 //! - the line-of-sight Doppler `((v_sv - v_rx) . l) / lambda` of seed 004 eq. 6 is
 //!   [`gpsrx_core::los_doppler_hz`].
 //!
@@ -55,6 +57,7 @@ pub mod error_model;
 pub mod ins_file;
 pub mod speed_filter;
 pub mod vehicle;
+pub mod velocity_calibration;
 
 pub use accel_log::{read_accel_csv, write_accel_csv, AccelLog, AccelSample};
 pub use band_limiter::BandLimiter;
@@ -73,3 +76,4 @@ pub use error_model::{simulate_ins, InsErrorConfig, TruthState};
 pub use ins_file::{read_ins_csv, write_ins_csv, InsError, InsSample, InsTrack};
 pub use speed_filter::{AccelSmoother, HoldLastSpeed, SpeedFilter, SpeedFilterConfig};
 pub use vehicle::{interpolate_truth, validate_truth, wrap_pi, VehicleTruth};
+pub use velocity_calibration::InsVelocityCalibration;

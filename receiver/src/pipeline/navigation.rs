@@ -1220,7 +1220,7 @@ impl NavigationProcessor {
         }
         let fix = fix_of(&sol, &epoch, &ephs, self.week_known());
         if let Some(ff) = aiding {
-            ff.set_fix(t_stream_s, sol.pos_ecef_m, sol.clock_drift_mps);
+            ff.set_fix_from(t_stream_s, &sol);
         }
         self.stats.add(t_stream_s, &fix);
         sink.fix(&FixReport {

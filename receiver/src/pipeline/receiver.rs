@@ -318,6 +318,11 @@ impl Receiver {
                 &assistance.nav,
                 reference_week,
                 run,
+                config
+                    .tracking
+                    .aided_track
+                    .unwrap_or(config.tracking.track)
+                    .pll_order,
             )?),
             None => None,
         };
@@ -356,6 +361,7 @@ impl Receiver {
         nav: &Option<NavData>,
         reference_week: u32,
         run: &crate::config::RunSettings,
+        aided_order: u8,
     ) -> Result<InsFeedForward, ReceiverError> {
         if let Some(a) = ins.band_limit_rad_s {
             if !(a.is_finite() && a > 0.0) {
@@ -366,7 +372,8 @@ impl Receiver {
         }
         Ok(
             InsFeedForward::new(ins.track, nav.clone(), reference_week, ins.band_limit_rad_s)
-                .allow_unhealthy(run.allow_unhealthy),
+                .allow_unhealthy(run.allow_unhealthy)
+                .with_velocity_calibration(aided_order <= 2),
         )
     }
 
@@ -662,7 +669,7 @@ fn log_aided_static_offset(tracking: &gpsrx_tracking::ChannelConfig) {
     let bias_mps2 = gpsrx_tracking::aiding::NOMINAL_INS_BIAS_LOS_MPS2;
     match gpsrx_tracking::aiding::static_phase_offset_cycles(loops.pll_order, loops.pll_bw_hz, bias_mps2) {
         Some(c) if c > 0.0 => tracing::info!(
-            "aided loops: 2nd-order PLL at {} Hz: an INS accelerometer bias of 1 mg per axis leaves up to {c:.3} cycle of static phase offset (B / (lambda w0^2); lock allows 0.2, slips at 0.25): a 3rd-order aided loop leaves none (--aided-pll-order 3)",
+            "aided loops: 2nd-order PLL at {} Hz: an INS accelerometer bias of 1 mg per axis leaves up to {c:.3} cycle of static phase offset (B / (lambda w0^2); lock allows 0.2, slips at 0.25) until the INS velocity calibration from the fixes takes the drift out (about 15 s of fixes outside manoeuvres); a 3rd-order aided loop leaves none (--aided-pll-order 3)",
             loops.pll_bw_hz
         ),
         Some(_) => tracing::info!(
