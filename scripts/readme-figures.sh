@@ -157,7 +157,7 @@ section_loops() {
     for ins in perfect 1mg 2mg; do
         run "$GPSRX" simulate "$ROOT/samples/scenarios/turn-10g-ins-$ins.toml" -o "$WORK/t10-$ins" >/dev/null
     done
-    for case in "perfect 3" "1mg 3" "2mg 3" "1mg 2"; do
+    for case in "perfect 3" "1mg 3" "2mg 3" "1mg 2" "2mg 2"; do
         read -r ins order <<<"$case"
         echo "-- 10 g turn (19-28 s), INS $ins, aided order $order at 0.4 Hz"
         run "$GPSRX" run "$WORK/t10-$ins/signal.ci8" --nav "$NAV" --ins "$WORK/t10-$ins/ins.csv" --allow-unhealthy \

@@ -383,9 +383,9 @@ fn aided_0p4_hz_loops_keep_every_satellite_through_a_10g_turn_with_a_1_or_2_mg_i
 /// through a 10 g turn.
 #[test]
 fn a_2nd_order_aided_loop_holds_a_2_mg_ins_once_its_drift_is_calibrated() {
-    let (turn_at, turn_s) = (24.0, 4.0);
+    let (turn_at, turn_s) = (16.0, 4.0);
     let dir = tmp();
-    let mut sc = turn_scenario_with(31.0, turn_at, turn_s, 250.0, 10.0);
+    let mut sc = turn_scenario_with(23.0, turn_at, turn_s, 250.0, 10.0);
     let b = 2.0 * 9.80665e-3;
     let ins_toml = format!("accel_bias_enu_mps2 = [{b}, {b}, {b}]\nrate_hz = 100.0");
     let (data_path, ins_path) = simulate_with_ins(&mut sc, &ins_toml, dir.path());

@@ -14,15 +14,24 @@
 //!
 //! The fixes' velocity (from the tracked carrier Doppler, which the loops measure whatever
 //! the aid) is compared with the INS velocity at the same instant; the difference
-//! `d(t) = v_INS - v_GNSS` is followed per ECEF axis by a type-2 tracking filter of states
+//! `d(t) = v_INS - v_GNSS` is fitted with a least-squares line over the first [`WARMUP_S`] of
+//! fixes (offset and drift; a loop started from zero drift would take tens of seconds to learn
+//! it), then followed per ECEF axis by a type-2 tracking filter of states
 //! offset `e` and drift `r` (m/s and m/s^2): between fixes `e += r dt`; at a fix, with the
 //! innovation `y = d - e`, `e += 2 zeta omega_n dt y` and `r += omega_n^2 dt y` (the
 //! critically damped analog loop `s^2 + 2 zeta omega_n s + omega_n^2` discretised by forward
-//! Euler; `dt` clamped to [`MAX_STEP_S`] so the gains stay well inside stability). Type 2: a
+//! Euler; the gain's `dt` clamped to [`MAX_GAIN_STEP_S`] so that the gains stay well inside
+//! stability and a fix after a gap moves the aid by one ordinary step, not a jump). Type 2: a
 //! constant bias (a ramp in `d`) is followed without steady error, so the corrected INS
 //! velocity `v_INS - e(t)` has no ramp. Its bandwidth ([`OMEGA_N_RAD_S`], about 0.03 Hz) is well
 //! below the narrowest carrier loop's (0.4 Hz), so the outer loop does not fight the inner one,
 //! and its noise is the fixes' velocity noise averaged over several seconds.
+//!
+//! The loops already hold the INS error of the moment the calibration starts (a loop's
+//! integrator absorbs a constant Doppler offset), so the feed-forward is corrected by the
+//! *change* of the estimate since then ([`InsVelocityCalibration::correction_mps`]):
+//! subtracting the whole estimate at once would step every loop's frequency by up to some Hz.
+//! What the loops cannot absorb, the drift, is taken out from then on.
 //!
 //! # Limits
 //!
@@ -45,22 +54,33 @@ pub const ZETA: f64 = 0.707;
 pub const MAX_OFFSET_MPS: f64 = 2.0;
 /// Largest velocity drift (accelerometer bias) the calibration takes out, m/s^2 per axis (10 mg).
 pub const MAX_DRIFT_MPS2: f64 = 0.098;
-/// A fix whose velocity sigma (per axis, largest) exceeds this is not used, m/s.
-pub const MAX_FIX_SIGMA_MPS: f64 = 0.5;
+/// A fix whose velocity sigma (per axis, largest) exceeds this is not used, m/s (a fix near a
+/// lost satellite or in poor geometry; 10 cm/s is 0.5 Hz on a line of sight).
+pub const MAX_FIX_SIGMA_MPS: f64 = 0.1;
 /// A fix taken while the INS reports more acceleration than this is not used, m/s^2: a fix's
 /// velocity is dated to within some milliseconds (its Doppler averaged over the correlation
 /// interval, the fix's time tag), and a time error `dt` reads as a velocity error `a dt`
 /// (0.1 m/s for 1 ms in a 10 g turn); under 2 m/s^2 a 20 ms error costs 4 cm/s. The
 /// calibration learnt before a manoeuvre is extrapolated through it.
 pub const MAX_ACCEL_MPS2: f64 = 2.0;
-/// Longest interval one update integrates, s (fixes further apart restart the offset).
-pub const MAX_STEP_S: f64 = 2.0;
+/// Longest interval whose gain one update applies, s: fixes further apart (after a gap, or
+/// slower than 5 Hz) are taken in as if 0.2 s apart, so the aid never jumps.
+pub const MAX_GAIN_STEP_S: f64 = 0.2;
+/// The warm-up: the loop starts from a least-squares line (offset and drift) through the
+/// first fixes once they span this long, s. The correction is zero until then.
+pub const WARMUP_S: f64 = 4.0;
+/// The warm-up needs at least this many fixes.
+pub const WARMUP_FIXES: usize = 8;
 
 /// The INS velocity error estimate (module docs).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct InsVelocityCalibration {
-    /// Time of the last update, s, and the state `(e, r)` there.
+    /// The fixes `(t, d)` of the warm-up (module docs "How"), until the loop starts.
+    warmup: Vec<(f64, Vector3<f64>)>,
+    /// Time of the last update, s, and the loop's state `(e, r)` there.
     state: Option<(f64, Vector3<f64>, Vector3<f64>)>,
+    /// The offset when the loop started, which the correction leaves out (module docs).
+    base: Vector3<f64>,
     updates: usize,
 }
 
@@ -73,7 +93,7 @@ impl InsVelocityCalibration {
     /// Takes a fix at `t_s`: `ins_minus_gnss_mps` is the INS velocity less the fix's, ECEF;
     /// `fix_sigma_mps` the fix velocity's largest per-axis sigma; `accel_mps2` the magnitude
     /// of the INS acceleration then. Returns whether it was used (not above
-    /// [`MAX_FIX_SIGMA_MPS`] or [`MAX_ACCEL_MPS2`], all finite).
+    /// [`MAX_FIX_SIGMA_MPS`] or [`MAX_ACCEL_MPS2`], all finite, later than the last).
     pub fn update(
         &mut self,
         t_s: f64,
@@ -85,34 +105,52 @@ impl InsVelocityCalibration {
         // NaN sigmas and accelerations fail these comparisons too.
         let usable = (0.0..=MAX_FIX_SIGMA_MPS).contains(&fix_sigma_mps)
             && (0.0..=MAX_ACCEL_MPS2).contains(&accel_mps2);
-        if !finite || !usable {
+        let last = self
+            .state
+            .map(|(t, _, _)| t)
+            .or(self.warmup.last().map(|(t, _)| *t));
+        if !finite || !usable || last.is_some_and(|t| t_s <= t) {
             return false;
         }
         let d = ins_minus_gnss_mps;
+        self.updates += 1;
         let (e, r) = match self.state {
-            Some((t_prev, e, r)) if t_s > t_prev && t_s - t_prev <= MAX_STEP_S => {
+            Some((t_prev, e, r)) => {
                 let dt = t_s - t_prev;
                 let e_pred = e + r * dt;
                 let y = d - e_pred;
+                // After a gap the innovation is taken in as over one ordinary step, never as a
+                // jump of the aid (a step of the feed-forward is a frequency step to the loops).
+                let g = dt.min(MAX_GAIN_STEP_S);
                 (
-                    e_pred + y * (2.0 * ZETA * OMEGA_N_RAD_S * dt),
-                    r + y * (OMEGA_N_RAD_S * OMEGA_N_RAD_S * dt),
+                    e_pred + y * (2.0 * ZETA * OMEGA_N_RAD_S * g),
+                    r + y * (OMEGA_N_RAD_S * OMEGA_N_RAD_S * g),
                 )
             }
-            Some((t_prev, e, r)) if t_s <= t_prev => (e, r),
-            // The first fix, or after a long gap: start from the fix, keeping the drift.
-            Some((_, _, r)) => (d, r),
-            None => (d, Vector3::zeros()),
+            None => {
+                self.warmup.push((t_s, d));
+                let Some((e, r)) = warmup_fit(&self.warmup) else {
+                    return true;
+                };
+                self.warmup.clear();
+                self.base = e;
+                (e, r)
+            }
         };
         let clamp = |v: Vector3<f64>, m: f64| v.map(|x| x.clamp(-m, m));
         self.state = Some((t_s, clamp(e, MAX_OFFSET_MPS), clamp(r, MAX_DRIFT_MPS2)));
-        self.updates += 1;
         true
     }
 
-    /// The INS velocity error at `t_s` (ECEF, m/s): subtract it from the INS velocity. Zero
-    /// before the first fix.
+    /// The change of the INS velocity error since the loop started at `t_s` (ECEF, m/s):
+    /// subtract it from the INS velocity. Zero until the warm-up ends.
     pub fn correction_mps(&self, t_s: f64) -> Vector3<f64> {
+        self.error_mps(t_s) - self.base
+    }
+
+    /// The whole INS velocity error estimate at `t_s` (ECEF, m/s; zero until the warm-up
+    /// ends), the offset the loops already hold included.
+    pub fn error_mps(&self, t_s: f64) -> Vector3<f64> {
         match self.state {
             Some((t, e, r)) => e + r * (t_s - t),
             None => Vector3::zeros(),
@@ -130,13 +168,30 @@ impl InsVelocityCalibration {
     }
 }
 
+/// The least-squares line `d(t) = e + r (t - t_last)` through the warm-up fixes, per axis, once
+/// they span [`WARMUP_S`] with at least [`WARMUP_FIXES`] fixes: `(e, r)` at the last one.
+fn warmup_fit(fixes: &[(f64, Vector3<f64>)]) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    let (t0, t1) = (fixes.first()?.0, fixes.last()?.0);
+    if t1 - t0 < WARMUP_S || fixes.len() < WARMUP_FIXES {
+        return None;
+    }
+    let n = fixes.len() as f64;
+    let t_mean = fixes.iter().map(|(t, _)| t).sum::<f64>() / n;
+    let d_mean = fixes.iter().map(|(_, d)| d).sum::<Vector3<f64>>() / n;
+    let stt: f64 = fixes.iter().map(|(t, _)| (t - t_mean).powi(2)).sum();
+    let std: Vector3<f64> = fixes.iter().map(|(t, d)| (d - d_mean) * (t - t_mean)).sum();
+    let r = std / stt;
+    Some((d_mean + r * (t1 - t_mean), r))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// An INS biased by 1 mg on every axis drifts by `b t`; after 40 s of 10 Hz fixes (with
-    /// 2 cm/s of white noise, fixed seed) the drift estimate is within 5 % of the bias and the
-    /// corrected velocity within 1 cm/s of the truth: no ramp is left for the loops.
+    /// An INS biased by 1 mg on every axis drifts by `b t`; nothing is corrected during the 4 s
+    /// warm-up; with 10 Hz fixes with 2 cm/s of white noise (fixed seed) the corrected velocity
+    /// is within 2 cm/s of the truth 10 s after the first fix, and after 40 s the drift is
+    /// within 10 % of the bias and the velocity within 1 cm/s: no ramp is left for the loops.
     #[test]
     fn a_constant_bias_is_followed_without_steady_error() {
         use rand::{Rng, SeedableRng};
@@ -144,16 +199,33 @@ mod tests {
         let b = Vector3::new(0.0098, 0.0098, 0.0098);
         let v0 = Vector3::new(0.05, -0.03, 0.02);
         let mut cal = InsVelocityCalibration::new();
-        for k in 0..400 {
-            let t = 5.0 + 0.1 * f64::from(k);
+        let mut fix = |cal: &mut InsVelocityCalibration, t: f64| {
             let noise = Vector3::from_fn(|_, _| 0.02 * (rng.random::<f64>() - 0.5) * 3.46);
             assert!(cal.update(t, v0 + b * t + noise, 0.05, 0.0));
+        };
+        for k in 0..40 {
+            fix(&mut cal, 5.0 + 0.1 * f64::from(k));
+        }
+        assert_eq!(cal.error_mps(8.9), Vector3::zeros(), "warm-up");
+        for k in 40..100 {
+            fix(&mut cal, 5.0 + 0.1 * f64::from(k));
+        }
+        // 10 s in: the warm-up's drift is good to `sigma sqrt(12 / (N T^2))` = 0.3 mg (40
+        // fixes over 4 s), so the velocity is within 2 cm/s.
+        let err = cal.error_mps(15.0) - (v0 + b * 15.0);
+        assert!(err.amax() < 0.02, "{err}");
+        for k in 100..400 {
+            fix(&mut cal, 5.0 + 0.1 * f64::from(k));
         }
         let t = 45.0;
-        let err = cal.correction_mps(t) - (v0 + b * t);
+        let err = cal.error_mps(t) - (v0 + b * t);
         assert!(err.amax() < 0.01, "{err}");
+        // The correction leaves out the offset the loops held when it started (at 9 s, the
+        // warm-up's end): it is the error's change since then.
+        let since = cal.correction_mps(t) - (b * (t - 8.9));
+        assert!(since.amax() < 0.03, "{since}");
         let drift = cal.drift_mps2();
-        assert!((drift - b).amax() < 0.05 * b.amax(), "{drift}");
+        assert!((drift - b).amax() < 0.1 * b.amax(), "{drift}");
         // Between fixes the correction is extrapolated with the drift.
         let ahead = cal.correction_mps(t + 1.0) - cal.correction_mps(t);
         assert!((ahead - drift).amax() < 1e-12);
@@ -168,7 +240,7 @@ mod tests {
             let t = 0.1 * f64::from(k);
             cal.update(t, Vector3::new(50.0 + 1.0 * t, 0.0, 0.0), 0.05, 0.0);
         }
-        assert!(cal.correction_mps(60.0).x <= MAX_OFFSET_MPS + MAX_DRIFT_MPS2 * 0.1);
+        assert!(cal.error_mps(60.0).x <= MAX_OFFSET_MPS + MAX_DRIFT_MPS2 * 0.1);
         assert!(cal.drift_mps2().x <= MAX_DRIFT_MPS2);
         let before = cal.clone();
         assert!(!cal.update(61.0, Vector3::new(f64::NAN, 0.0, 0.0), 0.05, 0.0));
@@ -183,20 +255,31 @@ mod tests {
         );
     }
 
-    /// A step of 1 m/s in the INS error is taken out with the overshoot of a type-2 loop at
-    /// `zeta` = 0.707 (about 20 %: the proportional path's zero) and within 1 % after 60 s
-    /// (8 time constants of `zeta omega_n`).
+    /// After a warm-up on zeros, a step of 1 m/s in the INS error is taken out with the
+    /// overshoot of a type-2 loop at `zeta` = 0.707 (about 20 %: the proportional path's zero)
+    /// and within 1 % after 60 s (8 time constants of `zeta omega_n`); a fix after a 7 s gap
+    /// moves the correction by one ordinary step (at most `2 zeta omega_n 0.2 s` = 5.7 % of the
+    /// innovation), not a jump.
     #[test]
-    fn a_velocity_step_settles_within_a_minute() {
+    fn a_velocity_step_settles_within_a_minute_and_a_gap_makes_no_jump() {
         let mut cal = InsVelocityCalibration::new();
-        cal.update(0.0, Vector3::zeros(), 0.05, 0.0);
+        for k in 0..50 {
+            cal.update(0.1 * f64::from(k), Vector3::zeros(), 0.05, 0.0);
+        }
         let mut peak: f64 = 0.0;
-        for k in 1..=600 {
+        for k in 50..=650 {
             let t = 0.1 * f64::from(k);
             cal.update(t, Vector3::new(1.0, 0.0, 0.0), 0.05, 0.0);
             peak = peak.max(cal.correction_mps(t).x);
         }
         assert!(peak > 1.1 && peak < 1.3, "{peak}");
-        assert!((cal.correction_mps(60.0).x - 1.0).abs() < 0.01);
+        assert!((cal.correction_mps(65.0).x - 1.0).abs() < 0.01);
+        let before = cal.correction_mps(72.0).x;
+        assert!(cal.update(72.0, Vector3::new(2.0, 0.0, 0.0), 0.05, 0.0));
+        let step = cal.correction_mps(72.0).x - before;
+        assert!(
+            step > 0.0 && step <= 2.0 * ZETA * OMEGA_N_RAD_S * MAX_GAIN_STEP_S * 1.001,
+            "{step}"
+        );
     }
 }

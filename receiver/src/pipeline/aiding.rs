@@ -198,7 +198,8 @@ impl InsFeedForward {
                 (self.calibrate, ins, velocity)
             {
                 let before = k.calibration.updates();
-                if k.calibration.update(t_s, v_ins - v_fix, sigma, accel) && before == 0 {
+                let used = k.calibration.update(t_s, v_ins - v_fix, sigma, accel);
+                if used && before == 0 {
                     tracing::info!(
                         "INS aiding: velocity calibrated from the fixes from {t_s:.2} s"
                     );
