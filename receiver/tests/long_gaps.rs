@@ -4,26 +4,29 @@
 //! simulator's truth position.
 
 use gpsrx_core::frames::Llh;
+use gpsrx_nav::rinex_nav::parse_rinex_nav;
 use gpsrx_receiver::output::FixQuality;
 use gpsrx_receiver::pipeline::{MemorySink, ReceiverEvent};
 use gpsrx_receiver::{Assistance, Receiver, ReceiverConfig};
+use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
 use gpsrx_samples::sim::{Scenario, Simulator};
 use num_complex::Complex32;
 use std::path::Path;
 
 const FS_HZ: f64 = 2.048e6;
-const LLH_DEG: [f64; 3] = [36.3721, 127.3604, 80.0];
+const LLH_DEG: [f64; 3] = [37.5665, 126.9780, 40.0];
 
-/// A static receiver at 2.048 MHz with a clock bias and drift, the built-in ephemerides.
+/// The project's static Seoul scenario (12 satellites, `samples/scenarios/static-seoul-4msps.toml`)
+/// at 2.048 MHz, starting 10 s later (TOW 28 mod 30: subframe 1 begins 2 s in, so subframes
+/// 1-3 are decoded by about 20 s), with a receiver clock bias and drift.
 fn simulator(duration_s: f64) -> Simulator {
     let text = format!(
         r#"
 duration_s = {duration_s}
-seed = 11
+seed = 7
 nav = "builtin:brdc0010.22n"
 [start]
-week = 2190
-tow_s = 538198.0
+gps_calendar = "2022-01-01 12:29:58"
 [output]
 format = "cf32_le"
 fs_hz = {FS_HZ}
@@ -31,8 +34,8 @@ fs_hz = {FS_HZ}
 kind = "static"
 llh_deg = [{}, {}, {}]
 [clock]
-bias_s = 3.0e-4
-drift_s_s = 4.0e-8
+bias_s = -3.0e-4
+drift_s_s = 1.0e-7
 "#,
         LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
     );
@@ -40,15 +43,17 @@ drift_s_s = 4.0e-8
     Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// A receiver with (`nav`) or without the built-in ephemerides as assistance.
+/// A receiver with (`nav`) or without the built-in ephemerides as assistance, week 2190, the
+/// tropospheric model on (the scenario simulates a troposphere).
 fn receiver(nav: bool) -> Receiver {
-    if nav {
-        return crate::pipeline::receiver(FS_HZ);
-    }
     let mut config = ReceiverConfig::default();
-    config.run.tropo = gpsrx_receiver::config::TropoModel::None;
     config.run.week = Some(2190);
-    Receiver::new(&config, FS_HZ, Assistance::default()).unwrap_or_else(|e| panic!("{e}"))
+    let nav = nav.then(|| parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}")));
+    let assistance = Assistance {
+        nav,
+        ..Assistance::default()
+    };
+    Receiver::new(&config, FS_HZ, assistance).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Runs the receiver on the simulator's samples with `len_s` cut out at `at_s` (simulator
@@ -57,8 +62,13 @@ fn run_cut(sim: &Simulator, nav: bool, at_s: f64, len_s: f64) -> MemorySink {
     let mut rx = receiver(nav);
     let mut sink = MemorySink::new();
     let mut buf = Vec::new();
+    let n = sim.chunk_samples() as u64;
     for chunk in 0..sim.chunk_count() {
-        let first = chunk * sim.chunk_samples() as u64;
+        let first = chunk * n;
+        let (t_first, t_end) = (first as f64 / FS_HZ, (first + n) as f64 / FS_HZ);
+        if t_first >= at_s && t_end <= at_s + len_s {
+            continue;
+        }
         sim.generate_chunk(chunk, &mut buf);
         let keep: Vec<Complex32> = buf
             .iter()
@@ -163,6 +173,80 @@ fn describe(name: &str, sink: &MemorySink, at_s: f64) {
     );
     eprintln!("  uncovered after: {:?}", uncovered(&fixes));
     eprintln!("  events: {}", events.join("; "));
+}
+
+/// The stream times of the reported sample gaps and the lengths measured for them (ms).
+fn gap_events(sink: &MemorySink) -> (Vec<f64>, Vec<f64>) {
+    let mut gaps = Vec::new();
+    let mut lengths = Vec::new();
+    for e in &sink.events {
+        match e {
+            ReceiverEvent::SampleGap { t_s } => gaps.push(*t_s),
+            ReceiverEvent::GapMeasured { length_ms, .. } => lengths.push(*length_ms),
+            _ => {}
+        }
+    }
+    (gaps, lengths)
+}
+
+/// Runs a `len_s` cut at stream time `at_s` of a recording that goes on for `after_s` past
+/// it, and checks against the truth: one gap reported where it happened and its length
+/// measured to a millisecond once the time is back; the first valid fix at most `within_s`
+/// after the signal returns, and valid fixes from then on; no valid fix, before or after,
+/// more than 5 m off unless its stated 3-sigma covers the error.
+fn assert_recovers(nav: bool, at_s: f64, len_s: f64, after_s: f64, within_s: f64) {
+    let name = format!("{len_s} s cut at {at_s} s, nav {nav}");
+    let sim = simulator(at_s + len_s + after_s);
+    let sink = run_cut(&sim, nav, at_s, len_s);
+    let (gaps, lengths) = gap_events(&sink);
+    assert!(
+        gaps.len() == 1 && (gaps[0] - at_s).abs() < 0.05,
+        "{name}: gaps reported at {gaps:?} s"
+    );
+    assert!(
+        lengths.len() == 1 && (lengths[0] - len_s * 1e3).abs() < 1.0,
+        "{name}: lengths measured {lengths:?} ms"
+    );
+    let all = scored(&sink, 0.0);
+    let wrong = uncovered(&all);
+    assert!(
+        wrong.is_empty(),
+        "{name}: valid fixes more than 5 m off, beyond their 3-sigma (t s, error m, 3-sigma m): {wrong:?}"
+    );
+    let after = scored(&sink, at_s);
+    let first = after.iter().find(|f| f.2).map(|f| f.0 - at_s);
+    assert!(
+        first.is_some_and(|b| b <= within_s),
+        "{name}: first valid fix {first:?} s after the signal returned"
+    );
+    // Fixes at 10 Hz from then on (a few may fail the integrity test).
+    let valid = after.iter().filter(|f| f.2).count() as f64;
+    let expected = (after_s - first.unwrap_or(after_s)) * 10.0;
+    assert!(
+        valid >= 0.9 * expected,
+        "{name}: {valid} valid fixes after the gap, {expected:.0} expected"
+    );
+}
+
+#[test]
+fn a_five_second_cut_gives_valid_fixes_within_two_seconds_with_nav() {
+    // Samples of unknown length were lost (the code of every satellite moved by more than a
+    // gap of a second explains): the coarse-time solver with the navigation file's
+    // ephemerides gives the time and every SV time back.
+    assert_recovers(true, 10.0, 5.0, 4.0, 2.0);
+}
+
+#[test]
+fn a_five_second_cut_gives_valid_fixes_within_two_seconds_with_ephemerides_decoded_before() {
+    // Without a navigation file: the ephemerides decoded before the gap serve the
+    // coarse-time solver (the issue's bound is 8 s, the next time of week).
+    assert_recovers(false, 21.0, 5.0, 4.0, 2.0);
+}
+
+#[test]
+fn a_sixty_second_cut_gives_valid_fixes_within_two_seconds_with_nav() {
+    // The satellites moved 60 s along their orbits: 60 km of error at the receiver's time.
+    assert_recovers(true, 10.0, 60.0, 4.0, 2.0);
 }
 
 #[test]
