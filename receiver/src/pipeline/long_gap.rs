@@ -30,6 +30,7 @@
 //! `timing/` wing behind one type that navigation asks would hold it.
 
 use crate::pipeline::coarse_fix::{CoarseFixer, CoarseOutcome};
+use crate::pipeline::sv_time::GapRecovery;
 use gpsrx_nav::frames::Llh;
 use gpsrx_nav::time::GpsTime;
 
@@ -39,6 +40,17 @@ pub const TIME_UNCERTAINTY_S: f64 = 150.0;
 /// gap, never early (the clock bias is kept within 0.5 ms; 10 ms covers the solver's
 /// millisecond-level time precision).
 pub const MIN_CORRECTION_S: f64 = -0.010;
+
+/// How the time comes back after a long gap ([`LongGapRecovery::begin`]).
+#[derive(Debug)]
+pub struct LongGapStart {
+    /// The coarse-time fixer (a-priori: the last fix and the receiver time), when ephemerides
+    /// and a fix before the gap are known.
+    pub coarse: Option<CoarseFixer>,
+    /// Frame sync from a TLM and HOW confirmed across satellites
+    /// ([`crate::pipeline::quick_sync`]): with ephemerides known a fix follows at once.
+    pub quick_sync: bool,
+}
 
 /// The receiver time lost with samples of unknown length, re-established from the signal.
 #[derive(Debug, Default)]
@@ -55,29 +67,41 @@ impl LongGapRecovery {
         self.last_fix = Some(llh);
     }
 
-    /// Whether the gap at stream time `t_s` is being recovered from already.
-    pub fn recovering_from(&self, t_s: f64) -> bool {
-        self.recovering == Some(t_s)
-    }
-
-    /// Samples of unknown length were lost at stream time `t_s` (samples at `fs_hz`; the
-    /// receiver time of sample 0 is `rx_origin`): the coarse-time fixer that re-establishes
-    /// the time, when `ephemerides_known` and a fix came before (else `None`: the time of week
-    /// decoded after the gap gives it).
-    pub fn start(
+    /// Once the length of the gap being recovered from (`gap`) cannot be measured (samples of
+    /// unknown length lost, [`GapRecovery::unresolved`]) and it is not recovered from yet:
+    /// how the time comes back (samples at `fs_hz`; `rx_origin` the receiver time of sample
+    /// 0; `ephemerides_known` from a navigation file, or decoded for enough satellites).
+    pub fn begin(
         &mut self,
-        t_s: f64,
+        gap: Option<&GapRecovery>,
         fs_hz: f64,
         rx_origin: Option<GpsTime>,
         ephemerides_known: bool,
-    ) -> Option<CoarseFixer> {
+    ) -> Option<LongGapStart> {
+        let t_s = gap
+            .filter(|g| g.unresolved && g.length_ms.is_none())
+            .map(|g| g.t_s)
+            .filter(|&t| self.recovering != Some(t))?;
         self.recovering = Some(t_s);
-        let (Some(llh), Some(t0), true) = (self.last_fix, rx_origin, ephemerides_known) else {
-            return None;
+        let coarse = match (self.last_fix, rx_origin, ephemerides_known) {
+            (Some(llh), Some(t0), true) => Some(
+                CoarseFixer::new(fs_hz, t0, llh)
+                    .with_time_window(MIN_CORRECTION_S, TIME_UNCERTAINTY_S),
+            ),
+            _ => None,
         };
-        Some(
-            CoarseFixer::new(fs_hz, t0, llh).with_time_window(MIN_CORRECTION_S, TIME_UNCERTAINTY_S),
-        )
+        tracing::info!(
+            "the receiver time lost at {t_s:.3} s comes back from {}",
+            if coarse.is_some() {
+                "the coarse-time solver (ephemerides known) or the next time of week"
+            } else {
+                "the next time of week"
+            }
+        );
+        Some(LongGapStart {
+            coarse,
+            quick_sync: ephemerides_known,
+        })
     }
 
     /// The receiver clock step (ms) that puts the receiver time on the time of a coarse-time
@@ -111,17 +135,31 @@ mod tests {
     }
 
     #[test]
-    fn the_clock_is_stepped_by_the_whole_milliseconds_of_the_lost_time() {
+    fn a_long_gap_is_recovered_from_once_and_the_clock_stepped_by_the_whole_milliseconds_lost() {
         let llh = Llh::from_degrees(37.5, 127.0, 40.0);
         let t0 = GpsTime::new(2190, 538_198.0);
         let mut r = LongGapRecovery::default();
-        // No fix before the gap: no a-priori position, the HOW gives the time.
-        assert!(r.start(16.0, 2.048e6, Some(t0), true).is_none());
+        let gap = |t_s: f64, unresolved: bool| GapRecovery {
+            unresolved,
+            ..GapRecovery::new(t_s, None, Vec::new(), Some(t_s))
+        };
+        // A gap whose length is being measured: nothing to do.
+        assert!(r
+            .begin(Some(&gap(16.0, false)), 2.048e6, Some(t0), true)
+            .is_none());
+        // No fix before the gap: no a-priori position, the time of week gives the time.
+        let s = r.begin(Some(&gap(16.0, true)), 2.048e6, Some(t0), true);
+        assert!(s.is_some_and(|s| s.coarse.is_none() && s.quick_sync));
+        // Once per gap.
+        assert!(r
+            .begin(Some(&gap(16.0, true)), 2.048e6, Some(t0), true)
+            .is_none());
         r.note_fix(llh);
-        // No ephemerides: the HOW gives the time.
-        assert!(r.start(16.0, 2.048e6, Some(t0), false).is_none());
-        assert!(r.start(16.0, 2.048e6, Some(t0), true).is_some());
-        assert!(r.recovering_from(16.0) && !r.recovering_from(17.0));
+        // No ephemerides: the time of week (normal frame sync).
+        let s = r.begin(Some(&gap(17.0, true)), 2.048e6, Some(t0), false);
+        assert!(s.is_some_and(|s| s.coarse.is_none() && !s.quick_sync));
+        let s = r.begin(Some(&gap(18.0, true)), 2.048e6, Some(t0), true);
+        assert!(s.is_some_and(|s| s.coarse.is_some()));
         // 60.0123 s lost: at stream time 17 s the true time is t0 + 77.0123 s.
         let out = outcome(17.0, t0.add_seconds(77.0123));
         assert_eq!(r.clock_step_ms(&out, Some(t0)), Some(60_012));

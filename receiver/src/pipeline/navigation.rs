@@ -280,7 +280,7 @@ impl NavigationProcessor {
         let t_s = r.jump_sample as f64 / self.fs_hz;
         if r.length_unknown {
             tracing::warn!(
-                "{t_s:.3} s: samples lost (the code of {} satellites moved by more than {:.0} s of lost samples explain): channels moved onto it; no fix until the receiver time is re-established",
+                "{t_s:.3} s: samples lost (the code of {} satellites moved by more than any gap of up to {:.0} s explains): channels moved onto it; no fix until the receiver time is re-established",
                 r.prns.len(),
                 r.shortest_gap_s
             );
@@ -883,41 +883,20 @@ impl NavigationProcessor {
             .get_or_insert_with(|| GapRecovery::new(t_s, before, Vec::new(), None));
     }
 
-    /// Once the length of the gap being recovered from cannot be measured (samples of unknown
-    /// length lost, [`crate::pipeline::sv_time::GapRecovery::unresolved`]): the time comes
-    /// back from the coarse-time solver when ephemerides are known, and from a time of week
-    /// confirmed across satellites (quick frame sync, here also without a navigation file).
+    /// Once the length of the gap being recovered from cannot be measured: the time comes
+    /// back from the coarse-time solver or the next time of week ([`LongGapRecovery::begin`]).
     fn start_long_gap(&mut self) {
-        let Some(t_s) = self
-            .sv_time
-            .gap
-            .as_ref()
-            .filter(|g| g.unresolved && g.length_ms.is_none())
-            .map(|g| g.t_s)
-        else {
-            return;
-        };
-        if self.long_gap.recovering_from(t_s) {
-            return;
-        }
         let with_eph = self.decoders.values().filter(|d| d.ephemeris.is_some());
-        let known = self.nav_assist.is_some()
+        let eph = self.nav_assist.is_some()
             || with_eph.count() >= crate::pipeline::coarse_fix::MIN_SATELLITES;
         let origin = self.builder.rx_time_origin();
-        let fixer = self.long_gap.start(t_s, self.fs_hz, origin, known);
-        tracing::info!(
-            "the receiver time lost at {t_s:.3} s comes back from {}",
-            if fixer.is_some() {
-                "the coarse-time solver (ephemerides known) or the next time of week"
-            } else {
-                "the next time of week"
-            }
-        );
-        if fixer.is_some() {
-            self.coarse = fixer;
-        }
-        if self.quick.is_none() && known {
-            self.quick = Some(QuickSync::default());
+        let gap = self.sv_time.gap.as_ref();
+        let Some(start) = self.long_gap.begin(gap, self.fs_hz, origin, eph) else {
+            return;
+        };
+        self.coarse = start.coarse.or(self.coarse.take());
+        if start.quick_sync {
+            self.quick.get_or_insert_with(QuickSync::default);
         }
         for d in self.decoders.values_mut() {
             d.report_tow_candidates(self.quick.is_some());

@@ -248,3 +248,50 @@ pub(super) fn realign_engine(
         },
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gpsrx_tracking::CodeShift;
+
+    /// The code shifts after `g_s` of lost samples at 2.6 MHz for satellites at `dopplers`.
+    fn shifts_after(g_s: f64, dopplers: &[f64]) -> Vec<(u8, CodeShift)> {
+        dopplers
+            .iter()
+            .enumerate()
+            .map(|(i, &f)| {
+                let period = 2600.0 / (1.0 + f / 1.57542e9);
+                let shift = (-g_s * 2.6e6).rem_euclid(period);
+                let s = CodeShift {
+                    shift_samples: shift,
+                    period_samples: period,
+                };
+                (i as u8 + 1, s)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn code_moves_of_a_gap_longer_than_the_fit_reaches_are_left_unexplained() {
+        let dopplers = [
+            -3186.0, 1963.0, -1888.0, 637.0, -565.0, 2480.0, -2710.0, 1210.0,
+        ];
+        let unexplained = |g: f64| {
+            let s = shifts_after(g, &dopplers);
+            unexplained_moves(&s, fit_code_gap(&s, 2.6e6, 2.0).as_ref(), 2.0)
+        };
+        // Up to the fit's reach, one length explains every move.
+        for g in [1.25e-3, 0.5, 0.7317] {
+            assert!(unexplained(g).is_empty(), "{g} s: {:?}", unexplained(g));
+        }
+        // Beyond, the moves g f_D / f_L1 (26 samples for 5 s at 3 kHz) differ between satellites by
+        // more than any one gap of up to a second explains (a few may agree by chance).
+        for g in [5.0, 5.37, 60.0] {
+            let u = unexplained(g);
+            assert!(u.len() >= 6, "{g} s: {u:?}");
+        }
+        // Nothing moved (a blockage that ended): no gap.
+        let still: Vec<(u8, CodeShift)> = shifts_after(0.0, &dopplers);
+        assert!(unexplained_moves(&still, None, 2.0).is_empty());
+    }
+}
