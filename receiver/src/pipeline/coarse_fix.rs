@@ -82,7 +82,9 @@ pub struct CoarseSvTime {
 pub struct CoarseOutcome {
     /// Stream time of the common instant, s.
     pub t_s: f64,
-    /// GPS time at it (corrected).
+    /// GPS time at it: the solver's, known to milliseconds, moved with the SV times by the
+    /// bit edges' whole milliseconds (right to the fraction of a millisecond the receiver
+    /// clock is off).
     pub time: GpsTime,
     /// Corrected minus approximate time, s.
     pub time_correction_s: f64,
@@ -307,8 +309,10 @@ impl CoarseFixer {
         self.given = sv_times.iter().map(|s| s.prn).collect();
         Ok(CoarseOutcome {
             t_s: k as f64 / self.fs_hz,
-            time: sol.time,
-            time_correction_s: sol.time_correction_s,
+            // The solver's time is known to milliseconds only; the bit edges moved its
+            // transmit times by `offset` whole ms, and the time moves with them.
+            time: sol.time.add_seconds(-(offset as f64) * 1e-3),
+            time_correction_s: sol.time_correction_s - offset as f64 * 1e-3,
             position_shift_m: (sol.pos_ecef_m - apriori.pos_ecef_m).norm(),
             sv_times,
             check: format!(
