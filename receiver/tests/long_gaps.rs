@@ -172,33 +172,45 @@ fn describe(name: &str, sink: &MemorySink, at_s: f64) {
             .collect::<Vec<_>>()
     );
     eprintln!("  uncovered after: {:?}", uncovered(&fixes));
+    let bias_ms: Vec<String> = sink
+        .fixes
+        .iter()
+        .filter(|f| f.t_stream_s > at_s && f.fix.quality != FixQuality::None)
+        .take(3)
+        .map(|f| format!("{:.4}", f.fix.clock_bias_m / 299_792_458.0 * 1e3))
+        .collect();
+    eprintln!("  clock bias of the first valid fixes after, ms: {bias_ms:?}");
     eprintln!("  events: {}", events.join("; "));
 }
 
-/// The stream times of the reported sample gaps and the lengths measured for them (ms).
-fn gap_events(sink: &MemorySink) -> (Vec<f64>, Vec<f64>) {
+/// The stream times of the reported sample gaps, the lengths measured for them (ms), and the
+/// receiver clock steps after the first gap (ms).
+fn gap_events(sink: &MemorySink) -> (Vec<f64>, Vec<f64>, Vec<i64>) {
     let mut gaps = Vec::new();
     let mut lengths = Vec::new();
+    let mut steps = Vec::new();
     for e in &sink.events {
         match e {
             ReceiverEvent::SampleGap { t_s } => gaps.push(*t_s),
             ReceiverEvent::GapMeasured { length_ms, .. } => lengths.push(*length_ms),
+            ReceiverEvent::ClockStep { ms } if !gaps.is_empty() => steps.push(*ms),
             _ => {}
         }
     }
-    (gaps, lengths)
+    (gaps, lengths, steps)
 }
 
 /// Runs a `len_s` cut at stream time `at_s` of a recording that goes on for `after_s` past
 /// it, and checks against the truth: one gap reported where it happened and its length
-/// measured to a millisecond once the time is back; the first valid fix at most `within_s`
+/// measured to a millisecond once the time is back, the receiver clock stepped once by it;
+/// the first valid fix at most `within_s`
 /// after the signal returns, and valid fixes from then on; no valid fix, before or after,
 /// more than 5 m off unless its stated 3-sigma covers the error.
 fn assert_recovers(nav: bool, at_s: f64, len_s: f64, after_s: f64, within_s: f64) {
     let name = format!("{len_s} s cut at {at_s} s, nav {nav}");
     let sim = simulator(at_s + len_s + after_s);
     let sink = run_cut(&sim, nav, at_s, len_s);
-    let (gaps, lengths) = gap_events(&sink);
+    let (gaps, lengths, steps) = gap_events(&sink);
     assert!(
         gaps.len() == 1 && (gaps[0] - at_s).abs() < 0.05,
         "{name}: gaps reported at {gaps:?} s"
@@ -206,6 +218,12 @@ fn assert_recovers(nav: bool, at_s: f64, len_s: f64, after_s: f64, within_s: f64
     assert!(
         lengths.len() == 1 && (lengths[0] - len_s * 1e3).abs() < 1.0,
         "{name}: lengths measured {lengths:?} ms"
+    );
+    // The receiver time is stepped once, by the whole milliseconds lost (the clock bias stays
+    // within a millisecond: the first fix need not step it again).
+    assert!(
+        steps.len() == 1 && (steps[0] as f64 - len_s * 1e3).abs() <= 1.0,
+        "{name}: clock steps after the gap {steps:?} ms"
     );
     let all = scored(&sink, 0.0);
     let wrong = uncovered(&all);

@@ -82,9 +82,8 @@ pub struct CoarseSvTime {
 pub struct CoarseOutcome {
     /// Stream time of the common instant, s.
     pub t_s: f64,
-    /// GPS time at it: the solver's, known to milliseconds, moved with the SV times by the
-    /// bit edges' whole milliseconds (right to the fraction of a millisecond the receiver
-    /// clock is off).
+    /// GPS time at it: the solver's, known to milliseconds, moved onto the time the SV times
+    /// fit (by its sub-millisecond clock offset and the bit edges' whole milliseconds).
     pub time: GpsTime,
     /// Corrected minus approximate time, s.
     pub time_correction_s: f64,
@@ -297,6 +296,12 @@ impl CoarseFixer {
                 sol.time_sigma_s * 1e3
             )));
         }
+        // The solver's time is known to milliseconds only: the transmit times fit it with
+        // the sub-millisecond clock offset `f = b / c + dt_c - u` (its clock-bias unknown
+        // `b`, time correction `dt_c` and common shift `u`), and the bit edges moved them by
+        // `offset` whole milliseconds. The time that fits them exactly is `t - f - offset`.
+        let frac_s = sol.clock_bias_s + sol.time_correction_s - sol.common_ms_shift as f64 * 1e-3;
+        let exact_s = frac_s + offset as f64 * 1e-3;
         let sv_times = used
             .iter()
             .map(|&(prn, m, n_ms, _)| CoarseSvTime {
@@ -309,10 +314,8 @@ impl CoarseFixer {
         self.given = sv_times.iter().map(|s| s.prn).collect();
         Ok(CoarseOutcome {
             t_s: k as f64 / self.fs_hz,
-            // The solver's time is known to milliseconds only; the bit edges moved its
-            // transmit times by `offset` whole ms, and the time moves with them.
-            time: sol.time.add_seconds(-(offset as f64) * 1e-3),
-            time_correction_s: sol.time_correction_s - offset as f64 * 1e-3,
+            time: sol.time.add_seconds(-exact_s),
+            time_correction_s: sol.time_correction_s - exact_s,
             position_shift_m: (sol.pos_ecef_m - apriori.pos_ecef_m).norm(),
             sv_times,
             check: format!(
