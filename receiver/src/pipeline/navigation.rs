@@ -285,6 +285,9 @@ impl NavigationProcessor {
                 r.shortest_gap_s
             );
             self.forget_time(t_s, Vec::new(), None);
+            let settled =
+                r.at_sample as f64 + crate::pipeline::long_gap::CODE_SETTLE_S * self.fs_hz;
+            self.fixes_from_sample = self.fixes_from_sample.max(settled);
             return sink.event(&ReceiverEvent::SampleGap { t_s });
         }
         let frac_ms = (-r.fraction_of_period).rem_euclid(1.0);
@@ -705,7 +708,8 @@ impl NavigationProcessor {
                     }
                 }
                 // A report covers up to 20 ms: later epochs have every channel's observables.
-                self.fixes_from_sample = (out.t_s + 0.025) * self.fs_hz;
+                let from = (out.t_s + 0.025) * self.fs_hz;
+                self.fixes_from_sample = self.fixes_from_sample.max(from);
                 tracing::info!(
                     "coarse-time fix at {:.2} s: {} satellites, time corrected by {:+.3} s, {:.1} km from the approximate position ({}): SV times set, fixes follow",
                     out.t_s,
