@@ -157,7 +157,7 @@ section_long-gaps() {
             # shellcheck disable=SC2086
             "$GPSRX" run "$WORK/lg-cut.ci8" --format ci8 --fs 2.048e6 $nav --out "$WORK/lg-run" \
                 --no-plots 2>"$WORK/lg.log" >/dev/null || true
-            echo "-- cut $len s at 35 s ${nav:+with --nav}${nav:-without --nav}: $(grep -E "coarse-time fix at|time re-established" "$WORK/lg.log" | sed 's/^.*\(WARN\|INFO\) //' | head -1)"
+            echo "-- cut $len s at 35 s $([[ -n $nav ]] && echo with || echo without) --nav: $(grep -E "coarse-time fix at|time re-established" "$WORK/lg.log" | sed 's/^.*\(WARN\|INFO\) //' | head -1)"
             # shellcheck disable=SC2086
             python3 "$TOOLS/fault_recovery.py" "$WORK/lg-run/pvt.csv" $llh --start-tow 563388 \
                 --at 35 --len "$len" --kind cut
