@@ -10,6 +10,7 @@
 #   hard       the "Hard recordings" table                    [Hard recordings]
 #   weak       the weak-mix recording, with and without --nav [Finding satellites]
 #   faults     samples cut / zeroed in the GPS-SDR-SIM file    [Lost samples and outages]
+#   long-gaps  5 s / 60 s cut from the simulated Seoul file    [Lost samples and outages]
 #   aided      the 5 g turn with an INS, aided and not         [INS aiding]
 #   loops      narrow 0.4 Hz loops: 10 g turns, the C/N0 ladder [Loss of carrier lock]
 #   dr         the drive with a 30 s outage, --dr --accel      [Dead reckoning]
@@ -29,7 +30,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 WORK=${WORK:-$(mktemp -d)}
 SHARED=${SHARED:-$ROOT/../shared/data}
-ALL=(demo seoul hard weak faults aided loops dr acquire track jitter studies bench vs-gnss-sdr scaling)
+ALL=(demo seoul hard weak faults long-gaps aided loops dr acquire track jitter studies bench vs-gnss-sdr scaling)
 die() { echo "readme-figures: $*" >&2; exit 1; }
 
 if [[ ${1:-} == --list ]]; then printf '%s\n' "${ALL[@]}"; exit 0; fi
@@ -129,7 +130,8 @@ section_weak() {
 section_faults() {
     local f
     f=$(seoul_file)
-    for fault in "cut 20 0.001" "cut 20 0.00125" "cut 20 0.020" "cut 20 0.031" "cut 20 0.5" "zero 20 2"; do
+    for fault in "cut 20 0.001" "cut 20 0.00125" "cut 20 0.020" "cut 20 0.031" "cut 20 0.5" "zero 20 2" \
+        "cut 20 5" "cut 10 20"; do
         read -r kind at len <<<"$fault"
         python3 "$TOOLS/fault.py" "$f" "$WORK/fault.ci8" --bytes-per-sample 2 --fs 2.6e6 --"$kind" "$at" "$len"
         "$GPSRX" run "$WORK/fault.ci8" --format ci8 --fs 2.6e6 --tropo none --allow-unhealthy --nav "$NAV" \
@@ -139,6 +141,29 @@ section_faults() {
             --len "$len" --kind "$kind"
     done
     rm -f "$WORK/fault.ci8"
+}
+
+# Long gaps (issue 26) on the simulator's static Seoul scenario (12 satellites; 2.048 MHz ci8,
+# 110 s): 5 s and 60 s cut at 35 s (the ephemerides are decoded by then), with and without --nav.
+section_long-gaps() {
+    run "$GPSRX" simulate "$ROOT/samples/scenarios/static-seoul-4msps.toml" -o "$WORK/lg" \
+        --duration 110 --fs 2.048e6 >/dev/null
+    local llh
+    llh=$(awk -F, 'NR == 2 { print $13, $14, $15 }' "$WORK/lg/truth.csv")
+    for len in 5 60; do
+        python3 "$TOOLS/fault.py" "$WORK/lg/signal.ci8" "$WORK/lg-cut.ci8" --bytes-per-sample 2 \
+            --fs 2.048e6 --cut 35 "$len"
+        for nav in "" "--nav $NAV"; do
+            # shellcheck disable=SC2086
+            "$GPSRX" run "$WORK/lg-cut.ci8" --format ci8 --fs 2.048e6 $nav --out "$WORK/lg-run" \
+                --no-plots 2>"$WORK/lg.log" >/dev/null || true
+            echo "-- cut $len s at 35 s $([[ -n $nav ]] && echo with || echo without) --nav: $(grep -E "coarse-time fix at|time re-established" "$WORK/lg.log" | sed 's/^.*\(WARN\|INFO\) //' | head -1)"
+            # shellcheck disable=SC2086
+            python3 "$TOOLS/fault_recovery.py" "$WORK/lg-run/pvt.csv" $llh --start-tow 563388 \
+                --at 35 --len "$len" --kind cut
+        done
+    done
+    rm -f "$WORK/lg-cut.ci8"
 }
 
 section_aided() {

@@ -4,6 +4,7 @@
 mod acquisition;
 mod ephemeris_file;
 mod faults;
+mod long_gaps;
 mod pipeline;
 mod plots;
 mod sigmf_lo;

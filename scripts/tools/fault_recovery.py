@@ -6,7 +6,9 @@ usage: fault_recovery.py PVT_CSV LAT LON H --start-tow S --at S --len S --kind c
 The signal comes back at true GPS time start + at + len (for a cut the samples of that span
 are gone, for zeros they are empty). Prints the first valid fix after it ("back", seconds after
 the return), the number of valid fixes after the fault, the largest 3D error of any valid fix
-after the fault (a fix from the wrong time would show here), and how many were written flagged
+after the fault (a fix from the wrong time would show here), how many of the valid fixes after
+it are more than 5 m off beyond their stated 3-sigma (3 x the root sum of squares of
+sigma_e_m, sigma_n_m, sigma_u_m: issue 26's integrity bound), and how many were written flagged
 invalid.
 """
 import argparse
@@ -38,7 +40,7 @@ def main():
     x0 = ecef(a.lat, a.lon, a.h)
     t_fault = a.start_tow + a.at
     t_back = t_fault + a.len
-    first, worst, valid, flagged = None, 0.0, 0, 0
+    first, worst, valid, flagged, uncovered = None, 0.0, 0, 0, 0
     for r in csv.DictReader(open(a.pvt)):
         if not r["tow_s"] or float(r["tow_s"]) <= t_fault:
             continue
@@ -49,11 +51,16 @@ def main():
         err = math.dist(x0, [float(r[k]) for k in ("x_m", "y_m", "z_m")])
         worst = max(worst, err)
         valid += 1
+        sig = [r.get(k) or "" for k in ("sigma_e_m", "sigma_n_m", "sigma_u_m")]
+        s3 = 3 * math.sqrt(sum(float(x) ** 2 for x in sig)) if all(sig) else 0.0
+        if err > 5.0 and err > s3:
+            uncovered += 1
         if first is None:
             first = t
     back = f"{first - t_back:.1f} s" if first is not None else "never"
     print(f"   back {back} after the signal returns; {valid} valid fixes after the fault, "
-          f"worst 3D error {worst:.1f} m; {flagged} written flagged invalid")
+          f"worst 3D error {worst:.1f} m ({uncovered} over 5 m beyond their 3-sigma); "
+          f"{flagged} written flagged invalid")
 
 
 if __name__ == "__main__":

@@ -82,7 +82,8 @@ pub struct CoarseSvTime {
 pub struct CoarseOutcome {
     /// Stream time of the common instant, s.
     pub t_s: f64,
-    /// GPS time at it (corrected).
+    /// GPS time at it: the solver's, known to milliseconds, moved onto the time the SV times
+    /// fit (by its sub-millisecond clock offset and the bit edges' whole milliseconds).
     pub time: GpsTime,
     /// Corrected minus approximate time, s.
     pub time_correction_s: f64,
@@ -129,6 +130,10 @@ pub struct CoarseFixer {
     pub given: BTreeSet<u8>,
     /// An outcome was handed out (no more attempts).
     pub done: bool,
+    /// Bound on the a-priori time error, s ([`CoarseApriori::time_uncertainty_s`]).
+    time_uncertainty_s: f64,
+    /// Smallest time correction accepted, s (`None`: any within the bound).
+    min_correction_s: Option<f64>,
 }
 
 impl CoarseFixer {
@@ -142,7 +147,20 @@ impl CoarseFixer {
             next_attempt: 0,
             given: BTreeSet::new(),
             done: false,
+            time_uncertainty_s: gpsrx_nav::pvt::coarse_time::DEFAULT_TIME_UNCERTAINTY_S,
+            min_correction_s: None,
         }
+    }
+
+    /// The a-priori time is only known to lie between `min_correction_s` and
+    /// `uncertainty_s` before the true time (after lost samples of unknown length the
+    /// receiver time, which counts samples, is late by the gap and never early): solutions
+    /// correcting it by less than `min_correction_s` are refused, and the solver's bound is
+    /// `uncertainty_s`.
+    pub fn with_time_window(mut self, min_correction_s: f64, uncertainty_s: f64) -> Self {
+        self.min_correction_s = Some(min_correction_s);
+        self.time_uncertainty_s = uncertainty_s;
+        self
     }
 
     /// Takes a channel report: kept while in phase lock, with C/N0 >= [`MIN_CN0_DBHZ`] and
@@ -219,9 +237,18 @@ impl CoarseFixer {
                 ephemeris: eph,
             })
             .collect();
-        let apriori = CoarseApriori::from_llh(t_a, &self.llh);
+        let apriori = CoarseApriori {
+            time_uncertainty_s: self.time_uncertainty_s,
+            ..CoarseApriori::from_llh(t_a, &self.llh)
+        };
         let sol = solve_coarse_time(&meas, &apriori, opts)
             .map_err(|e| CoarseRefusal::Refused(e.to_string()))?;
+        if let Some(min) = self.min_correction_s.filter(|&m| sol.time_correction_s < m) {
+            return Err(CoarseRefusal::Refused(format!(
+                "the coarse time moves the receiver time back by {:.3} s (at most {:.3} s allowed)",
+                -sol.time_correction_s, -min
+            )));
+        }
         // Whole milliseconds at the start of each satellite's period at k, and its bit edge.
         let mut used = Vec::new();
         for cs in sol
@@ -269,6 +296,12 @@ impl CoarseFixer {
                 sol.time_sigma_s * 1e3
             )));
         }
+        // The solver's time is known to milliseconds only: the transmit times fit it with
+        // the sub-millisecond clock offset `f = b / c + dt_c - u` (its clock-bias unknown
+        // `b`, time correction `dt_c` and common shift `u`), and the bit edges moved them by
+        // `offset` whole milliseconds. The time that fits them exactly is `t - f - offset`.
+        let frac_s = sol.clock_bias_s + sol.time_correction_s - sol.common_ms_shift as f64 * 1e-3;
+        let exact_s = frac_s + offset as f64 * 1e-3;
         let sv_times = used
             .iter()
             .map(|&(prn, m, n_ms, _)| CoarseSvTime {
@@ -281,8 +314,8 @@ impl CoarseFixer {
         self.given = sv_times.iter().map(|s| s.prn).collect();
         Ok(CoarseOutcome {
             t_s: k as f64 / self.fs_hz,
-            time: sol.time,
-            time_correction_s: sol.time_correction_s,
+            time: sol.time.add_seconds(-exact_s),
+            time_correction_s: sol.time_correction_s - exact_s,
             position_shift_m: (sol.pos_ecef_m - apriori.pos_ecef_m).norm(),
             sv_times,
             check: format!(

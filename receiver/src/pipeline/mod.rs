@@ -16,6 +16,7 @@
 //! - [`code_jump`]: lost samples found by a code jump (prompt power collapsing together);
 //! - [`carrier_step`]: a satellite's carrier-phase step over lost samples;
 //! - [`gap_length`]: the length of lost time from the bit edges and carrier-phase steps;
+//! - `long_gap`: the receiver time re-established after a gap too long to measure;
 //! - [`quick_sync`]: frame sync from one TLM and HOW, confirmed across satellites;
 //! - [`sv_time`]: SV times kept across losses of the signal and lost samples;
 //! - [`observables`]: pseudoranges, carrier phase, Doppler at common receiver epochs;
@@ -31,6 +32,7 @@ pub mod dating;
 pub mod discontinuity;
 pub mod fix_output;
 pub mod gap_length;
+pub(crate) mod long_gap;
 pub mod navdata;
 pub mod navigation;
 pub mod observables;

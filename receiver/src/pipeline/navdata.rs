@@ -352,7 +352,9 @@ impl NavDecoder {
         if self.sync_from_hint(events) {
             return;
         }
-        if self.tow_candidates && self.hint.is_none() && self.bits.len() >= 60 {
+        // A hint the TLM and HOW disagree with (samples of unknown length lost since it was
+        // taken) does not hold the candidate back: other satellites confirm it or not.
+        if self.tow_candidates && self.bits.len() >= 60 {
             let n = self.bits.len();
             let head: Vec<u8> = self.bits.iter().skip(n - 60).map(|&(b, _)| b).collect();
             if let Some((how, _)) = decode_tlm_how(&head) {

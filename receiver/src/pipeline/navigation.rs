@@ -16,6 +16,7 @@ use crate::pipeline::code_jump::{Collapse, CollapseMonitor};
 use crate::pipeline::discontinuity::{Discontinuity, DiscontinuityMonitor};
 pub use crate::pipeline::fix_output::FixStats;
 use crate::pipeline::fix_output::{fix_of, obs_epoch, passes_integrity};
+use crate::pipeline::long_gap::LongGapRecovery;
 use crate::pipeline::navdata::{NavDecoder, NavEvent};
 use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
 use crate::pipeline::quick_sync::{QuickSync, TowCandidate};
@@ -92,6 +93,8 @@ pub struct NavigationProcessor {
     /// Frame sync from one TLM and HOW confirmed across satellites (with ephemerides from a
     /// navigation file, a fix can follow at once).
     quick: Option<QuickSync>,
+    /// The receiver time re-established after samples of unknown length were lost.
+    long_gap: LongGapRecovery,
 }
 
 /// Time the code loops of channels that kept their satellites over lost samples need before
@@ -184,6 +187,7 @@ impl NavigationProcessor {
             fixes_from_sample: 0.0,
             quick: nav_assist_given.then(QuickSync::default),
             aided_offset_cycles: None,
+            long_gap: LongGapRecovery::default(),
         }
     }
 
@@ -274,6 +278,18 @@ impl NavigationProcessor {
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
         let t_s = r.jump_sample as f64 / self.fs_hz;
+        if r.length_unknown {
+            tracing::warn!(
+                "{t_s:.3} s: samples lost (the code of {} satellites moved by more than any gap of up to {:.0} s explains): channels moved onto it; no fix until the receiver time is re-established",
+                r.prns.len(),
+                r.shortest_gap_s
+            );
+            self.forget_time(t_s, Vec::new(), None);
+            let settled =
+                r.at_sample as f64 + crate::pipeline::long_gap::CODE_SETTLE_S * self.fs_hz;
+            self.fixes_from_sample = self.fixes_from_sample.max(settled);
+            return sink.event(&ReceiverEvent::SampleGap { t_s });
+        }
         let frac_ms = (-r.fraction_of_period).rem_euclid(1.0);
         tracing::warn!(
             "{t_s:.3} s: samples lost (the code of {} satellites jumped: {frac_ms:.4} ms modulo 1 ms, at least {:.1} ms): channels moved onto it; no fix until the receiver time is re-established",
@@ -461,6 +477,7 @@ impl NavigationProcessor {
             }
             None => {}
         }
+        self.start_long_gap();
         self.coarse_step(e, sink)?;
         self.channel_row(channel, e, sink)?;
         self.realign_clock(e, sink)?;
@@ -663,25 +680,36 @@ impl NavigationProcessor {
             return Ok(());
         }
         let opts = self.pvt_options();
-        let (Some(cf), Some(nav)) = (self.coarse.as_mut(), self.nav_assist.as_ref()) else {
+        let (decoders, nav) = (&self.decoders, self.nav_assist.as_ref());
+        let Some(cf) = self.coarse.as_mut() else {
             return Ok(());
         };
         cf.observe(e);
-        let policy = if self.settings.allow_unhealthy {
-            gpsrx_nav::ephemeris::HealthPolicy::PreferHealthy
+        let allow_unhealthy = self.settings.allow_unhealthy;
+        let policy = if allow_unhealthy {
+            HealthPolicy::PreferHealthy
         } else {
-            gpsrx_nav::ephemeris::HealthPolicy::HealthyOnly
+            HealthPolicy::HealthyOnly
         };
-        let ephemeris = |prn: u8, t| nav.select_with(prn, t, policy).cloned();
+        // Decoded (after a long gap without a navigation file), else from the file.
+        let ephemeris = |prn: u8, t| {
+            decoders
+                .get(&prn)
+                .and_then(|d| d.ephemeris.clone())
+                .filter(|eph| eph.sv_health == 0 || allow_unhealthy)
+                .or_else(|| nav?.select_with(prn, t, policy).cloned())
+        };
         match cf.attempt(&ephemeris, &opts) {
             Ok(out) => {
+                self.step_clock_to_coarse_time(&out, sink)?;
                 for t in &out.sv_times {
                     if let Some(d) = self.decoders.get_mut(&t.prn) {
                         d.carry_time(t.ms_count, t.sv_tow_s);
                     }
                 }
                 // A report covers up to 20 ms: later epochs have every channel's observables.
-                self.fixes_from_sample = (out.t_s + 0.025) * self.fs_hz;
+                let from = (out.t_s + 0.025) * self.fs_hz;
+                self.fixes_from_sample = self.fixes_from_sample.max(from);
                 tracing::info!(
                     "coarse-time fix at {:.2} s: {} satellites, time corrected by {:+.3} s, {:.1} km from the approximate position ({}): SV times set, fixes follow",
                     out.t_s,
@@ -844,21 +872,58 @@ impl NavigationProcessor {
             c.given.clear();
         }
         tracing::warn!(
-            "{t_s:.2} s: the solutions fail the integrity test with the SV times carried over the outage (samples lost during it?): those of {} satellites dropped, waiting for frame sync",
+            "{t_s:.2} s: the solutions fail the integrity test with the SV times carried over the outage of {} satellites (samples lost during it?): every SV time dropped (they all count the samples), re-establishing the time from the signal",
             carried.len()
         );
-        for p in carried {
-            if let Some(d) = self.decoders.get_mut(&p) {
-                d.reset_sync();
-            }
-            self.sv_time.make_rough(Some(p));
+        for d in self.decoders.values_mut() {
+            d.reset_sync();
         }
+        self.sv_time.make_rough(None);
         self.builder.restart();
         self.failed_in_row = 0;
         let before = self.last_clock;
         self.sv_time
             .gap
             .get_or_insert_with(|| GapRecovery::new(t_s, before, Vec::new(), None));
+    }
+
+    /// Once the length of the gap being recovered from cannot be measured: the time comes
+    /// back from the coarse-time solver or the next time of week ([`LongGapRecovery::begin`]).
+    fn start_long_gap(&mut self) {
+        let with_eph = self.decoders.values().filter(|d| d.ephemeris.is_some());
+        let eph = self.nav_assist.is_some()
+            || with_eph.count() >= crate::pipeline::coarse_fix::MIN_SATELLITES;
+        let origin = self.builder.rx_time_origin();
+        let gap = self.sv_time.gap.as_ref();
+        let Some(start) = self.long_gap.begin(gap, self.fs_hz, origin, eph) else {
+            return;
+        };
+        self.coarse = start.coarse.or(self.coarse.take());
+        if start.quick_sync {
+            self.quick.get_or_insert_with(QuickSync::default);
+        }
+        for d in self.decoders.values_mut() {
+            d.report_tow_candidates(self.quick.is_some());
+        }
+    }
+
+    /// After a coarse-time fix while a long gap is recovered from: the receiver clock stepped
+    /// by the whole milliseconds of the time lost ([`LongGapRecovery::clock_step_ms`]).
+    fn step_clock_to_coarse_time(
+        &mut self,
+        out: &crate::pipeline::coarse_fix::CoarseOutcome,
+        sink: &mut dyn Sink,
+    ) -> Result<(), SinkError> {
+        let origin = self.builder.rx_time_origin();
+        let Some(step) = self.long_gap.clock_step_ms(out, origin) else {
+            return Ok(());
+        };
+        self.builder.step_clock_ms(step);
+        if let Some(gap) = self.sv_time.gap.as_mut() {
+            gap.stepped_ms += step;
+        }
+        tracing::info!("receiver clock stepped by {step} ms to the coarse time");
+        sink.event(&ReceiverEvent::ClockStep { ms: step })
     }
 
     /// Once the length of the samples lost at stream time `t_s` is known: the carrier smoothing
@@ -1207,6 +1272,7 @@ impl NavigationProcessor {
             sink.event(&ReceiverEvent::ClockStep { ms: step })?;
         }
         self.last_clock = Some((t_stream_s, bias_after_m, sol.clock_drift_mps.unwrap_or(0.0)));
+        self.long_gap.note_fix(sol.llh);
         if self.stats.first_fix_s.is_none() {
             tracing::info!(
                 "first fix at {:.2} s: {:.7} {:.7} {:.1} m, {} satellites, PDOP {:.1}",
