@@ -273,6 +273,25 @@ pub fn fit_code_gap(shifts: &[(u8, CodeShift)], fs_hz: f64, tol_samples: f64) ->
     })
 }
 
+/// The code shifts after `g_s` of lost samples at 2.6 MHz for satellites at `dopplers` (Hz),
+/// PRNs 1, 2, ... (test support, also for `channel_manager::realign`).
+#[cfg(test)]
+pub(crate) fn shifts_after(g_s: f64, dopplers: &[f64]) -> Vec<(u8, gpsrx_tracking::CodeShift)> {
+    dopplers
+        .iter()
+        .enumerate()
+        .map(|(i, &f)| {
+            let period = 2600.0 / (1.0 + f / 1.57542e9);
+            let shift = (-g_s * 2.6e6).rem_euclid(period);
+            let s = gpsrx_tracking::CodeShift {
+                shift_samples: shift,
+                period_samples: period,
+            };
+            (i as u8 + 1, s)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -331,25 +350,6 @@ mod tests {
         assert_eq!(run(&[(3, 300), (7, 300)], &prns), None);
         assert_eq!(run(&[(3, 200), (7, 300), (11, 400)], &prns), None);
         assert_eq!(run(&[], &prns), None);
-    }
-
-    /// The shifts of satellites with these Dopplers after `g_s` of lost samples at 2.6 MHz.
-    fn shifts_after(g_s: f64, dopplers: &[f64]) -> Vec<(u8, CodeShift)> {
-        dopplers
-            .iter()
-            .enumerate()
-            .map(|(i, &f)| {
-                let period = 2600.0 / (1.0 + f / 1.57542e9);
-                let shift = (-g_s * 2.6e6).rem_euclid(period);
-                (
-                    i as u8 + 1,
-                    CodeShift {
-                        shift_samples: shift,
-                        period_samples: period,
-                    },
-                )
-            })
-            .collect()
     }
 
     #[test]

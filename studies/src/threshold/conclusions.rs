@@ -262,6 +262,27 @@ fn loop_reason(r: &CellResult, a: Agreement) -> String {
     }
 }
 
+/// How many of `run` agree by `compare`, and the measured-minus-theory deltas where both have
+/// a threshold.
+fn tally(
+    run: &[&CellResult],
+    compare: impl Fn(&CellResult) -> Option<Agreement>,
+) -> (usize, Vec<f64>) {
+    let outcomes: Vec<Option<Agreement>> = run.iter().map(|r| compare(r)).collect();
+    let agree = outcomes
+        .iter()
+        .filter(|a| a.is_some_and(|a| a.agrees()))
+        .count();
+    let deltas = outcomes
+        .iter()
+        .filter_map(|a| match a {
+            Some(Agreement::Delta(d)) => Some(*d),
+            _ => None,
+        })
+        .collect();
+    (agree, deltas)
+}
+
 /// `measured minus theory over the K cells with both thresholds: mean M dB, from LO to HI dB`
 /// (empty without any).
 fn spread_words(deltas: &[f64]) -> String {
@@ -285,10 +306,7 @@ fn spread_words(deltas: &[f64]) -> String {
 pub fn conclusions_md(results: &[CellResult]) -> String {
     let run: Vec<&CellResult> = results.iter().filter(|r| r.rejected.is_none()).collect();
     let n = run.len();
-    let agree = run
-        .iter()
-        .filter(|r| r.vs_rule().is_some_and(|a| a.agrees()))
-        .count();
+    let (agree, deltas) = tally(&run, CellResult::vs_rule);
     let both_none = run
         .iter()
         .filter(|r| r.vs_rule() == Some(Agreement::BothNone))
@@ -297,24 +315,7 @@ pub fn conclusions_md(results: &[CellResult]) -> String {
         .iter()
         .filter(|r| r.vs_expected().is_some_and(|a| a.agrees()))
         .count();
-    let deltas: Vec<f64> = run
-        .iter()
-        .filter_map(|r| match r.vs_rule() {
-            Some(Agreement::Delta(d)) => Some(d),
-            _ => None,
-        })
-        .collect();
-    let agree_atan = run
-        .iter()
-        .filter(|r| r.vs_atan_rule().is_some_and(|a| a.agrees()))
-        .count();
-    let atan_deltas: Vec<f64> = run
-        .iter()
-        .filter_map(|r| match r.vs_atan_rule() {
-            Some(Agreement::Delta(d)) => Some(d),
-            _ => None,
-        })
-        .collect();
+    let (agree_atan, atan_deltas) = tally(&run, CellResult::vs_atan_rule);
     let mut s = String::from("## Conclusions\n\n");
     let _ = writeln!(
         s,

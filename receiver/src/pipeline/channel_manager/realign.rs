@@ -254,22 +254,7 @@ mod tests {
     use super::*;
     use gpsrx_tracking::CodeShift;
 
-    /// The code shifts after `g_s` of lost samples at 2.6 MHz for satellites at `dopplers`.
-    fn shifts_after(g_s: f64, dopplers: &[f64]) -> Vec<(u8, CodeShift)> {
-        dopplers
-            .iter()
-            .enumerate()
-            .map(|(i, &f)| {
-                let period = 2600.0 / (1.0 + f / 1.57542e9);
-                let shift = (-g_s * 2.6e6).rem_euclid(period);
-                let s = CodeShift {
-                    shift_samples: shift,
-                    period_samples: period,
-                };
-                (i as u8 + 1, s)
-            })
-            .collect()
-    }
+    use crate::pipeline::code_jump::shifts_after;
 
     #[test]
     fn code_moves_of_a_gap_longer_than_the_fit_reaches_are_left_unexplained() {
