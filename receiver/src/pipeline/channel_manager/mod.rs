@@ -145,14 +145,19 @@ impl ChannelManager {
         channel_config: ChannelConfig,
         settings: SearchSettings,
     ) -> Result<Self, gpsrx_dsp::acquisition::AcqError> {
-        let mut engines = vec![AcquisitionEngine::new(fs_hz, settings.acq.clone())?];
+        // The levels and the realignment hold one copy of the replica spectra where their
+        // layouts give the same ones (1 MB each at 4 MHz).
+        let first = AcquisitionEngine::new(fs_hz, settings.acq.clone())?;
+        let mut engines = Vec::new();
         if settings.weak_fallback {
             for level in 1..=LEVELS.len() {
                 let cfg = level_config(&settings.acq, level);
-                engines.push(AcquisitionEngine::new(fs_hz, cfg)?);
+                engines.push(AcquisitionEngine::new(fs_hz, cfg)?.sharing_replicas_with(&first));
             }
         }
-        let realign_engine = Some(realign::realign_engine(fs_hz, &settings.acq)?);
+        engines.insert(0, first);
+        let realign_engine =
+            Some(realign::realign_engine(fs_hz, &settings.acq)?.sharing_replicas_with(&engines[0]));
         Ok(Self {
             fs_hz,
             channel_config,
