@@ -14,6 +14,7 @@ use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
 use crate::pipeline::dating::WeekReference;
 use crate::pipeline::navigation::{BlockEvent, NavigationProcessor};
+use crate::pipeline::profile::{add_timed, StageTimes};
 use crate::pipeline::ring::{block_samples, SampleWindow};
 use crate::pipeline::search_schedule::SearchBudget;
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
@@ -206,6 +207,8 @@ pub struct RunSummary {
     /// With `--ins`: how much of the recording was aided, and how often the INS was rejected
     /// for disagreeing with the tracked Doppler ([`crate::pipeline::aid_monitor`]).
     pub ins_aiding: Option<InsAidingSummary>,
+    /// Where the wall time went, stage by stage ([`crate::pipeline::profile`]).
+    pub profile: StageTimes,
 }
 
 /// The INS aiding over a run.
@@ -252,6 +255,9 @@ pub struct Receiver {
     /// Index of the first sample of the stream.
     first_sample: Option<u64>,
     started: std::time::Instant,
+    /// The serial stages' wall time so far (the rounds' parts come from the window and the
+    /// channel manager).
+    stages: StageTimes,
     finished: bool,
     non_finite_said: bool,
 }
@@ -346,6 +352,7 @@ impl Receiver {
             processed_to: None,
             first_sample: None,
             started: std::time::Instant::now(),
+            stages: StageTimes::default(),
             finished: false,
             non_finite_said: false,
         })
@@ -430,12 +437,13 @@ impl Receiver {
             let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
             let manager = &mut self.manager;
             let end = self.window.end();
-            let (got, found) = self
-                .window
-                .fill_during(source, self.block, |view| manager.work(view, due, aid))?;
+            let window = &mut self.window;
+            let (got, found) = add_timed(&mut self.stages.rounds_s, || {
+                window.fill_during(source, self.block, |view| manager.work(view, due, aid))
+            })?;
             self.processed_to = Some(end);
             let window_end = self.window.end();
-            self.deliver(found, window_end, sink)?;
+            self.timed_deliver(found, window_end, sink)?;
             if got == 0 {
                 break;
             }
@@ -499,7 +507,9 @@ impl Receiver {
             if self.processed_to.is_some_and(|done| done < end) {
                 self.step(end, sink)?;
             }
-            sink.finish(&self.nav.end()).map_err(ReceiverError::Sink)?;
+            let nav_end = self.nav.end();
+            add_timed(&mut self.stages.finish_s, || sink.finish(&nav_end))
+                .map_err(ReceiverError::Sink)?;
             self.finished = true;
         }
         let stats = self.nav.stats();
@@ -519,7 +529,20 @@ impl Receiver {
                 .aiding
                 .as_ref()
                 .map(|_| InsAidingSummary::new(self.monitor.stats(), duration_s)),
+            profile: self.profile(),
         })
+    }
+
+    /// Where the wall time went so far ([`crate::pipeline::profile`]).
+    pub fn profile(&self) -> StageTimes {
+        let work = self.manager.work_times();
+        StageTimes {
+            tracking_s: work.tracking_s,
+            search_s: work.search_s,
+            searches: work.searches,
+            read_s: self.window.read_s(),
+            ..self.stages
+        }
     }
 
     /// Samples the cold start wants.
@@ -532,7 +555,10 @@ impl Receiver {
         let first = self.window.start();
         let n = (self.window.end() - first).min(self.cold_samples()) as usize;
         let samples = self.window.get_cf32(first, n).unwrap_or_default();
-        let found = self.manager.cold_start(&samples, first)?;
+        let manager = &mut self.manager;
+        let found = add_timed(&mut self.stages.cold_start_s, || {
+            manager.cold_start(&samples, first)
+        })?;
         self.processed_to = Some(first);
         self.announce(&found, first, sink)
     }
@@ -561,9 +587,23 @@ impl Receiver {
             .due_search(view, &|p| nav.visibility(p.get(), t_s));
         let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
         let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
-        let found = self.manager.work(view, due, aid);
+        let manager = &mut self.manager;
+        let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
         self.processed_to = Some(limit);
-        self.deliver(found, limit, sink)
+        self.timed_deliver(found, limit, sink)
+    }
+
+    /// [`Receiver::deliver`], its wall time added to the navigation stage.
+    fn timed_deliver(
+        &mut self,
+        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        end: u64,
+        sink: &mut dyn Sink,
+    ) -> Result<(), ReceiverError> {
+        let t0 = std::time::Instant::now();
+        let r = self.deliver(found, end, sink);
+        self.stages.navigation_s += t0.elapsed().as_secs_f64();
+        r
     }
 
     /// After a round: the reports to the navigation processor, new channels for what a search

@@ -13,6 +13,7 @@
 //! with no conversion and a half or a quarter of the memory traffic of complex f32 -- else as
 //! complex f32. The searches, which need f32, convert the span they read.
 
+use crate::pipeline::profile::timed;
 use gpsrx_dsp::correlator::SampleSlice;
 use gpsrx_samples::{IntegerFormat, IntegerSamplesMut, SampleError, SampleSource};
 use num_complex::Complex32;
@@ -146,6 +147,8 @@ pub struct SampleWindow {
     end_of_stream: bool,
     /// Bytes dropped before a compaction ([`COMPACT_BYTES`]; smaller in tests).
     compact_bytes: usize,
+    /// Wall time spent reading the source, s.
+    read_s: f64,
 }
 
 impl Default for SampleWindow {
@@ -155,6 +158,7 @@ impl Default for SampleWindow {
             store: Store::default(),
             end_of_stream: false,
             compact_bytes: COMPACT_BYTES,
+            read_s: 0.0,
         }
     }
 }
@@ -265,6 +269,12 @@ impl SampleWindow {
         self.start + each!(&self.store, b => b.len()) as u64
     }
 
+    /// Wall time spent reading the source so far, s (each read timed on the thread that
+    /// made it, beside the work of [`SampleWindow::fill_during`]).
+    pub fn read_s(&self) -> f64 {
+        self.read_s
+    }
+
     /// Whether the source is exhausted.
     pub fn end_of_stream(&self) -> bool {
         self.end_of_stream
@@ -331,7 +341,7 @@ impl SampleWindow {
                     start,
                     data: Held::slice(held),
                 };
-                rayon::join(|| src.read(room), || work(view))
+                rayon::join(|| timed(|| src.read(room)), || work(view))
             }
             Store::Ci8(b) => {
                 let (held, room) = b.split(n);
@@ -340,7 +350,7 @@ impl SampleWindow {
                     data: Held::slice(held),
                 };
                 rayon::join(
-                    || src.read_integer(IntegerSamplesMut::Ci8(room)),
+                    || timed(|| src.read_integer(IntegerSamplesMut::Ci8(room))),
                     || work(view),
                 )
             }
@@ -351,11 +361,13 @@ impl SampleWindow {
                     data: Held::slice(held),
                 };
                 rayon::join(
-                    || src.read_integer(IntegerSamplesMut::Ci16(room)),
+                    || timed(|| src.read_integer(IntegerSamplesMut::Ci16(room))),
                     || work(view),
                 )
             }
         };
+        let (read, reading) = read;
+        self.read_s += reading.as_secs_f64();
         let (first, got) = read?;
         if got == 0 {
             self.end_of_stream = true;

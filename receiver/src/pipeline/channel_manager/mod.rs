@@ -19,6 +19,7 @@ pub mod realign;
 
 pub use realign::{Realigned, REALIGN_DOPPLER_HZ};
 
+use crate::pipeline::profile::timed;
 use crate::pipeline::ring::SampleView;
 use crate::pipeline::search_schedule::{
     level_config, search_pfa, Batch, Liveness, Scheduler, SearchBudget, Visibility, LEVELS,
@@ -136,6 +137,20 @@ pub struct ChannelManager {
     realign: Option<realign::Realign>,
     /// The engine of code realignment searches; `None` without searches.
     realign_engine: Option<AcquisitionEngine>,
+    /// Time spent in [`ChannelManager::work`] so far.
+    times: WorkTimes,
+}
+
+/// Wall time of the channels' work and of the searches beside it, summed over
+/// [`ChannelManager::work`] calls (see [`crate::pipeline::profile`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct WorkTimes {
+    /// The channels, s.
+    pub tracking_s: f64,
+    /// The searches, s.
+    pub search_s: f64,
+    /// Searches run.
+    pub searches: usize,
 }
 
 impl ChannelManager {
@@ -169,6 +184,7 @@ impl ChannelManager {
             schedule: None,
             realign: None,
             realign_engine,
+            times: WorkTimes::default(),
         })
     }
 
@@ -185,6 +201,7 @@ impl ChannelManager {
             schedule: None,
             realign: None,
             realign_engine: None,
+            times: WorkTimes::default(),
         }
     }
 
@@ -348,10 +365,13 @@ impl ChannelManager {
         let channels = &mut self.channels;
         let reports = &mut self.reports;
         let mut run_all = || {
-            channels
-                .par_iter_mut()
-                .zip(reports.par_iter_mut())
-                .for_each(|(ch, out)| run_channel(ch, window, aid, out));
+            timed(|| {
+                channels
+                    .par_iter_mut()
+                    .zip(reports.par_iter_mut())
+                    .for_each(|(ch, out)| run_channel(ch, window, aid, out));
+            })
+            .1
         };
         let engine = match &search {
             Some(s) if s.realign.is_some() => self.realign_engine.as_ref(),
@@ -365,9 +385,12 @@ impl ChannelManager {
                     let samples = window
                         .get(s.first, s.len)
                         .unwrap_or(gpsrx_dsp::SampleSlice::Cf32(&[]));
-                    engine.search_slice(samples, &s.targets)
+                    timed(|| engine.search_slice(samples, &s.targets))
                 };
-                let (results, ()) = rayon::join(search, run_all);
+                let ((results, searching), tracking) = rayon::join(search, run_all);
+                self.times.tracking_s += tracking.as_secs_f64();
+                self.times.search_s += searching.as_secs_f64();
+                self.times.searches += 1;
                 let results = results
                     .map_err(|e| tracing::warn!("a search failed: {e}"))
                     .ok();
@@ -379,7 +402,7 @@ impl ChannelManager {
                 })
             }
             _ => {
-                run_all();
+                self.times.tracking_s += run_all().as_secs_f64();
                 None
             }
         };
@@ -558,6 +581,11 @@ impl ChannelManager {
         {
             c.restart_bit_sync();
         }
+    }
+
+    /// Time spent in [`ChannelManager::work`] so far.
+    pub fn work_times(&self) -> WorkTimes {
+        self.times
     }
 
     /// The channels, in the order they were started.
