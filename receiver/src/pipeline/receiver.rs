@@ -424,8 +424,10 @@ impl Receiver {
                 self.catch_up(end.saturating_sub(1), sink)?;
             }
         }
-        // Every block: the channels (and a due search) work on the samples held while the next
-        // block is read behind them.
+        // Every block: the channels (and a due search) work on the samples held, on the pool;
+        // then their reports go to the navigation processor while the next block is read
+        // behind them (the channels have two threads; the read hides behind the navigation,
+        // which runs on this thread alone).
         loop {
             let view = self.window.view();
             let (nav, fs) = (&self.nav, self.fs_hz);
@@ -436,15 +438,10 @@ impl Receiver {
             let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
             let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
             let manager = &mut self.manager;
-            let end = self.window.end();
-            let window = &mut self.window;
-            let (got, found) = add_timed(&mut self.stages.rounds_s, || {
-                window.fill_during(source, self.block, |view| manager.work(view, due, aid))
-            })?;
+            let end = view.end();
+            let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
             self.processed_to = Some(end);
-            let window_end = self.window.end();
-            self.timed_deliver(found, window_end, sink)?;
-            if got == 0 {
+            if self.deliver_while_reading(found, source, sink)? == 0 {
                 break;
             }
         }
@@ -615,24 +612,59 @@ impl Receiver {
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
-        let nav = &mut self.nav;
-        let aiding = self.aiding.as_ref();
-        let monitor = &mut self.monitor;
-        let predict = |prn: u8, t: f64| aiding.and_then(|ff| ff.predicted_doppler_hz(prn, t));
-        self.manager
-            .drain_reports(|i, e| {
-                if aiding.is_some() {
-                    monitor.observe(i, e, &predict);
-                }
-                nav.on_report(i, e, aiding, sink)
-            })
-            .map_err(ReceiverError::Sink)?;
-        if let (Some(ff), Some(done)) = (aiding, self.processed_to) {
-            let t_first = self.first_sample.unwrap_or(0) as f64 / self.fs_hz;
-            let t_done = done as f64 / self.fs_hz;
-            monitor.evaluate(t_first, t_done, ff.expected_common_residual_hz(), &predict);
+        self.reports_out().pass(sink)?;
+        self.end_round(found, end, sink)
+    }
+
+    /// [`Receiver::deliver`] while the next block is read: the reports go to the navigation
+    /// processor on this thread while the pool reads (they need no sample), then the rest of
+    /// the round's end with the end of the samples read. Returns the samples read (0 at the
+    /// end of the source).
+    fn deliver_while_reading(
+        &mut self,
+        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        source: &mut dyn SampleSource,
+        sink: &mut dyn Sink,
+    ) -> Result<usize, ReceiverError> {
+        let t0 = std::time::Instant::now();
+        let reports = ReportsOut {
+            nav: &mut self.nav,
+            manager: &mut self.manager,
+            aiding: self.aiding.as_ref(),
+            monitor: &mut self.monitor,
+            span: done_span(self.first_sample, self.processed_to, self.fs_hz),
+        };
+        let (got, passed) = self
+            .window
+            .read_during(source, self.block, || reports.pass(sink))?;
+        passed?;
+        let end = self.window.end();
+        self.end_round(found, end, sink)?;
+        self.stages.navigation_s += t0.elapsed().as_secs_f64();
+        Ok(got)
+    }
+
+    /// The parts of the receiver that take the channels' reports.
+    fn reports_out(&mut self) -> ReportsOut<'_> {
+        ReportsOut {
+            nav: &mut self.nav,
+            manager: &mut self.manager,
+            aiding: self.aiding.as_ref(),
+            monitor: &mut self.monitor,
+            span: done_span(self.first_sample, self.processed_to, self.fs_hz),
         }
-        match nav.end_block(end, sink).map_err(ReceiverError::Sink)? {
+    }
+
+    /// The end of a round after its reports ([`ReportsOut::pass`]): the navigation
+    /// processor's end of block at `end` and what it asks of the channels, new channels for
+    /// what a search found, and the samples no one needs any more dropped.
+    fn end_round(
+        &mut self,
+        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        end: u64,
+        sink: &mut dyn Sink,
+    ) -> Result<(), ReceiverError> {
+        match self.nav.end_block(end, sink).map_err(ReceiverError::Sink)? {
             Some(BlockEvent::PhaseJump(_)) => self.manager.restart_bit_sync(),
             Some(BlockEvent::Collapse(c)) => self.manager.request_realignment(&c),
             None => {}
@@ -677,6 +709,59 @@ impl Receiver {
                 cn0_dbhz: d.cn0_dbhz.unwrap_or(f64::NAN),
             })
             .map_err(ReceiverError::Sink)?;
+        }
+        Ok(())
+    }
+}
+
+/// Stream times (s) of the first sample and of the end of the samples processed, when
+/// both are known.
+fn done_span(
+    first_sample: Option<u64>,
+    processed_to: Option<u64>,
+    fs_hz: f64,
+) -> Option<(f64, f64)> {
+    processed_to.map(|done| {
+        (
+            first_sample.unwrap_or(0) as f64 / fs_hz,
+            done as f64 / fs_hz,
+        )
+    })
+}
+
+/// What takes the reports of a round: the navigation processor, the INS integrity monitor
+/// (with an INS) and the channel manager that holds them.
+struct ReportsOut<'a> {
+    nav: &'a mut NavigationProcessor,
+    manager: &'a mut ChannelManager,
+    aiding: Option<&'a InsFeedForward>,
+    monitor: &'a mut AidMonitor,
+    /// [`done_span`] of the round.
+    span: Option<(f64, f64)>,
+}
+
+impl ReportsOut<'_> {
+    /// The reports of the last round to the navigation processor in stream order (and to the
+    /// integrity monitor, which then evaluates the round, with an INS).
+    fn pass(self, sink: &mut dyn Sink) -> Result<(), ReceiverError> {
+        let Self {
+            nav,
+            manager,
+            aiding,
+            monitor,
+            span,
+        } = self;
+        let predict = |prn: u8, t: f64| aiding.and_then(|ff| ff.predicted_doppler_hz(prn, t));
+        manager
+            .drain_reports(|i, e| {
+                if aiding.is_some() {
+                    monitor.observe(i, e, &predict);
+                }
+                nav.on_report(i, e, aiding, sink)
+            })
+            .map_err(ReceiverError::Sink)?;
+        if let (Some(ff), Some((t_first, t_done))) = (aiding, span) {
+            monitor.evaluate(t_first, t_done, ff.expected_common_residual_hz(), &predict);
         }
         Ok(())
     }
