@@ -5,12 +5,13 @@
 //!
 //! The stages follow the receiver's loop. Serial, on the calling thread, one after the other:
 //! the cold start's search, the parallel rounds, the navigation between rounds and the
-//! completion of the outputs at the end. Within a round three things run side by side on the
-//! rayon pool ([`crate::pipeline::ring::SampleWindow::fill_during`] and
-//! [`crate::pipeline::channel_manager::ChannelManager::work`]): the channels, a due search and
-//! the read of the next block; each is timed from its start to its end on its own, so their
-//! sum can exceed the round's wall time (they overlap) and each includes the time its own
-//! parallel parts waited for a thread.
+//! completion of the outputs at the end. Within a round the channels and a due search run side
+//! by side on the rayon pool ([`crate::pipeline::channel_manager::ChannelManager::work`]);
+//! the next block of the source is read on the pool while the navigation runs
+//! ([`crate::pipeline::ring::SampleWindow::read_during`]; before the cold start, and when the
+//! receiver is pushed samples, there is no such overlap). Each part is timed from its start to
+//! its end on its own, so parts that overlap can add up to more than their stage, and each
+//! includes the time its own parallel parts waited for a thread.
 
 use std::time::{Duration, Instant};
 
@@ -19,7 +20,7 @@ use std::time::{Duration, Instant};
 pub struct StageTimes {
     /// The cold start's search of every wanted PRN, s.
     pub cold_start_s: f64,
-    /// The parallel rounds (channels, a due search and the next read side by side), s.
+    /// The parallel rounds (the channels and a due search side by side), s.
     pub rounds_s: f64,
     /// Within the rounds: the channels' correlations and loops, from start to end of each
     /// round's channel work, s.
@@ -29,11 +30,11 @@ pub struct StageTimes {
     pub search_s: f64,
     /// Searches run in the rounds.
     pub searches: usize,
-    /// Within the rounds: reading the next block of the source (and converting it), s.
+    /// Reading the source (and converting it): beside the navigation, s.
     pub read_s: f64,
     /// Between the rounds: the channels' reports to the navigation processor (observables,
-    /// fixes, rows written to the sink), the channels started by a search, the samples
-    /// dropped, s.
+    /// fixes, rows written to the sink) while the next block is read, the channels started
+    /// by a search, the samples dropped, s.
     pub navigation_s: f64,
     /// At the end: the sink completing its outputs (plots, files), s.
     pub finish_s: f64,

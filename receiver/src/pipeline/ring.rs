@@ -1,7 +1,8 @@
 //! A window of recent samples, addressed by absolute sample index, shared read-only by all
-//! channels while they correlate and refilled from the source between rounds — or during
-//! them: [`SampleWindow::fill_during`] reads the next block into spare room behind the
-//! samples held while the channels work on those.
+//! channels while they correlate and refilled from the source between rounds — or beside
+//! other work: [`SampleWindow::fill_during`] reads the next block into spare room behind the
+//! samples held while the channels work on those, [`SampleWindow::read_during`] while the
+//! calling thread does work that needs no sample (the navigation after a round).
 //!
 //! Memory is bounded: samples older than the slowest channel's next integration are dropped.
 //! Nothing is allocated or zeroed per block in the steady state: the buffer keeps its size and
@@ -271,7 +272,8 @@ impl SampleWindow {
     }
 
     /// Wall time spent reading the source so far, s (each read timed on the thread that
-    /// made it, beside the work of [`SampleWindow::fill_during`]).
+    /// made it, beside the work of [`SampleWindow::fill_during`] or
+    /// [`SampleWindow::read_during`]).
     pub fn read_s(&self) -> f64 {
         self.read_s
     }

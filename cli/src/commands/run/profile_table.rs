@@ -56,7 +56,7 @@ pub fn write_profile(
     row(out, "cold start (search of every PRN)", p.cold_start_s)?;
     row(
         out,
-        "parallel rounds (channels | search | read, side by side)",
+        "parallel rounds (channels | search, side by side)",
         p.rounds_s,
     )?;
     row(out, "  - channels: correlators and loops", p.tracking_s)?;
@@ -65,12 +65,12 @@ pub fn write_profile(
         &format!("  - background search ({} searches)", p.searches),
         p.search_s,
     )?;
-    row(out, "  - reading the recording", p.read_s)?;
     row(
         out,
         "navigation between rounds (observables, fixes, rows)",
         p.navigation_s,
     )?;
+    row(out, "  - reading the next block, beside it", p.read_s)?;
     row(out, "outputs at the end (plots, files)", p.finish_s)?;
     row(
         out,
@@ -79,7 +79,7 @@ pub fn write_profile(
     )?;
     writeln!(
         out,
-        "  (the parts of the rounds overlap: each is timed from its start to its end on its own thread)"
+        "  (parts run side by side: each is timed from its start to its end on its own thread)"
     )
 }
 
