@@ -123,9 +123,12 @@ impl AcquisitionEngine {
                 let shift = (ideal - l.block_start_sample(ms) as f64) - ideal * f_hz / F_L1_HZ;
                 let rs = ((shift / l.lag_samples).round() as i64).rem_euclid(m as i64) as usize;
                 let first = lags.min(m - rs);
-                let (head, tail) = grid_row.split_at_mut(first);
-                add_power(head, &buf[rs..rs + first], power_scale);
-                add_power(tail, &buf[..lags - first], power_scale);
+                for (g, y) in grid_row[..first].iter_mut().zip(&buf[rs..rs + first]) {
+                    *g += power_scale * y.norm_sqr();
+                }
+                for (g, y) in grid_row[first..].iter_mut().zip(&buf[..lags - first]) {
+                    *g += power_scale * y.norm_sqr();
+                }
             }
         }
     }
@@ -247,39 +250,6 @@ unsafe fn mul_avx2(dst: &mut [Complex32], a: &[[i16; 2]], b: &[Complex32]) {
     }
 }
 
-/// `grid[t] += scale |y[t]|^2` over the shorter of the two: the non-coherent sum of a grid
-/// row. Compiled a second time for AVX2 + FMA, taken when the CPU has them (eight lanes
-/// instead of SSE2's four; the same products and sums in the same order, so the same
-/// values).
-fn add_power(grid: &mut [f32], y: &[Complex32], scale: f32) {
-    #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-        // SAFETY: the CPU supports AVX2 and FMA (checked above).
-        unsafe { add_power_avx2(grid, y, scale) };
-        return;
-    }
-    add_power_portable(grid, y, scale);
-}
-
-/// [`add_power`] with AVX2 and FMA.
-///
-/// # Safety
-/// The CPU must support AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn add_power_avx2(grid: &mut [f32], y: &[Complex32], scale: f32) {
-    add_power_portable(grid, y, scale);
-}
-
-/// The body of [`add_power`], inlined into each compiled version (`|y|^2 = re^2 + im^2`, as
-/// `Complex32::norm_sqr`).
-#[inline(always)]
-fn add_power_portable(grid: &mut [f32], y: &[Complex32], scale: f32) {
-    for (g, y) in grid.iter_mut().zip(y) {
-        *g += scale * (y.re * y.re + y.im * y.im);
-    }
-}
-
 /// A stored integer pair as complex f32.
 #[inline(always)]
 fn widen([re, im]: [i16; 2]) -> Complex32 {
@@ -303,24 +273,6 @@ fn mul_rotated_portable(dst: &mut [Complex32], src: &[[i16; 2]], start: usize, r
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn power_sums_match_the_scalar_norm_exactly() {
-        // Every length up to three vector steps (tails included), grids longer than the
-        // correlations: the compiled versions against `norm_sqr`, bit for bit.
-        let y: Vec<Complex32> = (0..27)
-            .map(|k| Complex32::new((k as f32 * 0.731).sin() * 1e3, -(k as f32 * 1.37).cos()))
-            .collect();
-        for len in 0..=y.len() {
-            let mut grid: Vec<f32> = (0..len + 3).map(|k| k as f32 * 0.25).collect();
-            let mut want = grid.clone();
-            add_power(&mut grid, &y[..len], 0.37);
-            for (g, c) in want.iter_mut().zip(&y[..len]) {
-                *g += 0.37 * c.norm_sqr();
-            }
-            assert_eq!(grid, want, "len {len}");
-        }
-    }
 
     #[test]
     fn rotated_products_of_stored_integers_match_the_portable_loop() {
