@@ -559,3 +559,62 @@ fn an_approximate_time_and_position_give_the_first_fix_within_two_seconds() {
         assert!(worst < 10.0, "{name}: a fix {worst:.2} m off");
     }
 }
+
+#[test]
+fn the_profile_accounts_for_the_run_stage_by_stage() {
+    // 3 s at 2.048 MHz: the cold start, rounds with background searches (their deep levels
+    // from 0.5 s on), the navigation and the outputs; no fix is needed.
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let data = simulate(STATIC_BUSAN, 3.0, dir.path());
+    let out = dir.path().join("out");
+    let (report, _) = crate::common::run_report(&data, &out, &["--no-plots"]);
+    let s = &report.receiver;
+    let p = &s.profile;
+    assert!(p.cold_start_s > 0.0 && p.rounds_s > 0.0, "{p:?}");
+    assert!(
+        p.tracking_s > 0.0 && p.navigation_s > 0.0 && p.read_s > 0.0,
+        "{p:?}"
+    );
+    assert!(p.searches >= 1 && p.search_s > 0.0, "{p:?}");
+    // The parts of the rounds lie within them (each timed inside its round), and the serial
+    // stages within the run's wall time.
+    assert!(p.tracking_s <= p.rounds_s + 1e-3, "{p:?}");
+    assert!(p.search_s <= p.rounds_s + 1e-3, "{p:?}");
+    assert!(
+        p.accounted_s() <= s.wall_s + 1e-3,
+        "{p:?} in {} s",
+        s.wall_s
+    );
+    assert!(p.accounted_s() >= 0.5 * s.wall_s, "{p:?} in {} s", s.wall_s);
+    // The table names every stage.
+    let mut text = Vec::new();
+    gpsrx_cli::commands::run::profile_table::write_profile(
+        &mut text,
+        p,
+        s.duration_s,
+        s.wall_s,
+        gpsrx_cli::commands::run::profile_table::process_usage(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let text = String::from_utf8(text).unwrap_or_else(|e| panic!("{e}"));
+    for stage in [
+        "cold start",
+        "channels",
+        "background search",
+        "navigation",
+        "reading",
+    ] {
+        assert!(text.contains(stage), "{stage} missing:\n{text}");
+    }
+    // And `--profile` is an option of `gpsrx run`.
+    let cli = <gpsrx_cli::cli::Cli as clap::Parser>::try_parse_from([
+        "gpsrx",
+        "run",
+        "x.ci8",
+        "--out",
+        "o",
+        "--profile",
+    ])
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(matches!(cli.command, gpsrx_cli::cli::Command::Run(a) if a.profile));
+}

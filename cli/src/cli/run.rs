@@ -41,6 +41,11 @@ pub struct RunArgs {
     /// the output directory (config file: `plots = false` in `[run]`).
     #[arg(long)]
     pub no_plots: bool,
+    /// After the summary, print where the run's wall time went, stage by stage (cold start,
+    /// channels, background search, reading, navigation, outputs), with the process's CPU
+    /// time and peak memory (with --json the stage times are in the summary's `profile`).
+    #[arg(long)]
+    pub profile: bool,
     /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
     #[arg(long, value_name = "FILE")]
     pub nav: Option<PathBuf>,

@@ -52,6 +52,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         json: false,
         // The plots only when the files are kept.
         no_plots: args.keep.is_none(),
+        profile: false,
         nav: None,
         iono: Some(IonoModel::Klobuchar),
         tropo: Some(TropoModel::Saastamoinen),

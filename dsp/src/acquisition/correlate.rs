@@ -83,7 +83,7 @@ impl AcquisitionEngine {
         let rows = (b1 - b0 + 1) as usize;
         s.grid.clear();
         s.grid.resize(rows * lags, 0.0);
-        let replica = &self.replicas[prn.index()];
+        let replica = &self.replicas.spectra[prn.index()];
         let starts = &l.block_start_ms[pass];
         // Rows in the order of the spectrum slices they read (fractional offset q, residue r):
         // the rows of one slice set (every Q D-th bin: 10 of 201 with 10 ms blocks) follow
@@ -152,7 +152,7 @@ impl AcquisitionEngine {
         let (mut all, mut kept) = (0.0f64, 0.0f64);
         for b in 0..l.block_start_ms.first().map_or(0, Vec::len) {
             let (src, scale) = spectra.slice((b * q_total + q) * d + r);
-            for (j, w) in self.replica_power.iter().enumerate() {
+            for (j, w) in self.replicas.power.iter().enumerate() {
                 let [re, im] = src[(j + a) % sl].map(f32::from);
                 let p = f64::from((re * re + im * im) * scale * scale * w);
                 all += p;

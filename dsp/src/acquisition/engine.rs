@@ -4,7 +4,7 @@
 use super::config::{AcqConfig, AcqError, Layout};
 use super::detect::{analyse, mark_cross_correlations, triangle_offset, Peak};
 use super::refine::{amplitude, cn0_dbhz, correlate_periods, fine_doppler};
-use super::replica::{fractional_wipeoffs, replica_spectra};
+use super::replica::{fractional_wipeoffs, replica_spectra, ReplicaSet};
 use super::spectra::Spectra;
 use super::stats::detection_threshold;
 use super::{AcqGrid, AcqResult, SearchTarget};
@@ -29,6 +29,8 @@ pub(super) struct Scratch {
     /// One decimated slice of a block spectrum, before it is stored.
     pub(super) slice: Vec<Complex32>,
     epl: [Vec<Complex64>; 3],
+    /// One code period of the refinement's samples, as f32 (when held as integers).
+    period: Vec<Complex32>,
     fine: Vec<Complex32>,
     floors: Vec<f64>,
 }
@@ -58,14 +60,13 @@ pub struct AcquisitionEngine {
     pub(super) inv: Arc<dyn Fft<f32>>,
     pub(super) fine: Arc<dyn Fft<f32>>,
     pub(super) fine_len: usize,
-    pub(super) replicas: Vec<Vec<Complex32>>,
-    /// Mean `|C[k]|^2` of the 32 replicas over the whole block spectrum (`spec_len` bins).
-    pub(super) replica_power: Vec<f32>,
+    /// The replica spectra and their mean power (shared with other engines of the same
+    /// layout: [`AcquisitionEngine::sharing_replicas_with`]).
+    pub(super) replicas: Arc<ReplicaSet>,
     pub(super) correlator: Correlator,
     pub(super) packed: Vec<PackedCode>,
     pub(super) wipeoffs: Vec<Vec<Complex32>>,
     pub(super) scratch_pool: Mutex<Vec<Scratch>>,
-    pub(super) spectra_pool: Mutex<Vec<Spectra>>,
 }
 
 impl fmt::Debug for AcquisitionEngine {
@@ -93,7 +94,7 @@ impl AcquisitionEngine {
         let fine_len = (8 * config.refine_ms as usize).next_power_of_two().max(256);
         let fine = planner.plan_fft_forward(fine_len);
         let fwd_replica = planner.plan_fft_forward(layout.replica_len);
-        let (replicas, replica_power) = replica_spectra(&layout, fs_hz, &fwd_replica);
+        let replicas = Arc::new(replica_spectra(&layout, fs_hz, &fwd_replica));
         let wipeoffs = fractional_wipeoffs(&layout);
         Ok(Self {
             fs_hz,
@@ -104,15 +105,30 @@ impl AcquisitionEngine {
             fine,
             fine_len,
             replicas,
-            replica_power,
             correlator: Correlator::best(),
             packed: Prn::all()
                 .map(|p| PackedCode::new(CaCode::new(p).chips()))
                 .collect(),
             wipeoffs,
             scratch_pool: Mutex::new(Vec::new()),
-            spectra_pool: Mutex::new(Vec::new()),
         })
+    }
+
+    /// This engine holding the replica spectra of `other` instead of its own when they are the
+    /// same (the same rate and search length, and a whole number of samples per code period
+    /// or the same coherent integration: every level of a background search at 4 MHz), so
+    /// engines kept side by side hold one copy (32 x `inv_len` complex values: 1 MB at 4 MHz
+    /// per engine). Otherwise unchanged.
+    pub fn sharing_replicas_with(mut self, other: &AcquisitionEngine) -> Self {
+        if other.replicas.fits(&self.layout, self.fs_hz) {
+            self.replicas = Arc::clone(&other.replicas);
+        }
+        self
+    }
+
+    /// Whether this engine and `other` hold the same replica spectra (one copy).
+    pub fn shares_replicas_with(&self, other: &AcquisitionEngine) -> bool {
+        Arc::ptr_eq(&self.replicas, &other.replicas)
     }
 
     /// The settings.
@@ -192,17 +208,15 @@ impl AcquisitionEngine {
         result
     }
 
-    /// Frees the scratch and spectra the pools keep between searches.
+    /// Frees the scratch the pool keeps between searches.
     pub fn release_memory(&self) {
         if let Ok(mut p) = self.scratch_pool.lock() {
             *p = Vec::new();
         }
-        if let Ok(mut p) = self.spectra_pool.lock() {
-            *p = Vec::new();
-        }
     }
 
-    /// The body of [`AcquisitionEngine::search_slice`] (the pools stay warm).
+    /// The body of [`AcquisitionEngine::search_slice`] (the scratch pool stays warm; the
+    /// block spectra live only while the passes need them).
     fn search_held(
         &self,
         samples: SampleSlice<'_>,
@@ -221,12 +235,7 @@ impl AcquisitionEngine {
         // One pass's spectra at a time (half the memory of keeping both): each target keeps
         // its best pass.
         let mut best: Vec<Option<PassPeak>> = vec![None; targets.len()];
-        let mut spectra = self
-            .spectra_pool
-            .lock()
-            .ok()
-            .and_then(|mut p| p.pop())
-            .unwrap_or_default();
+        let mut spectra = Spectra::default();
         for pass in 0..self.layout.block_start_ms.len() {
             self.block_spectra(samples, pass, &mut spectra);
             best.par_iter_mut()
@@ -245,23 +254,14 @@ impl AcquisitionEngine {
                     self.give_scratch(s);
                 });
         }
-        if let Ok(mut pool) = self.spectra_pool.lock() {
-            pool.push(spectra);
-        }
+        // The spectra are not needed any more: released before the refinement (they are
+        // the largest part of a search's memory).
+        drop(spectra);
         // The refinement's prompts: `refine_ms` code periods from the code phase (less than
-        // a period in), as f32.
+        // a period in), read where they are held (converted period by period).
         let refine_len =
             ((f64::from(self.config.refine_ms) + 2.0) * self.layout.period_samples).ceil() as usize;
-        let any_detected = best
-            .iter()
-            .zip(&thresholds)
-            .any(|(k, &th)| k.as_ref().is_some_and(|k| k.peak.metric >= th));
-        let refine_samples = if any_detected {
-            super::input::head_cf32(samples, refine_len)
-        } else {
-            std::borrow::Cow::Borrowed(&[][..])
-        };
-        let samples: &[Complex32] = &refine_samples;
+        let samples = head(samples, refine_len);
         let mut results: Vec<AcqResult> = targets
             .par_iter()
             .zip(best.par_iter())
@@ -416,7 +416,7 @@ impl AcquisitionEngine {
     /// The result of `prn` from its best pass: detected when over `threshold`, then refined.
     fn decide(
         &self,
-        samples: &[Complex32],
+        samples: SampleSlice<'_>,
         prn: Prn,
         b0: i64,
         kept: &PassPeak,
@@ -457,7 +457,7 @@ impl AcquisitionEngine {
     /// keeps the whole spectrum; see [`Self::band_noise_ratio`]).
     fn refine(
         &self,
-        samples: &[Complex32],
+        samples: SampleSlice<'_>,
         peak: &Peak,
         band: f64,
         r: &mut AcqResult,
@@ -477,6 +477,7 @@ impl AcquisitionEngine {
         let tau = r.code_phase_samples;
         correlate_periods(
             samples,
+            &mut s.period,
             &self.correlator,
             code,
             fs,
@@ -494,6 +495,7 @@ impl AcquisitionEngine {
         let d = 0.5 * fs / CA_CHIP_RATE_HZ;
         correlate_periods(
             samples,
+            &mut s.period,
             &self.correlator,
             code,
             fs,
@@ -519,5 +521,15 @@ impl AcquisitionEngine {
             let snr = peak.metric - 1.0;
             (snr > 0.0).then(|| 10.0 * (snr / self.coherent_s()).log10())
         });
+    }
+}
+
+/// The first `len` samples of `samples` (all of them when fewer), as held.
+fn head(samples: SampleSlice<'_>, len: usize) -> SampleSlice<'_> {
+    let n = len.min(samples.len());
+    match samples {
+        SampleSlice::Cf32(x) => SampleSlice::Cf32(&x[..n]),
+        SampleSlice::Ci16(x) => SampleSlice::Ci16(&x[..n]),
+        SampleSlice::Ci8(x) => SampleSlice::Ci8(&x[..n]),
     }
 }

@@ -4,7 +4,6 @@
 
 use crate::correlator::SampleSlice;
 use num_complex::Complex32;
-use std::borrow::Cow;
 
 /// Writes samples `from..from + out.len()` of `src` into `out` as complex f32 (integers are
 /// exact in f32). Panics if the range is outside `src` (the engine checks lengths first).
@@ -25,16 +24,23 @@ pub(super) fn copy_cf32(src: SampleSlice<'_>, from: usize, out: &mut [Complex32]
     }
 }
 
-/// The first `len` samples of `src` (at most all of them) as complex f32: borrowed when
-/// held so, else converted.
-pub(super) fn head_cf32<'a>(src: SampleSlice<'a>, len: usize) -> Cow<'a, [Complex32]> {
-    let len = len.min(src.len());
+/// Samples `from..to` of `src` as complex f32: borrowed when held so, else converted into
+/// `buf` (one code period at a time in the refinement, so a search never holds an f32 copy
+/// of its refinement's samples either: 102 ms at 4 MHz would be 3.3 MB). Panics if the range
+/// is outside `src` (callers check lengths first).
+pub(super) fn span_cf32<'a>(
+    src: SampleSlice<'a>,
+    from: usize,
+    to: usize,
+    buf: &'a mut Vec<Complex32>,
+) -> &'a [Complex32] {
     match src {
-        SampleSlice::Cf32(x) => Cow::Borrowed(&x[..len]),
+        SampleSlice::Cf32(x) => &x[from..to],
         _ => {
-            let mut out = vec![Complex32::new(0.0, 0.0); len];
-            copy_cf32(src, 0, &mut out);
-            Cow::Owned(out)
+            buf.clear();
+            buf.resize(to - from, Complex32::new(0.0, 0.0));
+            copy_cf32(src, from, buf);
+            buf
         }
     }
 }
@@ -52,13 +58,17 @@ mod tests {
             out,
             [Complex32::new(127.0, -128.0), Complex32::new(0.0, 5.0)]
         );
-        let ci16 = [[-32768i16, 32767], [3, 4]];
-        let h = head_cf32(SampleSlice::Ci16(&ci16), 5);
+        let ci16 = [[7i16, 7], [-32768, 32767], [3, 4]];
+        let mut buf = Vec::new();
+        let h = span_cf32(SampleSlice::Ci16(&ci16), 1, 3, &mut buf);
         assert_eq!(
-            &*h,
+            h,
             &[Complex32::new(-32768.0, 32767.0), Complex32::new(3.0, 4.0)]
         );
         let f = [Complex32::new(0.5, -0.25); 3];
-        assert!(matches!(head_cf32(SampleSlice::Cf32(&f), 2), Cow::Borrowed(s) if s.len() == 2));
+        let mut unused = Vec::new();
+        let b = span_cf32(SampleSlice::Cf32(&f), 1, 3, &mut unused);
+        assert_eq!(b.as_ptr(), f[1..].as_ptr());
+        assert!(unused.is_empty());
     }
 }

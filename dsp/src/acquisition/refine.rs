@@ -23,9 +23,12 @@ use std::sync::Arc;
 /// Each period is one call of the tracking loops' block correlator (`correlator`: SIMD where the
 /// CPU has it, f32 arithmetic, the carrier seeded exactly in f64 at the first sample of every
 /// period and the code from a 2^-32-chip NCO), so the cost per sample is the same at any rate.
+///
+/// `samples` are read as held (integers are converted one period at a time into `buf`).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn correlate_periods(
-    samples: &[Complex32],
+    samples: SampleSlice<'_>,
+    buf: &mut Vec<Complex32>,
     correlator: &Correlator,
     code: &PackedCode,
     fs_hz: f64,
@@ -35,8 +38,9 @@ pub(crate) fn correlate_periods(
     offsets_samples: &[f64],
     out: &mut [Vec<Complex64>],
 ) {
-    correlate_periods_code_doppler(
+    correlate_held_periods(
         samples,
+        buf,
         correlator,
         code,
         fs_hz,
@@ -55,6 +59,36 @@ pub(crate) fn correlate_periods(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn correlate_periods_code_doppler(
     samples: &[Complex32],
+    correlator: &Correlator,
+    code: &PackedCode,
+    fs_hz: f64,
+    code_phase_samples: f64,
+    dopplers_hz: (f64, f64),
+    k_max: usize,
+    offsets_samples: &[f64],
+    out: &mut [Vec<Complex64>],
+) {
+    correlate_held_periods(
+        SampleSlice::Cf32(samples),
+        &mut Vec::new(),
+        correlator,
+        code,
+        fs_hz,
+        code_phase_samples,
+        dopplers_hz,
+        k_max,
+        offsets_samples,
+        out,
+    );
+}
+
+/// [`correlate_periods_code_doppler`] of samples as held: each period is read in place when
+/// held as complex f32, else converted into `buf` first (the same f32 values, so the same
+/// correlations).
+#[allow(clippy::too_many_arguments)]
+fn correlate_held_periods(
+    samples: SampleSlice<'_>,
+    buf: &mut Vec<Complex32>,
     correlator: &Correlator,
     code: &PackedCode,
     fs_hz: f64,
@@ -92,8 +126,9 @@ pub(crate) fn correlate_periods_code_doppler(
             carrier_freq_hz: doppler_hz,
             carrier_rate_hz_s: 0.0,
         };
+        let held = super::input::span_cf32(samples, n0, n1, buf);
         correlator.correlate_packed(
-            SampleSlice::Cf32(&samples[n0..n1]),
+            SampleSlice::Cf32(held),
             fs_hz,
             code,
             &state,

@@ -28,11 +28,7 @@ use std::sync::Arc;
 /// start, the `keep_neg` lowest negative ones at the end, zeros between (when `inv_len` exceeds
 /// the spectrum). The scale stays `1/spec_len`, so an `inv_len`-point inverse FFT gives the
 /// band-limited correlation at lags `m * spec_len / inv_len` input samples.
-pub(crate) fn replica_spectra(
-    layout: &Layout,
-    fs_hz: f64,
-    fft: &Arc<dyn Fft<f32>>,
-) -> (Vec<Vec<Complex32>>, Vec<f32>) {
+pub(crate) fn replica_spectra(layout: &Layout, fs_hz: f64, fft: &Arc<dyn Fft<f32>>) -> ReplicaSet {
     let n = layout.spec_len;
     let len = layout.replica_len;
     let d = if len == n { 1 } else { layout.decimation };
@@ -43,7 +39,7 @@ pub(crate) fn replica_spectra(
     let mut scratch = vec![Complex32::new(0.0, 0.0); fft.get_inplace_scratch_len()];
     let mut mean_power = vec![0.0f32; n];
     let scale = 1.0 / len as f32;
-    let replicas = Prn::all()
+    let spectra = Prn::all()
         .map(|prn| {
             CaCode::new(prn).sample(fs_hz, CA_CHIP_RATE_HZ, 0.0, &mut chips);
             for (s, &c) in spec.iter_mut().zip(&chips) {
@@ -64,7 +60,63 @@ pub(crate) fn replica_spectra(
             out
         })
         .collect();
-    (replicas, mean_power)
+    ReplicaSet {
+        spectra,
+        power: mean_power,
+        key: ReplicaKey::of(layout, fs_hz),
+    }
+}
+
+/// The replica spectra of the 32 PRNs in one search layout ([`replica_spectra`]), shared by
+/// the engines whose layouts give the same ones ([`ReplicaKey`]).
+#[derive(Debug)]
+pub(crate) struct ReplicaSet {
+    /// Per PRN (index 0 = PRN 1), `inv_len` bins.
+    pub(crate) spectra: Vec<Vec<Complex32>>,
+    /// Mean `|C[k]|^2` of the 32 replicas over the whole block spectrum (`spec_len` bins).
+    pub(crate) power: Vec<f32>,
+    key: ReplicaKey,
+}
+
+impl ReplicaSet {
+    /// Whether `layout` at `fs_hz` has these replica spectra.
+    pub(crate) fn fits(&self, layout: &Layout, fs_hz: f64) -> bool {
+        self.key == ReplicaKey::of(layout, fs_hz)
+    }
+}
+
+/// What the replica spectra of a layout depend on: the rate, the decimated spectrum and
+/// replica lengths (with the decimation when the replica spans the whole block), and the
+/// search length with its kept bins. The coherent integration, the blocks and the Doppler
+/// range do not enter when a code period is a whole number of samples, so every level of a
+/// background search at such a rate has the same replicas.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ReplicaKey {
+    fs_hz: f64,
+    spec_len: usize,
+    replica_len: usize,
+    decimation: usize,
+    inv_len: usize,
+    keep_pos: usize,
+    keep_neg: usize,
+}
+
+impl ReplicaKey {
+    fn of(layout: &Layout, fs_hz: f64) -> Self {
+        Self {
+            fs_hz,
+            spec_len: layout.spec_len,
+            replica_len: layout.replica_len,
+            decimation: if layout.replica_len == layout.spec_len {
+                1
+            } else {
+                layout.decimation
+            },
+            inv_len: layout.inv_len,
+            keep_pos: layout.keep_pos,
+            keep_neg: layout.keep_neg,
+        }
+    }
 }
 
 /// `exp(-j 2 pi q n / (Q N))` for `n` in the block, one vector per fractional Doppler offset

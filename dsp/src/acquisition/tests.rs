@@ -677,3 +677,121 @@ fn false_alarm_rate_matches_pfa_at_three_rates() {
         assert!((over01 as f64) < 2.0 * e01, "fs {fs}: {over01} vs {e01}");
     }
 }
+
+/// `x` scaled by `gain` and rounded to 8-bit integers (clipped), as a ci8 recording holds it,
+/// and the same integers as complex f32.
+fn as_ci8(x: &[Complex32], gain: f32) -> (Vec<[i8; 2]>, Vec<Complex32>) {
+    let q = |v: f32| (v * gain).round().clamp(-128.0, 127.0) as i8;
+    let ints: Vec<[i8; 2]> = x.iter().map(|c| [q(c.re), q(c.im)]).collect();
+    let floats = ints
+        .iter()
+        .map(|&[i, q]| Complex32::new(f32::from(i), f32::from(q)))
+        .collect();
+    (ints, floats)
+}
+
+#[test]
+fn searches_of_held_integers_equal_searches_of_their_f32_values() {
+    // A detection's refinement reads its prompts period by period from the integers (no f32
+    // copy of its 102 ms): the same f32 values, so the very same results, detections and
+    // refined Doppler, code phase and C/N0 included. 1 ms x 10 and 10 ms x 13 at 4 MHz.
+    let fs = 4.0e6;
+    for (coherent_ms, noncoherent) in [(1u32, 10u32), (10, 13)] {
+        let e = engine(
+            fs,
+            AcqConfig {
+                coherent_ms,
+                noncoherent,
+                bit_edge_offsets: Some(false),
+                ..AcqConfig::default()
+            },
+        );
+        let sigs = [
+            Sig {
+                prn: 3,
+                tau: 1234.4,
+                doppler_hz: -2_210.0,
+                cn0_dbhz: 44.0,
+            },
+            Sig {
+                prn: 17,
+                tau: 377.8,
+                doppler_hz: 1_480.0,
+                cn0_dbhz: 38.0,
+            },
+        ];
+        let x = synth(fs, e.samples_wanted(), &sigs, 21);
+        let (ints, floats) = as_ci8(&x, 20.0);
+        let targets = [
+            SearchTarget::full(prn(3)),
+            SearchTarget::full(prn(17)),
+            SearchTarget::full(prn(9)),
+        ];
+        let held = e
+            .search_slice(crate::correlator::SampleSlice::Ci8(&ints), &targets)
+            .unwrap_or_else(|err| panic!("{err}"));
+        let f32s = e
+            .search(&floats, &targets)
+            .unwrap_or_else(|err| panic!("{err}"));
+        assert_eq!(held, f32s, "{coherent_ms} ms x {noncoherent}");
+        assert!(
+            held[0].detected && held[1].detected && !held[2].detected,
+            "{held:?}"
+        );
+        assert!(
+            held[0].refine_ms > 90 && held[0].cn0_dbhz.is_some(),
+            "{held:?}"
+        );
+    }
+}
+
+#[test]
+fn engines_of_one_rate_share_their_replica_spectra() {
+    // At 4 MHz (4000 samples per code period) the replicas do not depend on the coherent
+    // integration: every level of the background search holds one copy, and searches alike.
+    let fs = 4.0e6;
+    let base = engine(fs, AcqConfig::default());
+    let long = AcqConfig {
+        coherent_ms: 10,
+        noncoherent: 13,
+        bit_edge_offsets: Some(false),
+        ..AcqConfig::default()
+    };
+    let shared = engine(fs, long.clone()).sharing_replicas_with(&base);
+    let own = engine(fs, long.clone());
+    assert!(shared.shares_replicas_with(&base));
+    assert!(!own.shares_replicas_with(&base));
+    let sig = Sig {
+        prn: 22,
+        tau: 2_001.3,
+        doppler_hz: 3_020.0,
+        cn0_dbhz: 34.0,
+    };
+    let x = synth(fs, own.samples_wanted(), std::slice::from_ref(&sig), 33);
+    let targets = [SearchTarget::full(prn(22)), SearchTarget::full(prn(5))];
+    let a = shared
+        .search(&x, &targets)
+        .unwrap_or_else(|err| panic!("{err}"));
+    let b = own
+        .search(&x, &targets)
+        .unwrap_or_else(|err| panic!("{err}"));
+    assert_eq!(a, b);
+    assert!(a[0].detected && !a[1].detected, "{a:?}");
+    // Another rate, or a code period that is not a whole number of samples with another
+    // coherent integration (the replica spans the block): no sharing.
+    let other_rate = engine(2.6e6, long.clone()).sharing_replicas_with(&base);
+    assert!(!other_rate.shares_replicas_with(&base));
+    let fs_frac = 16.3676e6;
+    let base_frac = engine(fs_frac, AcqConfig::default());
+    let long_frac = engine(fs_frac, long.clone()).sharing_replicas_with(&base_frac);
+    assert!(!long_frac.shares_replicas_with(&base_frac));
+    let long_frac_more = engine(
+        fs_frac,
+        AcqConfig {
+            noncoherent: 50,
+            ..long
+        },
+    )
+    .sharing_replicas_with(&long_frac);
+    assert!(long_frac_more.shares_replicas_with(&long_frac));
+}

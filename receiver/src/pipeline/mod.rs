@@ -20,7 +20,8 @@
 //! - [`quick_sync`]: frame sync from one TLM and HOW, confirmed across satellites;
 //! - [`sv_time`]: SV times kept across losses of the signal and lost samples;
 //! - [`observables`]: pseudoranges, carrier phase, Doppler at common receiver epochs;
-//! - [`tracker`]: channels alone over a stream (loop studies).
+//! - [`tracker`]: channels alone over a stream (loop studies);
+//! - [`profile`]: where a run's time goes, stage by stage.
 
 pub mod aid_monitor;
 pub mod aiding;
@@ -36,6 +37,7 @@ pub(crate) mod long_gap;
 pub mod navdata;
 pub mod navigation;
 pub mod observables;
+pub mod profile;
 pub mod quick_sync;
 pub mod receiver;
 pub mod ring;
@@ -50,6 +52,7 @@ pub mod visibility;
 
 pub use channel_manager::SearchSettings;
 pub use dating::{WeekReference, WeekSource};
+pub use profile::StageTimes;
 pub use receiver::{
     Assistance, AssistanceError, AssistanceFiles, InsAiding, InsAidingSummary, Receiver,
     ReceiverError, RunSummary,

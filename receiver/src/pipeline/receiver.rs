@@ -14,6 +14,7 @@ use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
 use crate::pipeline::dating::WeekReference;
 use crate::pipeline::navigation::{BlockEvent, NavigationProcessor};
+use crate::pipeline::profile::{add_timed, StageTimes};
 use crate::pipeline::ring::{block_samples, SampleWindow};
 use crate::pipeline::search_schedule::SearchBudget;
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
@@ -206,6 +207,8 @@ pub struct RunSummary {
     /// With `--ins`: how much of the recording was aided, and how often the INS was rejected
     /// for disagreeing with the tracked Doppler ([`crate::pipeline::aid_monitor`]).
     pub ins_aiding: Option<InsAidingSummary>,
+    /// Where the wall time went, stage by stage ([`crate::pipeline::profile`]).
+    pub profile: StageTimes,
 }
 
 /// The INS aiding over a run.
@@ -252,6 +255,9 @@ pub struct Receiver {
     /// Index of the first sample of the stream.
     first_sample: Option<u64>,
     started: std::time::Instant,
+    /// The serial stages' wall time so far (the rounds' parts come from the window and the
+    /// channel manager).
+    stages: StageTimes,
     finished: bool,
     non_finite_said: bool,
 }
@@ -351,6 +357,7 @@ impl Receiver {
             processed_to: None,
             first_sample: None,
             started: std::time::Instant::now(),
+            stages: StageTimes::default(),
             finished: false,
             non_finite_said: false,
         })
@@ -424,8 +431,10 @@ impl Receiver {
                 self.catch_up(end.saturating_sub(1), sink)?;
             }
         }
-        // Every block: the channels (and a due search) work on the samples held while the next
-        // block is read behind them.
+        // Every block: the channels (and a due search) work on the samples held, on the pool;
+        // then their reports go to the navigation processor while the next block is read
+        // behind them (the channels have two threads; the read hides behind the navigation,
+        // which runs on this thread alone).
         loop {
             let view = self.window.view();
             let (nav, fs) = (&self.nav, self.fs_hz);
@@ -436,14 +445,10 @@ impl Receiver {
             let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
             let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
             let manager = &mut self.manager;
-            let end = self.window.end();
-            let (got, found) = self
-                .window
-                .fill_during(source, self.block, |view| manager.work(view, due, aid))?;
+            let end = view.end();
+            let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
             self.processed_to = Some(end);
-            let window_end = self.window.end();
-            self.deliver(found, window_end, sink)?;
-            if got == 0 {
+            if self.deliver_while_reading(found, source, sink)? == 0 {
                 break;
             }
         }
@@ -506,7 +511,9 @@ impl Receiver {
             if self.processed_to.is_some_and(|done| done < end) {
                 self.step(end, sink)?;
             }
-            sink.finish(&self.nav.end()).map_err(ReceiverError::Sink)?;
+            let nav_end = self.nav.end();
+            add_timed(&mut self.stages.finish_s, || sink.finish(&nav_end))
+                .map_err(ReceiverError::Sink)?;
             self.finished = true;
         }
         let stats = self.nav.stats();
@@ -526,7 +533,20 @@ impl Receiver {
                 .aiding
                 .as_ref()
                 .map(|_| InsAidingSummary::new(self.monitor.stats(), duration_s)),
+            profile: self.profile(),
         })
+    }
+
+    /// Where the wall time went so far ([`crate::pipeline::profile`]).
+    pub fn profile(&self) -> StageTimes {
+        let work = self.manager.work_times();
+        StageTimes {
+            tracking_s: work.tracking_s,
+            search_s: work.search_s,
+            searches: work.searches,
+            read_s: self.window.read_s(),
+            ..self.stages
+        }
     }
 
     /// Samples the cold start wants.
@@ -539,7 +559,10 @@ impl Receiver {
         let first = self.window.start();
         let n = (self.window.end() - first).min(self.cold_samples()) as usize;
         let samples = self.window.get_cf32(first, n).unwrap_or_default();
-        let found = self.manager.cold_start(&samples, first)?;
+        let manager = &mut self.manager;
+        let found = add_timed(&mut self.stages.cold_start_s, || {
+            manager.cold_start(&samples, first)
+        })?;
         self.processed_to = Some(first);
         self.announce(&found, first, sink)
     }
@@ -568,9 +591,23 @@ impl Receiver {
             .due_search(view, &|p| nav.visibility(p.get(), t_s));
         let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
         let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
-        let found = self.manager.work(view, due, aid);
+        let manager = &mut self.manager;
+        let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
         self.processed_to = Some(limit);
-        self.deliver(found, limit, sink)
+        self.timed_deliver(found, limit, sink)
+    }
+
+    /// [`Receiver::deliver`], its wall time added to the navigation stage.
+    fn timed_deliver(
+        &mut self,
+        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        end: u64,
+        sink: &mut dyn Sink,
+    ) -> Result<(), ReceiverError> {
+        let t0 = std::time::Instant::now();
+        let r = self.deliver(found, end, sink);
+        self.stages.navigation_s += t0.elapsed().as_secs_f64();
+        r
     }
 
     /// After a round: the reports to the navigation processor, new channels for what a search
@@ -582,24 +619,59 @@ impl Receiver {
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
-        let nav = &mut self.nav;
-        let aiding = self.aiding.as_ref();
-        let monitor = &mut self.monitor;
-        let predict = |prn: u8, t: f64| aiding.and_then(|ff| ff.predicted_doppler_hz(prn, t));
-        self.manager
-            .drain_reports(|i, e| {
-                if aiding.is_some() {
-                    monitor.observe(i, e, &predict);
-                }
-                nav.on_report(i, e, aiding, sink)
-            })
-            .map_err(ReceiverError::Sink)?;
-        if let (Some(ff), Some(done)) = (aiding, self.processed_to) {
-            let t_first = self.first_sample.unwrap_or(0) as f64 / self.fs_hz;
-            let t_done = done as f64 / self.fs_hz;
-            monitor.evaluate(t_first, t_done, ff.expected_common_residual_hz(), &predict);
+        self.reports_out().pass(sink)?;
+        self.end_round(found, end, sink)
+    }
+
+    /// [`Receiver::deliver`] while the next block is read: the reports go to the navigation
+    /// processor on this thread while the pool reads (they need no sample), then the rest of
+    /// the round's end with the end of the samples read. Returns the samples read (0 at the
+    /// end of the source).
+    fn deliver_while_reading(
+        &mut self,
+        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        source: &mut dyn SampleSource,
+        sink: &mut dyn Sink,
+    ) -> Result<usize, ReceiverError> {
+        let t0 = std::time::Instant::now();
+        let reports = ReportsOut {
+            nav: &mut self.nav,
+            manager: &mut self.manager,
+            aiding: self.aiding.as_ref(),
+            monitor: &mut self.monitor,
+            span: done_span(self.first_sample, self.processed_to, self.fs_hz),
+        };
+        let (got, passed) = self
+            .window
+            .read_during(source, self.block, || reports.pass(sink))?;
+        passed?;
+        let end = self.window.end();
+        self.end_round(found, end, sink)?;
+        self.stages.navigation_s += t0.elapsed().as_secs_f64();
+        Ok(got)
+    }
+
+    /// The parts of the receiver that take the channels' reports.
+    fn reports_out(&mut self) -> ReportsOut<'_> {
+        ReportsOut {
+            nav: &mut self.nav,
+            manager: &mut self.manager,
+            aiding: self.aiding.as_ref(),
+            monitor: &mut self.monitor,
+            span: done_span(self.first_sample, self.processed_to, self.fs_hz),
         }
-        match nav.end_block(end, sink).map_err(ReceiverError::Sink)? {
+    }
+
+    /// The end of a round after its reports ([`ReportsOut::pass`]): the navigation
+    /// processor's end of block at `end` and what it asks of the channels, new channels for
+    /// what a search found, and the samples no one needs any more dropped.
+    fn end_round(
+        &mut self,
+        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        end: u64,
+        sink: &mut dyn Sink,
+    ) -> Result<(), ReceiverError> {
+        match self.nav.end_block(end, sink).map_err(ReceiverError::Sink)? {
             Some(BlockEvent::PhaseJump(_)) => self.manager.restart_bit_sync(),
             Some(BlockEvent::Collapse(c)) => self.manager.request_realignment(&c),
             None => {}
@@ -644,6 +716,59 @@ impl Receiver {
                 cn0_dbhz: d.cn0_dbhz.unwrap_or(f64::NAN),
             })
             .map_err(ReceiverError::Sink)?;
+        }
+        Ok(())
+    }
+}
+
+/// Stream times (s) of the first sample and of the end of the samples processed, when
+/// both are known.
+fn done_span(
+    first_sample: Option<u64>,
+    processed_to: Option<u64>,
+    fs_hz: f64,
+) -> Option<(f64, f64)> {
+    processed_to.map(|done| {
+        (
+            first_sample.unwrap_or(0) as f64 / fs_hz,
+            done as f64 / fs_hz,
+        )
+    })
+}
+
+/// What takes the reports of a round: the navigation processor, the INS integrity monitor
+/// (with an INS) and the channel manager that holds them.
+struct ReportsOut<'a> {
+    nav: &'a mut NavigationProcessor,
+    manager: &'a mut ChannelManager,
+    aiding: Option<&'a InsFeedForward>,
+    monitor: &'a mut AidMonitor,
+    /// [`done_span`] of the round.
+    span: Option<(f64, f64)>,
+}
+
+impl ReportsOut<'_> {
+    /// The reports of the last round to the navigation processor in stream order (and to the
+    /// integrity monitor, which then evaluates the round, with an INS).
+    fn pass(self, sink: &mut dyn Sink) -> Result<(), ReceiverError> {
+        let Self {
+            nav,
+            manager,
+            aiding,
+            monitor,
+            span,
+        } = self;
+        let predict = |prn: u8, t: f64| aiding.and_then(|ff| ff.predicted_doppler_hz(prn, t));
+        manager
+            .drain_reports(|i, e| {
+                if aiding.is_some() {
+                    monitor.observe(i, e, &predict);
+                }
+                nav.on_report(i, e, aiding, sink)
+            })
+            .map_err(ReceiverError::Sink)?;
+        if let (Some(ff), Some((t_first, t_done))) = (aiding, span) {
+            monitor.evaluate(t_first, t_done, ff.expected_common_residual_hz(), &predict);
         }
         Ok(())
     }

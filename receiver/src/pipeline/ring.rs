@@ -1,7 +1,8 @@
 //! A window of recent samples, addressed by absolute sample index, shared read-only by all
-//! channels while they correlate and refilled from the source between rounds — or during
-//! them: [`SampleWindow::fill_during`] reads the next block into spare room behind the
-//! samples held while the channels work on those.
+//! channels while they correlate and refilled from the source between rounds — or beside
+//! other work: [`SampleWindow::fill_during`] reads the next block into spare room behind the
+//! samples held while the channels work on those, [`SampleWindow::read_during`] while the
+//! calling thread does work that needs no sample (the navigation after a round).
 //!
 //! Memory is bounded: samples older than the slowest channel's next integration are dropped.
 //! Nothing is allocated or zeroed per block in the steady state: the buffer keeps its size and
@@ -13,10 +14,12 @@
 //! with no conversion and a half or a quarter of the memory traffic of complex f32 -- else as
 //! complex f32. The searches, which need f32, convert the span they read.
 
+use crate::pipeline::profile::timed;
 use gpsrx_dsp::correlator::SampleSlice;
 use gpsrx_samples::{IntegerFormat, IntegerSamplesMut, SampleError, SampleSource};
 use num_complex::Complex32;
 use std::borrow::Cow;
+use std::time::Duration;
 
 /// Samples processed per block, as a fraction of a second (40 ms). Each block wakes the worker
 /// threads once; with the correlators at 6 instructions per sample, the wake-ups of 10 ms
@@ -146,6 +149,8 @@ pub struct SampleWindow {
     end_of_stream: bool,
     /// Bytes dropped before a compaction ([`COMPACT_BYTES`]; smaller in tests).
     compact_bytes: usize,
+    /// Wall time spent reading the source, s.
+    read_s: f64,
 }
 
 impl Default for SampleWindow {
@@ -155,6 +160,7 @@ impl Default for SampleWindow {
             store: Store::default(),
             end_of_stream: false,
             compact_bytes: COMPACT_BYTES,
+            read_s: 0.0,
         }
     }
 }
@@ -265,6 +271,13 @@ impl SampleWindow {
         self.start + each!(&self.store, b => b.len()) as u64
     }
 
+    /// Wall time spent reading the source so far, s (each read timed on the thread that
+    /// made it, beside the work of [`SampleWindow::fill_during`] or
+    /// [`SampleWindow::read_during`]).
+    pub fn read_s(&self) -> f64 {
+        self.read_s
+    }
+
     /// Whether the source is exhausted.
     pub fn end_of_stream(&self) -> bool {
         self.end_of_stream
@@ -331,7 +344,7 @@ impl SampleWindow {
                     start,
                     data: Held::slice(held),
                 };
-                rayon::join(|| src.read(room), || work(view))
+                rayon::join(|| timed(|| src.read(room)), || work(view))
             }
             Store::Ci8(b) => {
                 let (held, room) = b.split(n);
@@ -340,7 +353,7 @@ impl SampleWindow {
                     data: Held::slice(held),
                 };
                 rayon::join(
-                    || src.read_integer(IntegerSamplesMut::Ci8(room)),
+                    || timed(|| src.read_integer(IntegerSamplesMut::Ci8(room))),
                     || work(view),
                 )
             }
@@ -351,15 +364,56 @@ impl SampleWindow {
                     data: Held::slice(held),
                 };
                 rayon::join(
-                    || src.read_integer(IntegerSamplesMut::Ci16(room)),
+                    || timed(|| src.read_integer(IntegerSamplesMut::Ci16(room))),
                     || work(view),
                 )
             }
         };
+        Ok((self.take_read(read)?, r))
+    }
+
+    /// Reads up to `n` more samples from `src` on the rayon pool while `f` runs on the
+    /// calling thread (which need not be one of the pool's; `f` need not be `Send`): for
+    /// work that needs no sample, such as the navigation after a round. Returns the samples
+    /// read (0 at the end of the source) and `f`'s result; `f` runs even when the read fails
+    /// or the source has ended. Gaps as in [`SampleWindow::fill`].
+    pub fn read_during<R>(
+        &mut self,
+        src: &mut dyn SampleSource,
+        n: usize,
+        f: impl FnOnce() -> R,
+    ) -> Result<(usize, R), SampleError> {
+        if self.end_of_stream {
+            return Ok((0, f()));
+        }
+        let (read, r) = match &mut self.store {
+            Store::Cf32(b) => {
+                let room = b.split(n).1;
+                beside(|| src.read(room), f)
+            }
+            Store::Ci8(b) => {
+                let room = b.split(n).1;
+                beside(|| src.read_integer(IntegerSamplesMut::Ci8(room)), f)
+            }
+            Store::Ci16(b) => {
+                let room = b.split(n).1;
+                beside(|| src.read_integer(IntegerSamplesMut::Ci16(room)), f)
+            }
+        };
+        Ok((self.take_read(read)?, r))
+    }
+
+    /// Takes in the samples a read put behind the live ones (its result and how long it
+    /// took); returns how many arrived (0: the source has ended).
+    fn take_read(
+        &mut self,
+        (read, reading): (Result<(u64, usize), SampleError>, Duration),
+    ) -> Result<usize, SampleError> {
+        self.read_s += reading.as_secs_f64();
         let (first, got) = read?;
         if got == 0 {
             self.end_of_stream = true;
-            return Ok((0, r));
+            return Ok(0);
         }
         let empty = each!(&self.store, b => b.len()) == 0;
         if empty {
@@ -371,8 +425,24 @@ impl SampleWindow {
             self.start = first;
         }
         each!(&mut self.store, b => b.tail += got);
-        Ok((got, r))
+        Ok(got)
     }
+}
+
+/// Runs `read` on the rayon pool (timed) while `f` runs on the calling thread; returns both
+/// results when both are done.
+fn beside<T: Send, R>(
+    read: impl FnOnce() -> T + Send,
+    f: impl FnOnce() -> R,
+) -> ((T, Duration), R) {
+    let mut out = None;
+    let r = rayon::in_place_scope(|scope| {
+        scope.spawn(|_| out = Some(timed(read)));
+        f()
+    });
+    // The scope returns once the spawned read has run (a panic in it is resumed here).
+    let read = out.expect("the scope waits for its spawned read");
+    (read, r)
 }
 
 #[cfg(test)]
@@ -468,5 +538,38 @@ mod tests {
         // Every held sample is still its own index after the compactions.
         let v = w.view();
         assert!((v.start()..v.end()).all(|i| re(&v, i) == Some(i as f32)));
+    }
+
+    #[test]
+    fn read_during_runs_its_work_on_the_calling_thread_and_appends_the_read() {
+        let mut src = Counter { next: 10, end: 100 };
+        let mut w = SampleWindow::new();
+        let caller = std::thread::current().id();
+        let mut rounds = 0;
+        loop {
+            let before = w.end();
+            let (got, same_thread) = w
+                .read_during(&mut src, 40, || std::thread::current().id() == caller)
+                .unwrap_or_else(|e| panic!("{e}"));
+            assert!(same_thread, "the work left the calling thread");
+            if got == 0 {
+                break;
+            }
+            rounds += 1;
+            if rounds > 1 {
+                assert_eq!(w.end(), before + got as u64);
+            }
+        }
+        // 90 samples in reads of 40, 40 and 10; the first adopted the source's index.
+        assert_eq!(rounds, 3);
+        assert_eq!((w.start(), w.end()), (10, 100));
+        let v = w.view();
+        assert!((v.start()..v.end()).all(|i| re(&v, i) == Some(i as f32)));
+        assert!(w.end_of_stream());
+        // At the end of the stream the work still runs.
+        let (got, ran) = w
+            .read_during(&mut src, 40, || true)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!((got, ran), (0, true));
     }
 }

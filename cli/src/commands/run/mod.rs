@@ -20,6 +20,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{IsTerminal, Write};
 
 mod dr_inputs;
+pub mod profile_table;
 pub mod progress_line;
 
 pub use crate::cli::{DrFilterChoice, IonoModel, RunArgs, TropoModel};
@@ -168,6 +169,16 @@ pub fn run(args: &RunArgs) -> anyhow::Result<Completion> {
         writeln!(out, "{}", serde_json::to_string_pretty(&value)?)?;
     } else {
         print_report(&mut out, &report, args)?;
+        if args.profile {
+            let s = &report.receiver;
+            profile_table::write_profile(
+                &mut out,
+                &s.profile,
+                s.duration_s,
+                s.wall_s,
+                profile_table::process_usage(),
+            )?;
+        }
     }
     out.flush()?;
     Ok(if report.receiver.fixes == 0 {

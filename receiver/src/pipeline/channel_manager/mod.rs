@@ -19,6 +19,7 @@ pub mod realign;
 
 pub use realign::{Realigned, REALIGN_DOPPLER_HZ};
 
+use crate::pipeline::profile::timed;
 use crate::pipeline::ring::SampleView;
 use crate::pipeline::search_schedule::{
     level_config, search_pfa, Batch, Liveness, Scheduler, SearchBudget, Visibility, LEVELS,
@@ -136,6 +137,20 @@ pub struct ChannelManager {
     realign: Option<realign::Realign>,
     /// The engine of code realignment searches; `None` without searches.
     realign_engine: Option<AcquisitionEngine>,
+    /// Time spent in [`ChannelManager::work`] so far.
+    times: WorkTimes,
+}
+
+/// Wall time of the channels' work and of the searches beside it, summed over
+/// [`ChannelManager::work`] calls (see [`crate::pipeline::profile`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct WorkTimes {
+    /// The channels, s.
+    pub tracking_s: f64,
+    /// The searches, s.
+    pub search_s: f64,
+    /// Searches run.
+    pub searches: usize,
 }
 
 impl ChannelManager {
@@ -145,14 +160,19 @@ impl ChannelManager {
         channel_config: ChannelConfig,
         settings: SearchSettings,
     ) -> Result<Self, gpsrx_dsp::acquisition::AcqError> {
-        let mut engines = vec![AcquisitionEngine::new(fs_hz, settings.acq.clone())?];
+        // The levels and the realignment hold one copy of the replica spectra where their
+        // layouts give the same ones (1 MB each at 4 MHz).
+        let first = AcquisitionEngine::new(fs_hz, settings.acq.clone())?;
+        let mut engines = Vec::new();
         if settings.weak_fallback {
             for level in 1..=LEVELS.len() {
                 let cfg = level_config(&settings.acq, level);
-                engines.push(AcquisitionEngine::new(fs_hz, cfg)?);
+                engines.push(AcquisitionEngine::new(fs_hz, cfg)?.sharing_replicas_with(&first));
             }
         }
-        let realign_engine = Some(realign::realign_engine(fs_hz, &settings.acq)?);
+        engines.insert(0, first);
+        let realign_engine =
+            Some(realign::realign_engine(fs_hz, &settings.acq)?.sharing_replicas_with(&engines[0]));
         Ok(Self {
             fs_hz,
             channel_config,
@@ -164,6 +184,7 @@ impl ChannelManager {
             schedule: None,
             realign: None,
             realign_engine,
+            times: WorkTimes::default(),
         })
     }
 
@@ -180,6 +201,7 @@ impl ChannelManager {
             schedule: None,
             realign: None,
             realign_engine: None,
+            times: WorkTimes::default(),
         }
     }
 
@@ -343,10 +365,13 @@ impl ChannelManager {
         let channels = &mut self.channels;
         let reports = &mut self.reports;
         let mut run_all = || {
-            channels
-                .par_iter_mut()
-                .zip(reports.par_iter_mut())
-                .for_each(|(ch, out)| run_channel(ch, window, aid, out));
+            timed(|| {
+                channels
+                    .par_iter_mut()
+                    .zip(reports.par_iter_mut())
+                    .for_each(|(ch, out)| run_channel(ch, window, aid, out));
+            })
+            .1
         };
         let engine = match &search {
             Some(s) if s.realign.is_some() => self.realign_engine.as_ref(),
@@ -360,9 +385,12 @@ impl ChannelManager {
                     let samples = window
                         .get(s.first, s.len)
                         .unwrap_or(gpsrx_dsp::SampleSlice::Cf32(&[]));
-                    engine.search_slice(samples, &s.targets)
+                    timed(|| engine.search_slice(samples, &s.targets))
                 };
-                let (results, ()) = rayon::join(search, run_all);
+                let ((results, searching), tracking) = rayon::join(search, run_all);
+                self.times.tracking_s += tracking.as_secs_f64();
+                self.times.search_s += searching.as_secs_f64();
+                self.times.searches += 1;
                 let results = results
                     .map_err(|e| tracing::warn!("a search failed: {e}"))
                     .ok();
@@ -374,7 +402,7 @@ impl ChannelManager {
                 })
             }
             _ => {
-                run_all();
+                self.times.tracking_s += run_all().as_secs_f64();
                 None
             }
         };
@@ -553,6 +581,11 @@ impl ChannelManager {
         {
             c.restart_bit_sync();
         }
+    }
+
+    /// Time spent in [`ChannelManager::work`] so far.
+    pub fn work_times(&self) -> WorkTimes {
+        self.times
     }
 
     /// The channels, in the order they were started.
