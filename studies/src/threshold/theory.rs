@@ -179,7 +179,7 @@ pub fn rule_with_slope_dbhz(r: &RuleInputs) -> Option<f64> {
 /// random data bits: `crate::bandwidth::costas_atan_stats`) divided by its squared slope
 /// `(1 - exp(-rho))^2` (the receiver's normalisation, taken as ideal), through the linearised
 /// digital loop: `sigma = 360 sqrt(v / slope^2 * sum h^2)`, `sum h^2` its phase noise gain
-/// (`phase_gain`, [`LoopNoiseGains::phase_gain_of`] at slope 1; `~ 2 Bn T`). At high prompt
+/// (`phase_gain`, [`crate::bandwidth::LoopNoiseGains::phase_gain_of`] at slope 1; `~ 2 Bn T`). At high prompt
 /// SNR `v -> 1/(2 rho)/(2 pi)^2` and this is Kaplan's coherent term `Bn/CN0`; at low SNR the
 /// atan's output folds into `(-pi/2, pi/2]` and its variance exceeds the formula's squaring
 /// loss `1 + 1/(2 rho)`, which is that of the product (`I Q`) discriminator (module docs "The
