@@ -114,6 +114,36 @@ fn feedforward_doppler_matches_truth_for_a_perfect_ins() {
     assert!(worst < 0.1, "worst feed-forward error {worst} Hz");
     eprintln!("worst feed-forward error {worst:.4} Hz over {n} comparisons");
 
+    // 31 ms of samples lost (measured by the receiver): stream time `t` is now elapsed time
+    // `t + 0.031`, and the aid follows the truth there, also in the turn, where 31 ms of 5 g
+    // move the Doppler by several Hz (so the check can fail).
+    let lost = 0.031;
+    ff.note_samples_lost(lost);
+    let (mut worst_after, mut moved) = (0.0f64, 0.0f64);
+    for k in 1..=20 {
+        let t = 0.55 * f64::from(k);
+        for sat in &sim.satellites {
+            let truth_at = |t: f64| {
+                let (a, _) = sim.observe(sat, t - h);
+                let (b, _) = sim.observe(sat, t + h);
+                (b.carrier_cycles - a.carrier_cycles) / (2.0 * h)
+            };
+            let aid = ff
+                .aid(sat.prn.get(), t)
+                .unwrap_or_else(|| panic!("no aid for {} at {t}", sat.prn));
+            worst_after = worst_after.max((aid.doppler_hz - drift_hz - truth_at(t + lost)).abs());
+            moved = moved.max((truth_at(t + lost) - truth_at(t)).abs());
+        }
+    }
+    assert!(
+        moved > 1.0,
+        "31 ms of the turn move the Doppler by {moved} Hz"
+    );
+    assert!(
+        worst_after < 0.1,
+        "after the gap: worst feed-forward error {worst_after} Hz"
+    );
+
     // The drift rises by 1e-9 (1.58 Hz): after 5 smoothing time constants of 10 Hz fixes
     // (at the same place: the aid's position comes from the fix) the drift fed forward has
     // risen by 1e-9 (to 1 %), and the feed-forward by -f_L1 1e-9 = -1.58 Hz.

@@ -95,6 +95,8 @@ pub struct NavigationProcessor {
     quick: Option<QuickSync>,
     /// The receiver time re-established after samples of unknown length were lost.
     long_gap: LongGapRecovery,
+    /// Signal lost in gaps measured since the INS feed-forward was last told, ms.
+    lost_for_aid_ms: f64,
 }
 
 /// Time the code loops of channels that kept their satellites over lost samples need before
@@ -188,6 +190,7 @@ impl NavigationProcessor {
             quick: nav_assist_given.then(QuickSync::default),
             aided_offset_cycles: None,
             long_gap: LongGapRecovery::default(),
+            lost_for_aid_ms: 0.0,
         }
     }
 
@@ -473,6 +476,7 @@ impl NavigationProcessor {
                     e.t_rx_s
                 );
                 sink.event(&ReceiverEvent::GapMeasured { t_s, length_ms })?;
+                self.lost_for_aid_ms += length_ms;
                 self.step_clock_over_gap(t_s, length_ms, sink)?;
             }
             None => {}
@@ -490,6 +494,12 @@ impl NavigationProcessor {
         }
         for epoch in ready {
             self.solve_epoch(epoch, aiding, sink)?;
+        }
+        if self.lost_for_aid_ms > 0.0 {
+            if let Some(ff) = aiding {
+                ff.note_samples_lost(self.lost_for_aid_ms * 1e-3);
+            }
+            self.lost_for_aid_ms = 0.0;
         }
         let s = e.sample_index;
         if s > self.progress_at + (self.fs_hz * 0.2) as u64 {
@@ -849,6 +859,7 @@ impl NavigationProcessor {
                 );
                 self.sv_time.move_over_gap(length_ms);
                 sink.event(&ReceiverEvent::GapMeasured { t_s, length_ms })?;
+                self.lost_for_aid_ms += length_ms;
                 self.step_clock_over_gap(t_s, length_ms, sink)?;
             }
         }
@@ -1259,6 +1270,7 @@ impl NavigationProcessor {
                     t_s: gap.t_s,
                     length_ms,
                 })?;
+                self.lost_for_aid_ms += length_ms;
             }
         }
         // Keep the receiver clock within +-0.5 ms of GPS time by whole-millisecond steps.
