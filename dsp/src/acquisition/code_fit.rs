@@ -15,9 +15,9 @@
 //! first order whatever the front-end filter, and its noise is that of an early-minus-late
 //! discriminator about `2 J d` wide.
 
-use super::refine::correlate_periods_code_doppler;
+use super::refine::correlate_periods;
 use crate::constants::CA_CHIP_RATE_HZ;
-use crate::correlator::{Correlator, PackedCode, MAX_TAPS};
+use crate::correlator::{Correlator, PackedCode, SampleSlice, MAX_TAPS};
 use crate::{CaCode, Prn};
 use num_complex::{Complex32, Complex64};
 
@@ -83,8 +83,9 @@ pub fn fit_code_phase(
     let mut tau = code_phase_samples;
     let max_step = opts.half_lags as f64 * d_samples;
     for _ in 0..MAX_ITERATIONS {
-        correlate_periods_code_doppler(
-            samples,
+        correlate_periods(
+            SampleSlice::Cf32(samples),
+            &mut Vec::new(),
             &correlator,
             &code,
             fs_hz,
@@ -134,8 +135,9 @@ pub fn peak_to_noise(
     let mut offsets = vec![0.0];
     offsets.extend(NOISE_LAGS_CHIPS.iter().map(|c| c * per_chip));
     let mut out: Vec<Vec<Complex64>> = vec![Vec::new(); offsets.len()];
-    correlate_periods_code_doppler(
-        samples,
+    correlate_periods(
+        SampleSlice::Cf32(samples),
+        &mut Vec::new(),
         &correlator,
         &code,
         fs_hz,

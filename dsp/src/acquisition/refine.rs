@@ -17,76 +17,20 @@ use std::sync::Arc;
 
 /// Correlations over whole code periods `k = 0..k_max` starting at `code_phase_samples`:
 /// `p_k = sum_n x[n] c(n - offset) exp(-j 2 pi f n / fs)`, one output per `offsets_samples`
-/// entry (0 = prompt; +-d = late/early replicas), with the code rate scaled by the carrier
-/// Doppler (code Doppler = carrier Doppler / 1540). Stops where the samples end.
+/// entry (0 = prompt; +-d = late/early replicas), the carrier wiped off at `dopplers_hz.0` and
+/// the code run at the rate of the carrier Doppler `dopplers_hz.1` (code Doppler = carrier
+/// Doppler / 1540; the two differ for real samples whose spectrum is folded around 0 Hz,
+/// IF = k fs, where a satellite at Doppler D may be seen at -D while its code still runs at
+/// 1.023 MHz (1 + D / f_L1)). Stops where the samples end.
 ///
 /// Each period is one call of the tracking loops' block correlator (`correlator`: SIMD where the
 /// CPU has it, f32 arithmetic, the carrier seeded exactly in f64 at the first sample of every
 /// period and the code from a 2^-32-chip NCO), so the cost per sample is the same at any rate.
 ///
-/// `samples` are read as held (integers are converted one period at a time into `buf`).
+/// `samples` are read as held: in place when complex f32, else converted one period at a time
+/// into `buf` (the same f32 values, so the same correlations).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn correlate_periods(
-    samples: SampleSlice<'_>,
-    buf: &mut Vec<Complex32>,
-    correlator: &Correlator,
-    code: &PackedCode,
-    fs_hz: f64,
-    code_phase_samples: f64,
-    doppler_hz: f64,
-    k_max: usize,
-    offsets_samples: &[f64],
-    out: &mut [Vec<Complex64>],
-) {
-    correlate_held_periods(
-        samples,
-        buf,
-        correlator,
-        code,
-        fs_hz,
-        code_phase_samples,
-        (doppler_hz, doppler_hz),
-        k_max,
-        offsets_samples,
-        out,
-    );
-}
-
-/// [`correlate_periods`] with the carrier wiped off at `dopplers_hz.0` and the code run at
-/// the rate of the carrier Doppler `dopplers_hz.1`: the two differ for real samples whose
-/// spectrum is folded around 0 Hz (IF = k fs), where a satellite at Doppler D may be seen at
-/// -D while its code still runs at 1.023 MHz (1 + D / f_L1).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn correlate_periods_code_doppler(
-    samples: &[Complex32],
-    correlator: &Correlator,
-    code: &PackedCode,
-    fs_hz: f64,
-    code_phase_samples: f64,
-    dopplers_hz: (f64, f64),
-    k_max: usize,
-    offsets_samples: &[f64],
-    out: &mut [Vec<Complex64>],
-) {
-    correlate_held_periods(
-        SampleSlice::Cf32(samples),
-        &mut Vec::new(),
-        correlator,
-        code,
-        fs_hz,
-        code_phase_samples,
-        dopplers_hz,
-        k_max,
-        offsets_samples,
-        out,
-    );
-}
-
-/// [`correlate_periods_code_doppler`] of samples as held: each period is read in place when
-/// held as complex f32, else converted into `buf` first (the same f32 values, so the same
-/// correlations).
-#[allow(clippy::too_many_arguments)]
-fn correlate_held_periods(
     samples: SampleSlice<'_>,
     buf: &mut Vec<Complex32>,
     correlator: &Correlator,
