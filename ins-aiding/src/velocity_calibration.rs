@@ -72,11 +72,12 @@ pub const WARMUP_S: f64 = 4.0;
 /// The warm-up needs at least this many fixes.
 pub const WARMUP_FIXES: usize = 8;
 
-/// The INS velocity error estimate (module docs).
-#[derive(Debug, Clone, Default, PartialEq)]
+/// The INS velocity error estimate (module docs). Fixed-size and `Copy`: the feed-forward
+/// reads it for every aid.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct InsVelocityCalibration {
-    /// The fixes `(t, d)` of the warm-up (module docs "How"), until the loop starts.
-    warmup: Vec<(f64, Vector3<f64>)>,
+    /// The warm-up's running sums (module docs "How"), until the loop starts.
+    warmup: Warmup,
     /// Time of the last update, s, and the loop's state `(e, r)` there.
     state: Option<(f64, Vector3<f64>, Vector3<f64>)>,
     /// The offset when the loop started, which the correction leaves out (module docs).
@@ -105,10 +106,7 @@ impl InsVelocityCalibration {
         // NaN sigmas and accelerations fail these comparisons too.
         let usable = (0.0..=MAX_FIX_SIGMA_MPS).contains(&fix_sigma_mps)
             && (0.0..=MAX_ACCEL_MPS2).contains(&accel_mps2);
-        let last = self
-            .state
-            .map(|(t, _, _)| t)
-            .or(self.warmup.last().map(|(t, _)| *t));
+        let last = self.state.map(|(t, _, _)| t).or(self.warmup.last_t_s());
         if !finite || !usable || last.is_some_and(|t| t_s <= t) {
             return false;
         }
@@ -128,11 +126,11 @@ impl InsVelocityCalibration {
                 )
             }
             None => {
-                self.warmup.push((t_s, d));
-                let Some((e, r)) = warmup_fit(&self.warmup) else {
+                self.warmup.push(t_s, d);
+                let Some((e, r)) = self.warmup.fit() else {
                     return true;
                 };
-                self.warmup.clear();
+                self.warmup = Warmup::default();
                 self.base = e;
                 (e, r)
             }
@@ -168,20 +166,52 @@ impl InsVelocityCalibration {
     }
 }
 
-/// The least-squares line `d(t) = e + r (t - t_last)` through the warm-up fixes, per axis, once
-/// they span [`WARMUP_S`] with at least [`WARMUP_FIXES`] fixes: `(e, r)` at the last one.
-fn warmup_fit(fixes: &[(f64, Vector3<f64>)]) -> Option<(Vector3<f64>, Vector3<f64>)> {
-    let (t0, t1) = (fixes.first()?.0, fixes.last()?.0);
-    if t1 - t0 < WARMUP_S || fixes.len() < WARMUP_FIXES {
-        return None;
+/// The running sums of the warm-up fixes `(t, d)`, times taken from the first one (so that the
+/// sums of squares stay exact at any time of day).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Warmup {
+    /// Time of the first fix, s.
+    t_first: f64,
+    /// Time of the last fix less `t_first`, s.
+    t_last: f64,
+    n: usize,
+    sum_t: f64,
+    sum_tt: f64,
+    sum_d: Vector3<f64>,
+    sum_td: Vector3<f64>,
+}
+
+impl Warmup {
+    fn push(&mut self, t_s: f64, d: Vector3<f64>) {
+        if self.n == 0 {
+            self.t_first = t_s;
+        }
+        let t = t_s - self.t_first;
+        self.n += 1;
+        self.t_last = t;
+        self.sum_t += t;
+        self.sum_tt += t * t;
+        self.sum_d += d;
+        self.sum_td += d * t;
     }
-    let n = fixes.len() as f64;
-    let t_mean = fixes.iter().map(|(t, _)| t).sum::<f64>() / n;
-    let d_mean = fixes.iter().map(|(_, d)| d).sum::<Vector3<f64>>() / n;
-    let stt: f64 = fixes.iter().map(|(t, _)| (t - t_mean).powi(2)).sum();
-    let std: Vector3<f64> = fixes.iter().map(|(t, d)| (d - d_mean) * (t - t_mean)).sum();
-    let r = std / stt;
-    Some((d_mean + r * (t1 - t_mean), r))
+
+    fn last_t_s(&self) -> Option<f64> {
+        (self.n > 0).then_some(self.t_first + self.t_last)
+    }
+
+    /// The least-squares line `d(t) = e + r (t - t_last)` through the fixes, per axis, once
+    /// they span [`WARMUP_S`] with at least [`WARMUP_FIXES`] fixes: `(e, r)` at the last one.
+    fn fit(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        if self.t_last < WARMUP_S || self.n < WARMUP_FIXES {
+            return None;
+        }
+        let n = self.n as f64;
+        let (t_mean, d_mean) = (self.sum_t / n, self.sum_d / n);
+        let stt = self.sum_tt - n * t_mean * t_mean;
+        let std = self.sum_td - d_mean * (n * t_mean);
+        let r = std / stt;
+        Some((d_mean + r * (self.t_last - t_mean), r))
+    }
 }
 
 #[cfg(test)]
@@ -242,7 +272,7 @@ mod tests {
         }
         assert!(cal.error_mps(60.0).x <= MAX_OFFSET_MPS + MAX_DRIFT_MPS2 * 0.1);
         assert!(cal.drift_mps2().x <= MAX_DRIFT_MPS2);
-        let before = cal.clone();
+        let before = cal;
         assert!(!cal.update(61.0, Vector3::new(f64::NAN, 0.0, 0.0), 0.05, 0.0));
         assert!(!cal.update(61.0, Vector3::zeros(), 2.0, 0.0));
         // In a manoeuvre (a 10 g turn) the fix's dating error would read as velocity.

@@ -45,6 +45,7 @@
 //! ([`InsFeedForward::note_samples_lost`]) every stream time is taken as `t_s + lost` here
 //! (fixes, aids, predictions), and a time origin given after it is moved back by `lost`.
 
+use crate::pipeline::fix_output::passes_integrity;
 use gpsrx_core::{los_doppler_hz, PosVel};
 use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_ins_aiding::{BandLimiter, InsTrack, InsVelocityCalibration};
@@ -260,12 +261,10 @@ impl InsFeedForward {
     }
 
     /// [`Self::set_fix`] from a solution: its position, clock drift and velocity (the velocity
-    /// only when it has a covariance and its RAIM passed; a fault excluded counts as passed).
+    /// only when it has a covariance and it passed an integrity test that could run: a fix of
+    /// 4 satellites, which RAIM cannot check, does not calibrate the INS).
     pub fn set_fix_from(&self, t_s: f64, sol: &PvtSolution) {
-        let raim_ok = matches!(
-            sol.raim,
-            RaimStatus::Ok | RaimStatus::FaultExcluded { .. } | RaimStatus::Disabled
-        );
+        let raim_ok = passes_integrity(sol) && !matches!(sol.raim, RaimStatus::Unavailable);
         let velocity = sol
             .vel_ecef_mps
             .filter(|_| raim_ok)
@@ -445,7 +444,7 @@ impl Knowledge {
             fix: self.fix,
             rx_clock_drift_s_s: self.rx_clock_drift_s_s,
             rx_clock_drift_ref: self.rx_clock_drift_ref,
-            calibration: self.calibration.clone(),
+            calibration: self.calibration,
             lost_s: self.lost_s,
         }
     }
