@@ -11,6 +11,7 @@
 #   weak       the weak-mix recording, with and without --nav [Finding satellites]
 #   faults     samples cut / zeroed in the GPS-SDR-SIM file    [Lost samples and outages]
 #   long-gaps  5 s / 60 s cut from the simulated Seoul file    [Lost samples and outages]
+#   dyn-gaps   cuts and zeros inside a 10 g turn and a 4.3 g climb [Lost samples and outages]
 #   aided      the 5 g turn with an INS, aided and not         [INS aiding]
 #   loops      narrow 0.4 Hz loops: 10 g turns, the C/N0 ladder [Loss of carrier lock]
 #   dr         the drive with a 30 s outage, --dr --accel      [Dead reckoning]
@@ -30,7 +31,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 WORK=${WORK:-$(mktemp -d)}
 SHARED=${SHARED:-$ROOT/../shared/data}
-ALL=(demo seoul hard weak faults long-gaps aided loops dr acquire track jitter studies bench vs-gnss-sdr scaling)
+ALL=(demo seoul hard weak faults long-gaps dyn-gaps aided loops dr acquire track jitter studies bench vs-gnss-sdr scaling)
 die() { echo "readme-figures: $*" >&2; exit 1; }
 
 if [[ ${1:-} == --list ]]; then printf '%s\n' "${ALL[@]}"; exit 0; fi
@@ -164,6 +165,35 @@ section_long-gaps() {
         done
     done
     rm -f "$WORK/lg-cut.ci8"
+}
+
+# Gaps inside dynamics (issue 26): the simulator's 10 g turn (45-51 s) and 4.3 g climbing
+# acceleration (40-60 s), 65 s of ci8 at 2.6 MHz with a 1 mg INS; no fault, a 31 ms and a
+# 1.25 ms cut and 1 s of zeros in the middle of the manoeuvre, with and without --nav and --ins.
+# Columns: valid fixes back after the return, worst valid fix from the fault to 10 s after,
+# valid fixes over 5 m, and over 5 m beyond their stated 3-sigma (scripts/tools/gap_recovery.py).
+section_dyn-gaps() {
+    local sc at fault kind len opts args
+    for sc in turn rocket; do
+        case $sc in
+            turn) run "$GPSRX" simulate "$ROOT/samples/scenarios/gaps-turn-10g.toml" -o "$WORK/dg" >/dev/null; at=48.0 ;;
+            rocket) run "$GPSRX" simulate "$ROOT/samples/scenarios/gaps-rocket-4g.toml" -o "$WORK/dg" >/dev/null; at=50.0 ;;
+        esac
+        for fault in "cut 0" "cut 0.031" "cut 0.00125" "zero 1.0"; do
+            read -r kind len <<<"$fault"
+            python3 "$TOOLS/fault.py" "$WORK/dg/signal.ci8" "$WORK/dg-fault.ci8" --bytes-per-sample 2 \
+                --fs 2.6e6 --"$kind" "$at" "$len"
+            for opts in nav nav+ins none ins; do
+                args=(--format ci8 --fs 2.6e6 --allow-unhealthy --no-plots)
+                [[ $opts == nav* ]] && args+=(--nav "$NAV")
+                [[ $opts == *ins ]] && args+=(--ins "$WORK/dg/ins.csv")
+                "$GPSRX" run "$WORK/dg-fault.ci8" "${args[@]}" --out "$WORK/dg-run" 2>/dev/null >/dev/null || true
+                python3 "$TOOLS/gap_recovery.py" "$WORK/dg-run" "$WORK/dg/truth.csv" --at "$at" \
+                    --len "$len" --label "$sc | $kind $len s at $at s | $opts"
+            done
+        done
+        rm -f "$WORK/dg-fault.ci8"
+    done
 }
 
 section_aided() {

@@ -596,12 +596,21 @@ impl Channel {
 
     /// Forgets the data-bit edges (after samples were lost, the bits no longer fall where they
     /// did): the bit synchroniser starts again on the coming prompts; the loops keep running.
-    /// Only a channel integrating 1 ms: longer integrations are aligned to the bit edges and
-    /// would stop until new ones are found (a weak pull-in goes back to its frequency stage,
-    /// whose sums need no edges).
+    /// A channel integrating longer than 1 ms (aligned to the old edges, so now straddling
+    /// the new ones) goes back to its 1 ms loops at the frequency it held; a weak pull-in goes
+    /// back to its frequency stage, whose sums need no edges.
     pub fn restart_bit_sync(&mut self) {
         if self.weak_stage.is_none() && (self.carrier.t_coh_s() * 1e3).round() as usize != 1 {
-            return;
+            // Integrations aligned to the old bit edges straddle the new ones: back to the
+            // 1 ms loops (at the frequency held), where the edges can be found again.
+            let ff = self.ff_applied_hz.unwrap_or(0.0);
+            let f = self.carrier.frequency_memory_hz() + ff;
+            if self.restart_carrier(f, 0.0).is_none() {
+                return;
+            }
+            self.acc = [Complex64::new(0.0, 0.0); 3];
+            self.acc_ms = 0;
+            self.phase_fit.reset();
         }
         self.weak_restart_frequency_stage();
         self.bit_sync.reset();

@@ -217,7 +217,8 @@ pub struct Fix {
     /// Solution kind.
     pub quality: FixQuality,
     /// One-sigma position uncertainty east, north and up, m, from the solution's covariance
-    /// (`sigma0^2 N^-1` rotated to the local frame); `None` when there is none (fused rows).
+    /// (`s^2 N^-1` rotated to the local frame, with the variance factor's 95 % upper bound
+    /// `s^2`); `None` when there is none (fused rows).
     pub sigma_enu_m: Option<[f64; 3]>,
     /// Satellites in view, for NMEA GSV.
     pub sats_in_view: Vec<SatView>,

@@ -267,14 +267,29 @@ impl DiscontinuityMonitor {
         }
         self.steps.retain(|s| s.0 + cluster > ready);
         if found.is_some() {
-            self.steps.clear();
-            for w in self.watches.values_mut() {
-                w.steady = 0;
-                w.recent.clear();
-                w.nco.clear();
-            }
+            self.reset();
         }
         found
+    }
+
+    /// Forgets the steps and the carrier histories (a discontinuity was found, here or by
+    /// another monitor).
+    pub fn reset(&mut self) {
+        self.steps.clear();
+        for w in self.watches.values_mut() {
+            w.steady = 0;
+            w.recent.clear();
+            w.nco.clear();
+        }
+    }
+
+    /// Per satellite with a carrier history: the carrier-phase step over a jump known only
+    /// to lie between samples `before` and `after` (the bit edges' move,
+    /// [`crate::pipeline::bit_edge`]): measured from the reports before the one and after
+    /// the other, so that neither side holds the jump.
+    pub fn steps_between(&self, before: u64, after: u64) -> Vec<PhaseStep> {
+        let prns: Vec<u8> = self.watches.keys().copied().collect();
+        self.phase_steps(&prns, before, Some(after))
     }
 }
 

@@ -36,7 +36,7 @@ pub const STEP_SIGMA_RAD: f64 = 0.25;
 /// Fewest phase steps that can resolve a length.
 pub const MIN_STEPS: usize = 4;
 /// Fewest satellites whose code offsets can measure a length.
-pub const MIN_CODE_OFFSETS: usize = 6;
+pub const MIN_CODE_OFFSETS: usize = 5;
 
 /// Lowest score accepted.
 pub const MIN_SCORE: f64 = 0.6;

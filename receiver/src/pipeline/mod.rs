@@ -12,6 +12,7 @@
 //! - [`coarse_fix`]: the first fix from code phases alone (approximate time and position);
 //! - [`dating`]: which GPS week labels receiver time before subframe 1 is decoded;
 //! - [`navdata`]: frame sync, subframes, ephemerides and SV time per satellite;
+//! - [`bit_edge`]: lost samples found by the data-bit edges moving together;
 //! - [`discontinuity`]: lost samples found by a carrier-phase jump common to the satellites;
 //! - [`code_jump`]: lost samples found by a code jump (prompt power collapsing together);
 //! - [`carrier_step`]: a satellite's carrier-phase step over lost samples;
@@ -25,6 +26,7 @@
 
 pub mod aid_monitor;
 pub mod aiding;
+pub mod bit_edge;
 pub mod carrier_step;
 pub mod channel_manager;
 pub mod coarse_fix;

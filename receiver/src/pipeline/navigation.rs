@@ -10,6 +10,7 @@ use crate::config::{IonoModel, RunSettings, TropoModel};
 use crate::landmarks::LandmarkObservation;
 use crate::output::{ChannelRow, FixQuality};
 use crate::pipeline::aiding::InsFeedForward;
+use crate::pipeline::bit_edge::BitEdgeMonitor;
 use crate::pipeline::channel_manager::Realigned;
 use crate::pipeline::coarse_fix::{CoarseFixer, CoarseRefusal};
 use crate::pipeline::code_jump::{Collapse, CollapseMonitor};
@@ -71,6 +72,8 @@ pub struct NavigationProcessor {
     sv_time: SvTimeKeeper,
     /// Watches for lost samples: carrier-phase jumps.
     monitor: DiscontinuityMonitor,
+    /// Watches for lost samples: the data-bit edges moving together.
+    edges: BitEdgeMonitor,
     /// Watches for lost samples: prompt power collapsing on several satellites at once.
     collapse: CollapseMonitor,
     /// After a code realignment: the jump's sample, the satellites moved and the sample from
@@ -179,6 +182,7 @@ impl NavigationProcessor {
             locked: BTreeSet::new(),
             sv_time: SvTimeKeeper::default(),
             monitor: DiscontinuityMonitor::new(fs_hz),
+            edges: BitEdgeMonitor::new(),
             collapse: CollapseMonitor::new(),
             pending_steps: None,
             last_clock: None,
@@ -253,15 +257,40 @@ impl NavigationProcessor {
             );
             return Ok(Some(BlockEvent::Collapse(c)));
         }
-        let Some(d) = self.monitor.evaluate(end) else {
-            return Ok(None);
+        let d = match self.monitor.evaluate(end) {
+            Some(d) => {
+                self.edges.reset();
+                let t_s = d.sample as f64 / self.fs_hz;
+                tracing::warn!(
+                    "{t_s:.3} s: samples lost (the carrier phase of {} of {} satellites jumped at once): no fix until the receiver time is re-established",
+                    d.jumped,
+                    d.watched
+                );
+                d
+            }
+            None => match self.edges.evaluate() {
+                Some(m) => {
+                    tracing::warn!(
+                        "{:.3}-{:.3} s: samples lost (the data-bit edges of {} of {} satellites moved by {} ms at once): no fix until the receiver time is re-established",
+                        m.before_sample as f64 / self.fs_hz,
+                        m.after_sample as f64 / self.fs_hz,
+                        m.prns.len(),
+                        m.watched,
+                        m.offset_ms
+                    );
+                    let steps = self.monitor.steps_between(m.before_sample, m.after_sample);
+                    self.monitor.reset();
+                    Discontinuity {
+                        sample: m.before_sample,
+                        jumped: m.prns.len(),
+                        watched: m.watched,
+                        steps,
+                    }
+                }
+                None => return Ok(None),
+            },
         };
         let t_s = d.sample as f64 / self.fs_hz;
-        tracing::warn!(
-            "{t_s:.3} s: samples lost (the carrier phase of {} of {} satellites jumped at once): no fix until the receiver time is re-established",
-            d.jumped,
-            d.watched
-        );
         let steps = d.steps.clone();
         tracing::debug!("carrier-phase steps over the jump: {steps:?}");
         // The code loops of the channels that kept their satellites take a second to follow
@@ -281,6 +310,7 @@ impl NavigationProcessor {
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
         let t_s = r.jump_sample as f64 / self.fs_hz;
+        self.edges.reset();
         if r.length_unknown {
             tracing::warn!(
                 "{t_s:.3} s: samples lost (the code of {} satellites moved by more than any gap of up to {:.0} s explains): channels moved onto it; no fix until the receiver time is re-established",
@@ -455,6 +485,7 @@ impl NavigationProcessor {
     ) -> Result<(), SinkError> {
         sink.channel_epoch(channel, e)?;
         self.monitor.push(e);
+        self.edges.push(e);
         self.collapse.push(e);
         self.searched.insert(e.prn);
         let locked = e.bit.is_some() || (e.pll_lock && e.state == ChannelState::Track);

@@ -163,10 +163,14 @@ const SV_CLOCK_CARRY_S: f64 = 120.0;
 const SV_CLOCK_HINT_S: f64 = 600.0;
 const SV_CLOCK_HINT_TOLERANCE_S: f64 = 3.0;
 
-/// A satellite's SV time at a sample, with its rate: where the code of the last usable report
-/// stood. After the channel has lost the signal, the SV time of a new channel's bit edge is
-/// predicted from it, `sv(k) = sv_ref + (k - k_ref) / fs * r / 1.023 MHz` for the code rate `r`,
-/// and rounded to the 20 ms data bit (the bit edge the channel found): the satellite's time is
+/// A satellite's SV time at a sample, with its rate and the rate's rate: where the code of the
+/// last usable report stood. After the channel has lost the signal, the SV time of a new
+/// channel's bit edge is predicted from it, `sv(k) = sv_ref + r dt + r' dt^2 / 2` (the rate
+/// held after [`RATE_RATE_HORIZON_S`]) with
+/// `dt = (k - k_ref) / fs`, the SV time rate `r = 1 + f_D / f_L1` and its rate `r'` (the
+/// Doppler rate over `f_L1`: under a 4.3 g acceleration along the line of sight the quadratic
+/// term is 120 ns after 1.3 s, as much as the code offsets that measure a 31 ms gap), and
+/// rounded to the 20 ms data bit (the bit edge the channel found): the satellite's time is
 /// known again as soon as its new channel has bit sync, without waiting 6-12 s for frame sync.
 #[derive(Debug, Clone, Copy)]
 pub struct SvClock {
@@ -174,8 +178,10 @@ pub struct SvClock {
     sample: u64,
     /// SV time at it (TOW, s).
     sv_tow_s: f64,
-    /// SV seconds per receiver second (`1 + f_D / f_L1`, averaged).
+    /// SV seconds per receiver second (`1 + f_D / f_L1`, filtered).
     pub rate: f64,
+    /// Its rate, 1/s (the Doppler rate over `f_L1`, filtered).
+    rate_rate: f64,
     /// Known only roughly (samples may have been lost since): not carried over, only a hint
     /// for frame sync ([`NavDecoder::hint_time`]).
     rough: bool,
@@ -184,9 +190,21 @@ pub struct SvClock {
 impl SvClock {
     /// The predicted SV time at sample `k` for samples at `fs_hz`.
     fn at(&self, k: u64, fs_hz: f64) -> f64 {
-        self.sv_tow_s + (k as f64 - self.sample as f64) / fs_hz * self.rate
+        let dt = (k as f64 - self.sample as f64) / fs_hz;
+        // The rate changes at most over the first seconds (a manoeuvre ends), then holds.
+        let dq = dt.clamp(-RATE_RATE_HORIZON_S, RATE_RATE_HORIZON_S);
+        self.sv_tow_s + dt * self.rate + (dq * dt - 0.5 * dq * dq) * self.rate_rate
     }
 }
+
+/// Longest time over which a predicted SV time follows the rate's rate, s.
+const RATE_RATE_HORIZON_S: f64 = 5.0;
+
+/// Gains of the alpha-beta filter of the SV time rate over the reports (Benedict-Bordner:
+/// `beta = alpha^2 / (2 - alpha)`): the rate averages about 50 reports against the PLL's
+/// jitter and, with its rate, follows a Doppler ramp without lag.
+const RATE_ALPHA: f64 = 0.02;
+const RATE_BETA: f64 = RATE_ALPHA * RATE_ALPHA / (2.0 - RATE_ALPHA);
 
 /// The satellites' SV times and the gap being recovered from.
 #[derive(Debug, Default)]
@@ -211,8 +229,10 @@ impl SvTimeKeeper {
     /// Moves every kept SV time over a gap of `length_ms` of receiver time (once its length is
     /// known): each satellite's SV time ran `length r` meanwhile; they are exact again.
     pub fn move_over_gap(&mut self, length_ms: f64) {
+        let g = length_ms * 1e-3;
         for c in self.clocks.values_mut() {
-            c.sv_tow_s += length_ms * 1e-3 * c.rate;
+            c.sv_tow_s += g * c.rate + 0.5 * g * g * c.rate_rate;
+            c.rate += g * c.rate_rate;
             c.rough = false;
         }
     }
@@ -273,16 +293,25 @@ impl SvTimeKeeper {
         if let Some(sv) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) {
             // The rate from the carrier (the code NCO's rate carries the DLL's corrections,
             // tenths of a chip per second, which would grow to a tenth of a microsecond over a
-            // second), averaged over about 50 reports against the PLL's jitter.
-            let rate = 1.0 + e.doppler_hz / F_L1_HZ;
-            let rate = match self.clocks.get(&e.prn) {
-                Some(c) if !c.rough && e.sample_index > c.sample => c.rate + 0.02 * (rate - c.rate),
-                _ => rate,
+            // second), filtered with its rate.
+            let measured = 1.0 + e.doppler_hz / F_L1_HZ;
+            let (rate, rate_rate) = match self.clocks.get(&e.prn) {
+                Some(c) if !c.rough && e.sample_index > c.sample => {
+                    let dt = (e.sample_index - c.sample) as f64 / fs_hz;
+                    let predicted = c.rate + c.rate_rate * dt;
+                    let residual = measured - predicted;
+                    (
+                        predicted + RATE_ALPHA * residual,
+                        c.rate_rate + RATE_BETA * residual / dt,
+                    )
+                }
+                _ => (measured, 0.0),
             };
             let clock = SvClock {
                 sample: e.sample_index,
                 sv_tow_s: sv,
                 rate,
+                rate_rate,
                 rough: false,
             };
             self.clocks.insert(e.prn, clock);

@@ -99,7 +99,7 @@ impl Channel {
     /// The 1 ms loops again (the aided ones while aided, else the normal ones), the carrier
     /// loop at `doppler_hz` (and `rate_hz_s`), the C/N0 estimator restarted; `None` (nothing
     /// changed) when the configured loops do not integrate 1 ms.
-    fn restart_carrier(&mut self, doppler_hz: f64, rate_hz_s: f64) -> Option<()> {
+    pub(super) fn restart_carrier(&mut self, doppler_hz: f64, rate_hz_s: f64) -> Option<()> {
         let was_weak = self.weak;
         self.weak = false;
         let which = self.wanted_loops();
