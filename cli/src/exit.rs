@@ -41,22 +41,10 @@ pub fn is_broken_pipe(e: &anyhow::Error) -> bool {
     })
 }
 
-/// The error and its causes on one line, `outer: cause: root`, each text once: a cause whose
-/// text its outer message already includes (errors that print their source and also return
-/// it as their source) is left out.
+/// The error and its causes on one line, `outer: cause: root`, each text once
+/// ([`gpsrx_receiver::error_message`]).
 pub fn error_message(e: &anyhow::Error) -> String {
-    let mut text = String::new();
-    for cause in e.chain() {
-        let c = cause.to_string();
-        if c.is_empty() || text.contains(&c) {
-            continue;
-        }
-        if !text.is_empty() {
-            text.push_str(": ");
-        }
-        text.push_str(&c);
-    }
-    text
+    gpsrx_receiver::error_message(e.as_ref())
 }
 
 /// Standard output for the commands' results: a write error says it was standard output
