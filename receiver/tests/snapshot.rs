@@ -129,7 +129,8 @@ fn simulated_snapshots_are_positioned_from_30_km_and_seconds_away() {
         } = *c;
         let dir = tempfile::tempdir().expect("tempdir");
         let snap = simulate(dir.path(), c, 11 + k as u64);
-        let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+        let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default())
+            .unwrap_or_else(|e| panic!("{e}"));
         let out = p.run(std::slice::from_ref(&snap), seed(2.5), |_| {});
         let o = &out[0];
         assert_eq!(o.quality, SnapshotQuality::Fix, "{format}: {}", o.reason);
@@ -172,7 +173,8 @@ fn snapshot_table() {
                     );
                     let mut opts = SnapshotOptions::default();
                     opts.measure.max_speed_mps = 120.0;
-                    let mut p = SnapshotProcessor::new(&nav, opts);
+                    let mut p =
+                        SnapshotProcessor::new(&nav, opts).unwrap_or_else(|e| panic!("{e}"));
                     let o = &p.run(std::slice::from_ref(&snap), seed(2.5), |_| {})[0];
                     let e = o.llh.map_or("-".to_string(), |l| {
                         format!("{:.1}", horizontal_error_m(&l, &truth))
@@ -224,7 +226,8 @@ fn bad_snapshots_give_rows_with_reasons_and_do_not_move_the_seed() {
         with(Vec::new(), 4),
         with(good.samples.clone(), 5),
     ];
-    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+    let mut p =
+        SnapshotProcessor::new(&nav, SnapshotOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let out = p.run(&snaps, seed(1.0), |_| {});
     assert_eq!(out.len(), 6);
     let q: Vec<SnapshotQuality> = out.iter().map(|o| o.quality).collect();
@@ -250,7 +253,18 @@ fn bad_snapshots_give_rows_with_reasons_and_do_not_move_the_seed() {
     };
     let o = p.run(&snaps[..1], no_time, |_| {});
     assert_eq!(o[0].quality, None);
-    assert!(o[0].reason.contains("--time"), "{}", o[0].reason);
+    assert!(o[0].reason.contains("no a-priori time"), "{}", o[0].reason);
+    assert!(!o[0].reason.contains("--"), "{}", o[0].reason);
+}
+
+#[test]
+fn navigation_data_without_an_ephemeris_is_an_error_that_names_no_flag() {
+    let e = SnapshotProcessor::new(&NavData::default(), SnapshotOptions::default())
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(e.contains("no navigation data were given"), "{e}");
+    assert!(!e.contains("--"), "{e}");
 }
 
 #[test]
@@ -258,7 +272,8 @@ fn an_apriori_beyond_the_limits_gives_no_fix() {
     let nav = nav();
     let dir = tempfile::tempdir().expect("tempdir");
     let snap = simulate(dir.path(), &case("ci2", 4.0e6, 0.0, 10.0, 44.0, 0.0), 9);
-    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+    let mut p =
+        SnapshotProcessor::new(&nav, SnapshotOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     // 1000 km away (Beijing is ~950 km from Seoul), the right time.
     let far = Seed {
         pos_ecef_m: Llh::from_degrees(39.9, 116.4, 50.0).to_ecef(),
@@ -314,7 +329,7 @@ fn snappergps_walk_first_60_snapshots_against_rtk_truth() {
         h_m: 112.0,
         sigma_m: 30.0,
     });
-    let mut p = SnapshotProcessor::new(&nav, opts);
+    let mut p = SnapshotProcessor::new(&nav, opts).unwrap_or_else(|e| panic!("{e}"));
     let seed = Seed {
         pos_ecef_m: apriori.to_ecef(),
         time_correction_s: 0.0,
@@ -354,7 +369,8 @@ fn airborne_capture_within_50_m_of_the_reference() {
     // The time 3 s late and the position 35 km off.
     let t = GpsTime::new(1672, 391_561.0);
     let snap = read_raw_snapshot(&stream, &spec, Some(t)).expect("capture");
-    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+    let mut p =
+        SnapshotProcessor::new(&nav, SnapshotOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let seed = Seed {
         pos_ecef_m: Llh::from_degrees(52.6, 10.9, 0.0).to_ecef(),
         time_correction_s: 0.0,

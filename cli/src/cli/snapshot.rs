@@ -8,9 +8,10 @@ pub struct SnapshotArgs {
     /// The snapshots: a SnapperGPS JSON file (`.json`: many snapshots with their timestamps),
     /// or a raw/WAV/SigMF recording holding one snapshot (needs --time unless SigMF).
     pub input: PathBuf,
-    /// RINEX navigation file (broadcast ephemerides of the day; RINEX 2 or 3).
+    /// RINEX navigation file (broadcast ephemerides of the day; RINEX 2 or 3). Needed: without
+    /// it the command says so.
     #[arg(long, value_name = "FILE")]
-    pub nav: PathBuf,
+    pub nav: Option<PathBuf>,
     /// GPS time of the first sample, WEEK:TOW (full week, seconds of week): for a raw
     /// recording; with a SnapperGPS file it replaces the first timestamp (the others keep
     /// their spacing).

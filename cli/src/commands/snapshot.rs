@@ -19,8 +19,12 @@ pub use crate::cli::SnapshotArgs;
 
 /// Runs `gpsrx snapshot`.
 pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
-    let nav = gpsrx_nav::read_rinex_nav(&args.nav)
-        .with_context(|| format!("cannot read the navigation file {}", args.nav.display()))?;
+    let nav = match &args.nav {
+        Some(path) => gpsrx_nav::read_rinex_nav(path)
+            .with_context(|| format!("cannot read the navigation file {}", path.display()))?,
+        // The library says what is missing; the error's hint names --nav.
+        None => gpsrx_nav::NavData::default(),
+    };
     let llh = parse_llh(&args.approx_llh)?;
     let time = args.time.as_deref().map(parse_time).transpose()?;
     let snapshots = read_input(args, time)?;
@@ -53,7 +57,7 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
         h_m: llh.h_m,
         sigma_m: args.height_sigma,
     });
-    let mut processor = SnapshotProcessor::new(&nav, opts);
+    let mut processor = SnapshotProcessor::new(&nav, opts)?;
     let started = std::time::Instant::now();
     let n = snapshots.len();
     let outcomes = processor.run(&snapshots, seed, |o| {

@@ -17,6 +17,7 @@ use super::measure::{
     SnapshotAcquisition,
 };
 use super::solve::{predict_missed, residual_rms_m, solve_snapshot, SnapshotQuality, SolveOptions};
+use super::SnapshotError;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
 use gpsrx_nav::pvt::CoarseTimeSolution;
 use gpsrx_nav::pvt::{PvtOptions, Weighting};
@@ -158,16 +159,20 @@ pub struct SnapshotProcessor<'a> {
 
 impl<'a> SnapshotProcessor<'a> {
     /// A processor with the ephemerides of `nav`. The ionosphere of `nav` is used when the
-    /// options have none.
-    pub fn new(nav: &'a NavData, mut opts: SnapshotOptions) -> Self {
+    /// options have none. Without a single GPS ephemeris in `nav` no satellite can be
+    /// predicted: [`SnapshotError::NoEphemerides`].
+    pub fn new(nav: &'a NavData, mut opts: SnapshotOptions) -> Result<Self, SnapshotError> {
+        if nav.ephemerides.is_empty() {
+            return Err(SnapshotError::NoEphemerides);
+        }
         if opts.solve.pvt.iono.is_none() {
             opts.solve.pvt.iono = nav.iono;
         }
-        Self {
+        Ok(Self {
             nav,
             opts,
             engines: HashMap::new(),
-        }
+        })
     }
 
     /// Processes `snapshots` in order from `seed` (module docs: seeding), then, when the
@@ -238,7 +243,7 @@ impl<'a> SnapshotProcessor<'a> {
             .map(|t| t.add_seconds(seed.time_correction_s))
             .or(seed.time);
         let Some(t_a) = apriori_time else {
-            let reason = "no time: give --time WEEK:TOW".into();
+            let reason = "no a-priori time: the snapshot carries none and none was given".into();
             return (SnapshotOutcome::none(s, None, reason), None);
         };
         if let Some(reason) = unusable(s) {
@@ -361,7 +366,7 @@ impl<'a> SnapshotProcessor<'a> {
         if pred.len() < gpsrx_nav::pvt::coarse_time::MIN_SATELLITES {
             return Err(format!(
                 "{} satellites with an ephemeris above the horizon at the a-priori time: \
-                 check --nav and --time",
+                 check the navigation data and the a-priori time",
                 pred.len()
             ));
         }

@@ -43,6 +43,12 @@ pub enum SnapshotError {
         /// What went wrong.
         reason: String,
     },
+    /// No navigation data with a GPS ephemeris were given: no satellite can be predicted.
+    #[error(
+        "no navigation data were given (no GPS ephemeris): snapshot positioning needs the \
+         broadcast ephemerides of the day, from a RINEX navigation file"
+    )]
+    NoEphemerides,
     /// An option out of range.
     #[error("{0}")]
     Option(String),
