@@ -341,7 +341,13 @@ impl<'a> SnapshotProcessor<'a> {
             &acq.predicted,
             &have,
         );
-        let extra = look_at_predicted(&s.samples, s.fs_hz, offset, &missed);
+        let extra = look_at_predicted(
+            &s.samples,
+            s.fs_hz,
+            offset,
+            &missed,
+            self.opts.measure.code_band_hz,
+        );
         if extra.is_empty() {
             return o;
         }
@@ -398,6 +404,7 @@ impl<'a> SnapshotProcessor<'a> {
             &cfg,
             self.opts.fe_offset_max_hz,
             self.opts.measure.max_speed_mps,
+            self.opts.measure.code_band_hz,
         )
         .map_err(|e| e.to_string())
     }

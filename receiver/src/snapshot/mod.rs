@@ -6,6 +6,7 @@
 //!   (many snapshots, device timestamps) and their truth files;
 //! - [`measure`]: assisted acquisition of one snapshot (sub-sample code phase, common
 //!   front-end offset, narrow second search, false-peak rejection);
+//! - [`fine_phase`]: the sub-sample code phase from a band-limited matched replica;
 //! - [`solve`]: the coarse-time fix ([`gpsrx_nav::pvt::coarse_time`]) and its checks;
 //! - [`driver`]: a sequence of snapshots, each good fix seeding the next;
 //! - [`clock`]: the device clock's error from the sequence's fixes (a second pass);
@@ -20,6 +21,7 @@
 
 pub mod clock;
 pub mod driver;
+pub mod fine_phase;
 pub mod input;
 pub mod measure;
 pub mod output;
