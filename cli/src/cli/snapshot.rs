@@ -41,6 +41,11 @@ pub struct SnapshotArgs {
     /// Largest receiver speed, m/s (widens the Doppler checks: 50 m/s adds 263 Hz).
     #[arg(long, value_name = "M/S", default_value_t = 50.0)]
     pub max_speed: f64,
+    /// Smooth the horizontal track across consecutive snapshots (a Rauch-Tung-Striebel
+    /// smoother, constant velocity) with this acceleration sigma, m/s^2 (a walker about 0.5).
+    /// Off by default: every snapshot is positioned alone.
+    #[arg(long, value_name = "M/S2")]
+    pub smooth_accel: Option<f64>,
     /// Coherent integration, ms (default: 1 ms below 40 ms of samples, else 10 ms).
     #[arg(long, value_name = "MS")]
     pub coherent_ms: Option<u32>,

@@ -7,6 +7,7 @@ use gpsrx_nav::pvt::HeightConstraint;
 use gpsrx_nav::{Llh, Vector3};
 use gpsrx_receiver::snapshot::driver::Seed;
 use gpsrx_receiver::snapshot::output::{self, Truth};
+use gpsrx_receiver::snapshot::smooth::{smooth_track, SmoothOptions, DEFAULT_RANGE_SIGMA_M};
 use gpsrx_receiver::snapshot::snappergps::read_snappergps;
 use gpsrx_receiver::snapshot::{
     read_raw_snapshot, SampleSpec, Snapshot, SnapshotOptions, SnapshotProcessor,
@@ -65,6 +66,18 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
             tracing::info!("snapshot {} of {n}", o.index + 1);
         }
     });
+    let mut outcomes = outcomes;
+    let smoothed = match args.smooth_accel {
+        Some(a) if a.is_finite() && a > 0.0 => Some(smooth_track(
+            &mut outcomes,
+            &SmoothOptions {
+                accel_sigma_mps2: a,
+                range_sigma_m: DEFAULT_RANGE_SIGMA_M,
+            },
+        )),
+        Some(a) => bail!("--smooth-accel {a}: give a positive acceleration in m/s^2"),
+        None => None,
+    };
     let elapsed_s = started.elapsed().as_secs_f64();
     let truth = truth(args)?;
     let errors = truth
@@ -91,6 +104,13 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
         elapsed_s,
         s.snapshots as f64 / elapsed_s.max(1e-9)
     )?;
+    if let Some(moved) = smoothed {
+        writeln!(
+            out,
+            "smoothed {moved} fixes across snapshots (acceleration sigma {} m/s^2)",
+            args.smooth_accel.unwrap_or_default()
+        )?;
+    }
     if n == 1 {
         let o = &outcomes[0];
         if let Some(l) = o.llh {

@@ -120,11 +120,21 @@ pub struct SnapshotOutcome {
 impl SnapshotOutcome {
     fn none(s: &Snapshot, apriori_time: Option<GpsTime>, reason: String) -> Self {
         SnapshotOutcome {
-            index: s.index,
             label: s.label.clone(),
             apriori_time,
-            quality: SnapshotQuality::None,
             reason,
+            ..Self::empty(s.index)
+        }
+    }
+
+    /// A row of quality `none` with nothing known, for the snapshot at `index`.
+    pub(crate) fn empty(index: usize) -> Self {
+        SnapshotOutcome {
+            index,
+            label: String::new(),
+            apriori_time: None,
+            quality: SnapshotQuality::None,
+            reason: String::new(),
             time: None,
             time_correction_s: None,
             llh: None,

@@ -8,6 +8,7 @@
 //!   front-end offset, narrow second search, false-peak rejection);
 //! - [`fine_phase`]: the sub-sample code phase from a band-limited matched replica;
 //! - [`solve`]: the coarse-time fix ([`gpsrx_nav::pvt::coarse_time`]) and its checks;
+//! - [`smooth`]: optional smoothing of the track across consecutive snapshots;
 //! - [`driver`]: a sequence of snapshots, each good fix seeding the next;
 //! - [`clock`]: the device clock's error from the sequence's fixes (a second pass);
 //! - [`output`]: `snapshots.csv`, the GeoJSON track, errors against a truth.
@@ -25,6 +26,7 @@ pub mod fine_phase;
 pub mod input;
 pub mod measure;
 pub mod output;
+pub mod smooth;
 pub mod snappergps;
 pub mod solve;
 
