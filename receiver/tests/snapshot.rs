@@ -5,6 +5,7 @@
 use gpsrx_nav::{GpsTime, Llh, NavData};
 use gpsrx_receiver::snapshot::driver::Seed;
 use gpsrx_receiver::snapshot::output::{horizontal_error_m, score, Truth};
+use gpsrx_receiver::snapshot::smooth::{smooth_track, SmoothOptions, DEFAULT_RANGE_SIGMA_M};
 use gpsrx_receiver::snapshot::snappergps::read_snappergps;
 use gpsrx_receiver::snapshot::{
     read_raw_snapshot, SampleSpec, Snapshot, SnapshotOptions, SnapshotProcessor, SnapshotQuality,
@@ -157,7 +158,7 @@ fn simulated_snapshots_are_positioned_from_30_km_and_seconds_away() {
 fn snapshot_table() {
     let nav = nav();
     let truth = Llh::from_degrees(SEOUL[0], SEOUL[1], SEOUL[2]);
-    println!("| format | ms | C/N0 | speed m/s | satellites | quality | horizontal error m | time error ms | reason |");
+    println!("| format | ms | C/N0 | speed m/s | satellites | quality | horizontal error m (parabola fit alone) | time error ms | reason |");
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut seed_no = 100;
     for (format, fs, if_hz) in [("ri1_lsb", 4.092e6, 1.3e6), ("ci2", 4.0e6, 0.0)] {
@@ -173,12 +174,21 @@ fn snapshot_table() {
                     );
                     let mut opts = SnapshotOptions::default();
                     opts.measure.max_speed_mps = 120.0;
+                    // The parabola fit alone, for comparison.
+                    let mut parabola = opts.clone();
+                    parabola.measure.code_band_hz = None;
+                    let mut p =
+                        SnapshotProcessor::new(&nav, parabola).unwrap_or_else(|e| panic!("{e}"));
+                    let before = &p.run(std::slice::from_ref(&snap), seed(2.5), |_| {})[0];
                     let mut p =
                         SnapshotProcessor::new(&nav, opts).unwrap_or_else(|e| panic!("{e}"));
                     let o = &p.run(std::slice::from_ref(&snap), seed(2.5), |_| {})[0];
-                    let e = o.llh.map_or("-".to_string(), |l| {
-                        format!("{:.1}", horizontal_error_m(&l, &truth))
-                    });
+                    let error = |o: &gpsrx_receiver::snapshot::SnapshotOutcome| {
+                        o.llh.map_or("-".to_string(), |l| {
+                            format!("{:.1}", horizontal_error_m(&l, &truth))
+                        })
+                    };
+                    let e = format!("{} ({})", error(o), error(before));
                     let dt = o
                         .time_correction_s
                         .map_or("-".to_string(), |d| format!("{:.1}", (d + 2.5) * 1e3));
@@ -340,11 +350,24 @@ fn snappergps_walk_first_60_snapshots_against_rtk_truth() {
     let errors = truth.errors(&out);
     let s = score(&out, &errors);
     eprintln!("{s:?}");
-    // Measured: 56 of 60, median 18.1 m, 95th percentile 45.5 m (the issue's target of 10 m
-    // median is not reached yet): these bounds guard against regressions.
+    // Each snapshot alone, measured: 56 of 60, median 14.6 m, 95th percentile 24.9 m (17.3
+    // and 45.5 m with the parabola fit alone; the 10 m median of issue 27 is not reached by
+    // single GPS-only snapshots): these bounds guard against regressions.
     assert!(s.fixes >= 54, "{s:?}");
-    assert!(s.median_m <= 25.0 && s.p95_m <= 60.0, "{s:?}");
+    assert!(s.median_m <= 17.0 && s.p95_m <= 30.0, "{s:?}");
     assert!(matches!(truth, Truth::Track { .. }));
+    // Smoothed across snapshots as a walker (0.5 m/s^2), measured: median 5.9 m, 95th
+    // percentile 9.3 m; the issue's acceptance is 10 m and 25 m.
+    let mut smoothed = out.clone();
+    let opts = SmoothOptions {
+        accel_sigma_mps2: 0.5,
+        range_sigma_m: DEFAULT_RANGE_SIGMA_M,
+    };
+    assert!(smooth_track(&mut smoothed, &opts) >= 50);
+    let s = score(&smoothed, &truth.errors(&smoothed));
+    eprintln!("smoothed: {s:?}");
+    assert!(s.fixes >= 54, "{s:?}");
+    assert!(s.median_m <= 10.0 && s.p95_m <= 25.0, "{s:?}");
 }
 
 #[test]
