@@ -413,8 +413,7 @@ impl<'a> SnapshotProcessor<'a> {
             engine,
             &cfg,
             self.opts.fe_offset_max_hz,
-            self.opts.measure.max_speed_mps,
-            self.opts.measure.code_band_hz,
+            &self.opts.measure,
         )
         .map_err(|e| e.to_string())
     }

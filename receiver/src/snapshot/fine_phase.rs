@@ -43,9 +43,9 @@ use rustfft::FftPlanner;
 use std::f64::consts::PI;
 
 /// Half-width of the delay searched around the start, samples.
-pub const SPAN_SAMPLES: f64 = 1.5;
+pub const SPAN_SAMPLES: f64 = 1.0;
 /// Grid step of the first pass, samples.
-pub const GRID_STEP_SAMPLES: f64 = 0.1;
+pub const GRID_STEP_SAMPLES: f64 = 0.25;
 /// Width of the final golden-section bracket, samples.
 pub const TOLERANCE_SAMPLES: f64 = 1e-3;
 

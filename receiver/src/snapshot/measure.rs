@@ -222,10 +222,9 @@ pub fn acquire_snapshot(
     wide: &AcquisitionEngine,
     narrow_config: &AcqConfig,
     fe_offset_max_hz: f64,
-    max_speed_mps: f64,
-    code_band_hz: Option<f64>,
+    opts: &MeasureOptions,
 ) -> Result<SnapshotAcquisition, gpsrx_dsp::acquisition::AcqError> {
-    let tol = doppler_tolerance_hz(max_speed_mps);
+    let tol = doppler_tolerance_hz(opts.max_speed_mps);
     let narrow_hz = NARROW_WINDOW_HZ + (tol - DOPPLER_TOLERANCE_HZ);
     let targets: Vec<SearchTarget> = pred.iter().map(|p| SearchTarget::full(p.prn)).collect();
     let mut results = wide.search(samples, &targets)?;
@@ -280,7 +279,7 @@ pub fn acquire_snapshot(
         ) {
             s.code_phase_samples = tau;
         }
-        s.code_phase_samples = refine(samples, wide.fs_hz(), s, code_band_hz);
+        s.code_phase_samples = refine(samples, wide.fs_hz(), s, opts.code_band_hz);
     }
     Ok(acq)
 }

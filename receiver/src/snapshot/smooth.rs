@@ -102,9 +102,12 @@ pub fn smooth_track(outcomes: &mut [SnapshotOutcome], opts: &SmoothOptions) -> u
     moved
 }
 
+/// One axis of the gate's forward filter: state, covariance, time of the last fix used.
+type AxisState = Option<(Vector2<f64>, Matrix2<f64>, f64)>;
+
 /// Which fixes fail the innovation test of a forward filter on both axes together.
 fn gate(meas: &[(f64, [f64; 2], f64)], q: f64) -> Vec<bool> {
-    let mut state: [Option<(Vector2<f64>, Matrix2<f64>, f64)>; 2] = [None, None];
+    let mut state: [AxisState; 2] = [None, None];
     meas.iter()
         .map(|&(t, z, r)| {
             let mut nis = 0.0;
