@@ -6,8 +6,8 @@
 //! `gpsrx bench` measures the full 60 s recording the same way.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use gpsrx_cli::commands::simulate::simulate;
 use gpsrx_receiver::output::FileSink;
+use gpsrx_receiver::simulate::simulate;
 use gpsrx_receiver::{Assistance, Receiver, ReceiverConfig};
 use gpsrx_samples::sim::Scenario;
 use gpsrx_samples::{open_source, SourceConfig};
@@ -23,8 +23,8 @@ fn bench_run(c: &mut Criterion) {
     let mut scenario = Scenario::from_toml(SEOUL_SCENARIO_TOML).unwrap_or_else(|e| panic!("{e}"));
     scenario.nav = "builtin:brdc0010.22n".into();
     scenario.duration_s = DURATION_S;
-    let sim =
-        simulate(&scenario, Path::new(""), dir.path(), false).unwrap_or_else(|e| panic!("{e:#}"));
+    let (sim, _) = simulate(&scenario, Path::new(""), dir.path(), &|_| ())
+        .unwrap_or_else(|e| panic!("{}", gpsrx_receiver::error_message(&e)));
     let mut config = ReceiverConfig::default();
     config.run.week = Some(scenario.start_time().unwrap_or_else(|e| panic!("{e}")).week);
     let out = dir.path().join("run");

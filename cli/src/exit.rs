@@ -8,6 +8,9 @@
 //! | 2 | `gpsrx run` (or `gpsrx demo`) processed the recording but made no valid fix (the summary says why) |
 //! | 130 | a second Ctrl-C |
 
+use gpsrx_receiver::config::ConfigError;
+use gpsrx_receiver::snapshot::SnapshotError;
+use gpsrx_samples::SampleError;
 use std::io::{self, Write};
 
 /// The exit status of `gpsrx run` when it ran to the end without a valid fix.
@@ -41,22 +44,59 @@ pub fn is_broken_pipe(e: &anyhow::Error) -> bool {
     })
 }
 
-/// The error and its causes on one line, `outer: cause: root`, each text once: a cause whose
-/// text its outer message already includes (errors that print their source and also return
-/// it as their source) is left out.
+/// The error and its causes on one line, `outer: cause: root`, each text once
+/// ([`gpsrx_receiver::error_message`]), followed by the command-line option that gives what
+/// the library says is missing or wrong ([`option_hint`]).
 pub fn error_message(e: &anyhow::Error) -> String {
-    let mut text = String::new();
-    for cause in e.chain() {
-        let c = cause.to_string();
-        if c.is_empty() || text.contains(&c) {
-            continue;
-        }
-        if !text.is_empty() {
-            text.push_str(": ");
-        }
-        text.push_str(&c);
+    let text = gpsrx_receiver::error_message(e.as_ref());
+    match option_hint(e) {
+        Some(option) => format!("{text} (option {option})"),
+        None => text,
     }
-    text
+}
+
+/// The command-line option behind an error, from the variant of the first cause that has one:
+/// the library's messages describe the input ("no sampling rate known", "no navigation data
+/// were given"), not the flag that gives it.
+pub fn option_hint(e: &anyhow::Error) -> Option<&'static str> {
+    e.chain().find_map(option_for)
+}
+
+/// See [`option_hint`].
+fn option_for(cause: &(dyn std::error::Error + 'static)) -> Option<&'static str> {
+    if let Some(e) = cause.downcast_ref::<SampleError>() {
+        return match e {
+            SampleError::FormatUnknown { .. } => Some("--format"),
+            SampleError::SampleRateUnknown { .. } | SampleError::BadSampleRate { .. } => {
+                Some("--fs HZ")
+            }
+            SampleError::StreamNeedsFormatAndRate {
+                format_missing,
+                rate_missing,
+                ..
+            } => match (format_missing, rate_missing) {
+                (true, true) => Some("--format and --fs HZ"),
+                (true, false) => Some("--format"),
+                _ => Some("--fs HZ"),
+            },
+            SampleError::IfOutOfRange { .. } => Some("--if HZ (and --fs HZ)"),
+            SampleError::IfConflict { .. } => Some("--if HZ: leave it out to use the metadata"),
+            SampleError::SkipBeyondEnd { .. } => Some("--skip S"),
+            _ => None,
+        };
+    }
+    if let Some(ConfigError::Setting { key, .. }) = cause.downcast_ref::<ConfigError>() {
+        return match *key {
+            "[run] week" => Some("--week WEEK"),
+            "[run] approx_time" => Some("--time WEEK:TOW"),
+            "[run] approx_llh" => Some("--approx-llh LAT,LON,H"),
+            _ => None,
+        };
+    }
+    if let Some(SnapshotError::NoEphemerides) = cause.downcast_ref::<SnapshotError>() {
+        return Some("--nav FILE");
+    }
+    None
 }
 
 /// Standard output for the commands' results: a write error says it was standard output

@@ -2,12 +2,12 @@
 //! `gpsrx run --ins` through a 5 g turn with narrow loops, aided and unaided.
 
 use crate::common::{run, run_report, truth};
-use gpsrx_cli::commands::simulate::write_ins_for;
 use gpsrx_ins_aiding::error_model::InsErrorConfig;
 use gpsrx_ins_aiding::read_ins_csv;
 use gpsrx_nav::rinex_nav::parse_rinex_nav;
 use gpsrx_receiver::output::Fix;
 use gpsrx_receiver::pipeline::aiding::InsFeedForward;
+use gpsrx_receiver::simulate::write_ins_for;
 use gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT;
 use gpsrx_samples::sim::{Scenario, Simulator};
 use std::path::{Path, PathBuf};

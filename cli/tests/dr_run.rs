@@ -2,8 +2,8 @@
 //! satellite and its DR and accelerometer logs from the simulator, against the truth.
 
 use crate::common::{run, truth};
-use gpsrx_cli::commands::simulate::simulate_with_sensors;
 use gpsrx_nav::frames::{enu_rotation, Llh, Vector3};
+use gpsrx_receiver::simulate::simulate;
 use gpsrx_samples::sim::Scenario;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -50,7 +50,7 @@ fn fused_fixes_continue_through_a_30_s_outage_within_metres_of_the_truth() {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
     let (sc, base) = Scenario::load(&scenario_path()).unwrap_or_else(|e| panic!("{e}"));
     let (report, sensors) =
-        simulate_with_sensors(&sc, &base, dir.path(), false).unwrap_or_else(|e| panic!("{e:#}"));
+        simulate(&sc, &base, dir.path(), &|_| ()).unwrap_or_else(|e| panic!("{e}"));
     let dr = sensors
         .dr
         .unwrap_or_else(|| panic!("the scenario has a [dr] table"));

@@ -1,8 +1,10 @@
 //! `gpsrx simulate` with an `[ins]` table: `ins.csv` against `truth.csv`.
 
-use gpsrx_cli::commands::simulate::{ins_config, simulate, simulate_with_ins};
 use gpsrx_ins_aiding::read_ins_csv;
+use gpsrx_receiver::error_message;
+use gpsrx_receiver::simulate::{ins_config, simulate, InsOutput};
 use gpsrx_samples::sim::Scenario;
+use gpsrx_samples::sim::SimReport;
 use std::path::Path;
 
 /// Start of every scenario here (geodetic, WGS-84).
@@ -81,8 +83,7 @@ fn ins_csv_is_truth_plus_bias_times_t() {
         "rate_hz = 50.0\naccel_bias_enu_mps2 = [{be}, {bn}, {bu}]"
     )));
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let (report, ins) = simulate_with_ins(&sc, Path::new("."), dir.path(), false)
-        .unwrap_or_else(|e| panic!("{e:#}"));
+    let (report, ins) = simulate_with_ins(&sc, dir.path());
     let ins = ins.unwrap_or_else(|| panic!("no ins.csv written"));
     assert_eq!(ins.path, dir.path().join("ins.csv"));
     assert_eq!(ins.rows, 101);
@@ -143,8 +144,7 @@ fn scenario_without_ins_writes_no_ins_csv() {
     let sc = load(&text);
     assert!(sc.ins.is_none());
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let (_, ins) = simulate_with_ins(&sc, Path::new("."), dir.path(), false)
-        .unwrap_or_else(|e| panic!("{e:#}"));
+    let (_, ins) = simulate_with_ins(&sc, dir.path());
     assert!(ins.is_none());
     assert!(!dir.path().join("ins.csv").exists());
 }
@@ -179,14 +179,14 @@ fn bad_ins_tables_are_named_before_simulating() {
         let sc = load(&scenario_text(body));
         let e = ins_config(&sc)
             .err()
-            .map(|e| format!("{e:#}"))
+            .map(|e| error_message(&e))
             .unwrap_or_default();
         assert!(e.contains(needle), "{body}: {e} (wanted {needle})");
         assert!(e.contains("[ins]"), "{body}: {e}");
         let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-        let e = simulate(&sc, Path::new("."), dir.path(), false)
+        let e = simulate(&sc, Path::new("."), dir.path(), &|_| ())
             .err()
-            .map(|e| format!("{e:#}"))
+            .map(|e| error_message(&e))
             .unwrap_or_default();
         assert!(e.contains(needle), "{body}: {e}");
         // Nothing was simulated.
@@ -225,4 +225,11 @@ fn gpsrx_simulate_prints_the_ins_file() {
     assert!(stdout.contains(&line), "{stdout}");
     let track = read_ins_csv(&out.join("ins.csv"), 0.5).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(track.span_s(), (0.0, 1.0));
+}
+
+/// Simulates `sc` into `dir` and returns the report and the `ins.csv` written, if any.
+fn simulate_with_ins(sc: &Scenario, dir: &Path) -> (SimReport, Option<InsOutput>) {
+    let (report, sensors) = simulate(sc, Path::new("."), dir, &|_| ())
+        .unwrap_or_else(|e| panic!("{}", error_message(&e)));
+    (report, sensors.ins)
 }

@@ -58,7 +58,7 @@ fn bad_snappergps_snapshots_give_rows_with_reasons() {
     }
     assert!(rows[1].contains("too short"), "{}", rows[1]);
     assert!(rows[3].contains("too short"), "{}", rows[3]);
-    assert!(rows[4].contains("no time"), "{}", rows[4]);
+    assert!(rows[4].contains("no a-priori time"), "{}", rows[4]);
     // The constant snapshot has signal power but no satellite.
     assert!(rows[2].contains("satellites"), "{}", rows[2]);
     for f in ["track.geojson", "track.kml", "track.gpx"] {
@@ -87,4 +87,46 @@ fn a_file_that_is_not_snappergps_json_is_one_error_line() {
         err.contains("not a SnapperGPS JSON file") && !err.contains("panicked"),
         "{err}"
     );
+}
+
+#[test]
+fn a_missing_navigation_file_is_named_by_its_option_on_the_command_line_only() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let input = dir.path().join("snaps.json");
+    std::fs::write(
+        &input,
+        r#"{"deviceID": "test", "snapshots": [{"timestamp": "2022-01-01T12:29:30.000Z", "data": "AAAA"}]}"#,
+    )
+    .expect("write");
+    let o = gpsrx()
+        .args(["snapshot", &input.display().to_string()])
+        .args([
+            "--approx-llh",
+            "37.5,127.0,40",
+            "--out",
+            &dir.path().join("o").display().to_string(),
+        ])
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    // The command line: what is missing, then the option that gives it.
+    assert!(
+        err.contains("no navigation data were given")
+            && err.trim_end().ends_with("(option --nav FILE)"),
+        "{err}"
+    );
+    // The library's message (as Python raises it) describes the data and names no option.
+    let library = gpsrx_receiver::snapshot::SnapshotProcessor::new(
+        &gpsrx_nav::NavData::default(),
+        gpsrx_receiver::snapshot::SnapshotOptions::default(),
+    )
+    .err()
+    .map(|e| gpsrx_receiver::error_message(&e))
+    .unwrap_or_default();
+    assert!(
+        library.contains("no navigation data were given"),
+        "{library}"
+    );
+    assert!(!library.contains("--"), "{library}");
 }

@@ -2,7 +2,8 @@
 //! `FileNotFoundError`, another unreadable file `OSError`, a bad value or option `ValueError`,
 //! anything else `gpsrx.Error`.
 
-use gpsrx_receiver::batch::{error_chain, RecordingError};
+use gpsrx_receiver::batch::RecordingError;
+use gpsrx_receiver::error_message;
 use gpsrx_receiver::ReceiverError;
 use gpsrx_samples::SampleError;
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
@@ -26,7 +27,7 @@ pub fn sample_error(e: &SampleError, message: String) -> PyErr {
 
 /// The Python exception of a receiver error.
 pub fn receiver_error(e: &ReceiverError) -> PyErr {
-    let message = error_chain(e);
+    let message = error_message(e);
     match e {
         ReceiverError::Config(_) | ReceiverError::RateMismatch { .. } => {
             PyValueError::new_err(message)
@@ -39,7 +40,7 @@ pub fn receiver_error(e: &ReceiverError) -> PyErr {
 
 /// The Python exception of a recording that cannot be processed.
 pub fn recording_error(e: &RecordingError) -> PyErr {
-    let message = error_chain(e);
+    let message = error_message(e);
     match e {
         RecordingError::Config(gpsrx_receiver::config::ConfigError::Read { .. }) => {
             PyOSError::new_err(message)

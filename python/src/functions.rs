@@ -211,10 +211,8 @@ pub fn simulate<'py>(
         sc.output.fs_hz = f;
     }
     let (report, sensors) = py
-        .detach(|| {
-            gpsrx_cli::commands::simulate::simulate_with_sensors(&sc, &base, &out_dir, false)
-        })
-        .map_err(|e| Error::new_err(gpsrx_cli::exit::error_message(&e)))?;
+        .detach(|| gpsrx_receiver::simulate::simulate(&sc, &base, &out_dir, &|_| ()))
+        .map_err(|e| Error::new_err(gpsrx_receiver::error_message(&e)))?;
     let mut v = serde_json::to_value(&report).map_err(|e| Error::new_err(e.to_string()))?;
     let sensors = serde_json::to_value(&sensors).map_err(|e| Error::new_err(e.to_string()))?;
     if let (Some(map), serde_json::Value::Object(s)) = (v.as_object_mut(), sensors) {

@@ -162,6 +162,15 @@ pub enum ConfigError {
     /// A value out of its range.
     #[error("{0}")]
     Invalid(String),
+    /// A setting a front end may also take from its own input (a command-line option, a
+    /// keyword) out of its range: `key` names it in the configuration file.
+    #[error("{key}: {message}")]
+    Setting {
+        /// The setting in the configuration file, e.g. `[run] week`.
+        key: &'static str,
+        /// The value and its valid range.
+        message: String,
+    },
 }
 
 impl ReceiverConfig {
@@ -330,17 +339,26 @@ impl RunSettings {
             return bad(format!("PRN {p}: GPS PRNs are 1 to 32"));
         }
         if let Some(t) = self.approx_time {
-            check_approx_time(&t).map_err(ConfigError::Invalid)?;
+            check_approx_time(&t).map_err(|message| ConfigError::Setting {
+                key: "[run] approx_time",
+                message,
+            })?;
         }
         if let Some(llh) = self.approx_llh {
-            check_approx_llh(&llh).map_err(ConfigError::Invalid)?;
+            check_approx_llh(&llh).map_err(|message| ConfigError::Setting {
+                key: "[run] approx_llh",
+                message,
+            })?;
         }
         if let Some(w) = self.week {
             let (lo, hi) = WEEK_RANGE;
             if !(lo..=hi).contains(&w) {
-                return bad(format!(
-                    "GPS week {w} (--week, [run] week): give the full week number, {lo} to {hi} (e.g. 2190 for 1 January 2022)"
-                ));
+                return Err(ConfigError::Setting {
+                    key: "[run] week",
+                    message: format!(
+                        "GPS week {w}: give the full week number, {lo} to {hi} (e.g. 2190 for 1 January 2022)"
+                    ),
+                });
             }
         }
         Ok(())
@@ -351,43 +369,41 @@ impl RunSettings {
 /// the Earth's surface).
 pub const APPROX_HEIGHT_RANGE_M: (f64, f64) = (-1000.0, 100_000.0);
 
-/// Checks an approximate time (`--time`, `[run] approx_time`): a full week in [`WEEK_RANGE`]
+/// Checks an approximate time (`[run] approx_time`): a full week in [`WEEK_RANGE`]
 /// and a time of week in [0, 604800) s.
 pub fn check_approx_time(t: &gpsrx_nav::time::GpsTime) -> Result<(), String> {
     let (lo, hi) = WEEK_RANGE;
     if !(lo..=hi).contains(&t.week) {
         return Err(format!(
-            "approximate time week {} (--time WEEK:TOW, [run] approx_time): give the full GPS week, {lo} to {hi} (e.g. 2190:538200)",
+            "approximate time week {}: give the full GPS week, {lo} to {hi} (e.g. 2190:538200)",
             t.week
         ));
     }
     if !(t.tow_s.is_finite() && (0.0..604_800.0).contains(&t.tow_s)) {
         return Err(format!(
-            "approximate time of week {} s (--time WEEK:TOW, [run] approx_time): use 0 to 604800 s",
+            "approximate time of week {} s: use 0 to 604800 s",
             t.tow_s
         ));
     }
     Ok(())
 }
 
-/// Checks an approximate position (`--approx-llh`, `[run] approx_llh`): latitude within
+/// Checks an approximate position (`[run] approx_llh`): latitude within
 /// +-90 deg, longitude within +-180 deg, height in [`APPROX_HEIGHT_RANGE_M`].
 pub fn check_approx_llh(llh: &[f64; 3]) -> Result<(), String> {
     let [lat, lon, h] = *llh;
     let (hlo, hhi) = APPROX_HEIGHT_RANGE_M;
     if !(lat.is_finite() && lat.abs() <= 90.0) {
-        return Err(format!(
-            "approximate latitude {lat} deg (--approx-llh LAT,LON,H, [run] approx_llh): use -90 to 90 deg"
-        ));
+        return Err(format!("approximate latitude {lat} deg: use -90 to 90 deg"));
     }
     if !(lon.is_finite() && lon.abs() <= 180.0) {
         return Err(format!(
-            "approximate longitude {lon} deg (--approx-llh LAT,LON,H, [run] approx_llh): use -180 to 180 deg"
+            "approximate longitude {lon} deg: use -180 to 180 deg"
         ));
     }
     if !(h.is_finite() && (hlo..=hhi).contains(&h)) {
         return Err(format!(
-            "approximate height {h} m (--approx-llh LAT,LON,H, [run] approx_llh): use {hlo} to {hhi} m above the ellipsoid"
+            "approximate height {h} m: use {hlo} to {hhi} m above the ellipsoid"
         ));
     }
     Ok(())

@@ -5,7 +5,10 @@
 //! - [`output`]: RINEX, NMEA, GeoJSON, KML and CSV writers;
 //! - [`fusion`]: GNSS/dead-reckoning fusion after tracking (seeds 000 and 002);
 //! - [`landmarks`]: landmark range observations for the solver (seed 001);
-//! - [`batch`]: batches of recordings from a manifest (`gpsrx batch`, the Python package).
+//! - [`batch`]: batches of recordings from a manifest (`gpsrx batch`, the Python package);
+//! - [`simulate`]: a scenario into an IF recording, its truth and the simulated sensor logs
+//!   (`gpsrx simulate`, the Python package, the benchmarks);
+//! - [`error_message`]: an error and its causes as one message.
 //!
 //! # Example: the whole receiver in memory
 //!
@@ -67,9 +70,12 @@ pub mod batch;
 pub mod config;
 pub mod fusion;
 pub mod landmarks;
+mod message;
 pub mod output;
 pub mod pipeline;
+pub mod simulate;
 pub mod snapshot;
 
 pub use config::ReceiverConfig;
+pub use message::error_message;
 pub use pipeline::{Assistance, MemorySink, Receiver, ReceiverError, RunSummary, Sink};

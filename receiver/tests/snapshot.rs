@@ -5,6 +5,7 @@
 use gpsrx_nav::{GpsTime, Llh, NavData};
 use gpsrx_receiver::snapshot::driver::Seed;
 use gpsrx_receiver::snapshot::output::{horizontal_error_m, score, Truth};
+use gpsrx_receiver::snapshot::smooth::{smooth_track, SmoothOptions, DEFAULT_RANGE_SIGMA_M};
 use gpsrx_receiver::snapshot::snappergps::read_snappergps;
 use gpsrx_receiver::snapshot::{
     read_raw_snapshot, SampleSpec, Snapshot, SnapshotOptions, SnapshotProcessor, SnapshotQuality,
@@ -113,7 +114,8 @@ fn seed(dt_s: f64) -> Seed {
 fn simulated_snapshots_are_positioned_from_30_km_and_seconds_away() {
     let nav = nav();
     let truth = Llh::from_degrees(SEOUL[0], SEOUL[1], SEOUL[2]);
-    // Cases and the largest horizontal error accepted, m (measured: 6.5, 17.9, 6.6 m).
+    // Cases and the largest horizontal error accepted, m (measured: 8.7, 16.5, 9.5 m; 6.5,
+    // 17.9, 6.6 m with the parabola fit alone).
     let cases = [
         (case("ci2", 4.0e6, 0.0, 10.0, 42.0, 0.0), 30.0),
         (case("ri1_lsb", 4.092e6, 1.3e6, 20.0, 45.0, 0.0), 40.0),
@@ -129,7 +131,8 @@ fn simulated_snapshots_are_positioned_from_30_km_and_seconds_away() {
         } = *c;
         let dir = tempfile::tempdir().expect("tempdir");
         let snap = simulate(dir.path(), c, 11 + k as u64);
-        let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+        let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default())
+            .unwrap_or_else(|e| panic!("{e}"));
         let out = p.run(std::slice::from_ref(&snap), seed(2.5), |_| {});
         let o = &out[0];
         assert_eq!(o.quality, SnapshotQuality::Fix, "{format}: {}", o.reason);
@@ -156,7 +159,7 @@ fn simulated_snapshots_are_positioned_from_30_km_and_seconds_away() {
 fn snapshot_table() {
     let nav = nav();
     let truth = Llh::from_degrees(SEOUL[0], SEOUL[1], SEOUL[2]);
-    println!("| format | ms | C/N0 | speed m/s | satellites | quality | horizontal error m | time error ms | reason |");
+    println!("| format | ms | C/N0 | speed m/s | satellites | quality | horizontal error m (parabola fit alone) | time error ms | reason |");
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut seed_no = 100;
     for (format, fs, if_hz) in [("ri1_lsb", 4.092e6, 1.3e6), ("ci2", 4.0e6, 0.0)] {
@@ -172,11 +175,21 @@ fn snapshot_table() {
                     );
                     let mut opts = SnapshotOptions::default();
                     opts.measure.max_speed_mps = 120.0;
-                    let mut p = SnapshotProcessor::new(&nav, opts);
+                    // The parabola fit alone, for comparison.
+                    let mut parabola = opts.clone();
+                    parabola.measure.code_band_hz = None;
+                    let mut p =
+                        SnapshotProcessor::new(&nav, parabola).unwrap_or_else(|e| panic!("{e}"));
+                    let before = &p.run(std::slice::from_ref(&snap), seed(2.5), |_| {})[0];
+                    let mut p =
+                        SnapshotProcessor::new(&nav, opts).unwrap_or_else(|e| panic!("{e}"));
                     let o = &p.run(std::slice::from_ref(&snap), seed(2.5), |_| {})[0];
-                    let e = o.llh.map_or("-".to_string(), |l| {
-                        format!("{:.1}", horizontal_error_m(&l, &truth))
-                    });
+                    let error = |o: &gpsrx_receiver::snapshot::SnapshotOutcome| {
+                        o.llh.map_or("-".to_string(), |l| {
+                            format!("{:.1}", horizontal_error_m(&l, &truth))
+                        })
+                    };
+                    let e = format!("{} ({})", error(o), error(before));
                     let dt = o
                         .time_correction_s
                         .map_or("-".to_string(), |d| format!("{:.1}", (d + 2.5) * 1e3));
@@ -224,7 +237,8 @@ fn bad_snapshots_give_rows_with_reasons_and_do_not_move_the_seed() {
         with(Vec::new(), 4),
         with(good.samples.clone(), 5),
     ];
-    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+    let mut p =
+        SnapshotProcessor::new(&nav, SnapshotOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let out = p.run(&snaps, seed(1.0), |_| {});
     assert_eq!(out.len(), 6);
     let q: Vec<SnapshotQuality> = out.iter().map(|o| o.quality).collect();
@@ -250,7 +264,18 @@ fn bad_snapshots_give_rows_with_reasons_and_do_not_move_the_seed() {
     };
     let o = p.run(&snaps[..1], no_time, |_| {});
     assert_eq!(o[0].quality, None);
-    assert!(o[0].reason.contains("--time"), "{}", o[0].reason);
+    assert!(o[0].reason.contains("no a-priori time"), "{}", o[0].reason);
+    assert!(!o[0].reason.contains("--"), "{}", o[0].reason);
+}
+
+#[test]
+fn navigation_data_without_an_ephemeris_is_an_error_that_names_no_flag() {
+    let e = SnapshotProcessor::new(&NavData::default(), SnapshotOptions::default())
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(e.contains("no navigation data were given"), "{e}");
+    assert!(!e.contains("--"), "{e}");
 }
 
 #[test]
@@ -258,7 +283,8 @@ fn an_apriori_beyond_the_limits_gives_no_fix() {
     let nav = nav();
     let dir = tempfile::tempdir().expect("tempdir");
     let snap = simulate(dir.path(), &case("ci2", 4.0e6, 0.0, 10.0, 44.0, 0.0), 9);
-    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+    let mut p =
+        SnapshotProcessor::new(&nav, SnapshotOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     // 1000 km away (Beijing is ~950 km from Seoul), the right time.
     let far = Seed {
         pos_ecef_m: Llh::from_degrees(39.9, 116.4, 50.0).to_ecef(),
@@ -314,7 +340,7 @@ fn snappergps_walk_first_60_snapshots_against_rtk_truth() {
         h_m: 112.0,
         sigma_m: 30.0,
     });
-    let mut p = SnapshotProcessor::new(&nav, opts);
+    let mut p = SnapshotProcessor::new(&nav, opts).unwrap_or_else(|e| panic!("{e}"));
     let seed = Seed {
         pos_ecef_m: apriori.to_ecef(),
         time_correction_s: 0.0,
@@ -325,11 +351,24 @@ fn snappergps_walk_first_60_snapshots_against_rtk_truth() {
     let errors = truth.errors(&out);
     let s = score(&out, &errors);
     eprintln!("{s:?}");
-    // Measured: 56 of 60, median 18.1 m, 95th percentile 45.5 m (the issue's target of 10 m
-    // median is not reached yet): these bounds guard against regressions.
+    // Each snapshot alone, measured: 56 of 60, median 14.7 m, 95th percentile 25.0 m (17.3
+    // and 45.5 m with the parabola fit alone; the 10 m median of issue 27 is not reached by
+    // single GPS-only snapshots): these bounds guard against regressions.
     assert!(s.fixes >= 54, "{s:?}");
-    assert!(s.median_m <= 25.0 && s.p95_m <= 60.0, "{s:?}");
+    assert!(s.median_m <= 17.0 && s.p95_m <= 30.0, "{s:?}");
     assert!(matches!(truth, Truth::Track { .. }));
+    // Smoothed across snapshots as a walker (0.5 m/s^2), measured: median 6.0 m, 95th
+    // percentile 9.3 m; the issue's acceptance is 10 m and 25 m.
+    let mut smoothed = out.clone();
+    let opts = SmoothOptions {
+        accel_sigma_mps2: 0.5,
+        range_sigma_m: DEFAULT_RANGE_SIGMA_M,
+    };
+    assert!(smooth_track(&mut smoothed, &opts) >= 50);
+    let s = score(&smoothed, &truth.errors(&smoothed));
+    eprintln!("smoothed: {s:?}");
+    assert!(s.fixes >= 54, "{s:?}");
+    assert!(s.median_m <= 10.0 && s.p95_m <= 25.0, "{s:?}");
 }
 
 #[test]
@@ -354,7 +393,8 @@ fn airborne_capture_within_50_m_of_the_reference() {
     // The time 3 s late and the position 35 km off.
     let t = GpsTime::new(1672, 391_561.0);
     let snap = read_raw_snapshot(&stream, &spec, Some(t)).expect("capture");
-    let mut p = SnapshotProcessor::new(&nav, SnapshotOptions::default());
+    let mut p =
+        SnapshotProcessor::new(&nav, SnapshotOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let seed = Seed {
         pos_ecef_m: Llh::from_degrees(52.6, 10.9, 0.0).to_ecef(),
         time_correction_s: 0.0,

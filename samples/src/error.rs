@@ -71,14 +71,14 @@ pub enum SampleError {
     },
 
     /// Neither the configuration nor any metadata beside the file says how samples are stored.
-    #[error("no sample format known for {path} (no --format, no .sigmf-meta beside it, not a WAV file): give --format, one of {}", crate::format::SampleFormat::SUPPORTED.join(", "))]
+    #[error("no sample format known for {path} (none given, no .sigmf-meta beside it, not a WAV file): give the sample format, one of {}", crate::format::SampleFormat::SUPPORTED.join(", "))]
     FormatUnknown {
         /// The recording.
         path: PathBuf,
     },
 
     /// Neither the configuration nor any metadata beside the file gives the sampling rate.
-    #[error("no sampling rate known for {path} (no --fs, no core:sample_rate in SigMF, not a WAV file): give --fs in Hz")]
+    #[error("no sampling rate known for {path} (none given, no core:sample_rate in SigMF, not a WAV file): give the sampling rate in Hz")]
     SampleRateUnknown {
         /// The recording.
         path: PathBuf,
@@ -86,12 +86,18 @@ pub enum SampleError {
 
     /// Samples streamed from standard input, a pipe or a device, without an explicit format or
     /// sampling rate (a stream has no metadata beside it to take them from).
-    #[error("reading from {stream} needs --format and --fs (a stream has no metadata to take them from): give {missing}")]
+    #[error("reading from {stream} needs the sample format and the sampling rate (a stream has no metadata to take them from): give {}", match (format_missing, rate_missing) {
+        (true, true) => "both",
+        (true, false) => "the sample format",
+        _ => "the sampling rate",
+    })]
     StreamNeedsFormatAndRate {
         /// What is being read: "standard input" or the pipe's path.
         stream: String,
-        /// What was not given: "--format", "--fs" or "--format and --fs".
-        missing: &'static str,
+        /// The sample format was not given.
+        format_missing: bool,
+        /// The sampling rate was not given.
+        rate_missing: bool,
     },
 
     /// A pipe or device path that names a metadata-bearing file (`.sigmf-meta`, `.wav`):
@@ -105,7 +111,7 @@ pub enum SampleError {
     },
 
     /// The sampling rate is not positive and finite, or too low to hold the C/A signal.
-    #[error("sampling rate {fs_hz} Hz for {path} is {reason}: give --fs in Hz (at least {min_hz} Hz for {kind} samples)")]
+    #[error("sampling rate {fs_hz} Hz for {path} is {reason}: give the sampling rate in Hz (at least {min_hz} Hz for {kind} samples)")]
     BadSampleRate {
         /// The recording.
         path: PathBuf,
@@ -121,7 +127,7 @@ pub enum SampleError {
 
     /// The intermediate frequency does not fit the sampling rate.
     #[error(
-        "IF {if_hz} Hz for {path} is outside {allowed} at fs = {fs_hz} Hz: check --if (and --fs)"
+        "IF {if_hz} Hz for {path} is outside {allowed} at fs = {fs_hz} Hz: check the intermediate frequency (and the sampling rate)"
     )]
     IfOutOfRange {
         /// The recording.
@@ -136,7 +142,7 @@ pub enum SampleError {
 
     /// `--if` disagrees with the IF the SigMF metadata describes.
     #[error(
-        "--if {given_hz} Hz for {path} disagrees with the SigMF metadata's IF of {described_hz} Hz (from {field}): drop --if to use the metadata, or correct the .sigmf-meta"
+        "the IF given, {given_hz} Hz, for {path} disagrees with the SigMF metadata's IF of {described_hz} Hz (from {field}): give none to use the metadata, or correct the .sigmf-meta"
     )]
     IfConflict {
         /// The recording.
@@ -161,7 +167,7 @@ pub enum SampleError {
     },
 
     /// The skip lands at or beyond the end of the recording.
-    #[error("skip of {skip_s} s is at or beyond the end of {path}, which holds only {file_duration_s:.6} s ({file_samples} samples): use a smaller --skip")]
+    #[error("skip of {skip_s} s is at or beyond the end of {path}, which holds only {file_duration_s:.6} s ({file_samples} samples): skip less")]
     SkipBeyondEnd {
         /// The recording.
         path: PathBuf,

@@ -50,13 +50,13 @@ pub(crate) fn notes(r: &InfoReport, format: &SampleFormat) -> Vec<String> {
     };
     let dead = |c: &ComponentStats| c.std == 0.0 && c.mean == 0.0;
     if comps.iter().all(|(_, c)| dead(c)) {
-        notes.push("every analysed sample is zero: a dead front end, or the wrong --skip?".into());
+        notes.push("every analysed sample is zero: a dead front end, or the wrong skip?".into());
         return notes;
     }
     if let Some(q) = &r.q {
         if q.std == 0.0 && r.i.std > 0.0 {
             notes.push(format!(
-                "Q is constant ({}): looks like real data read as complex; try a real format (ri8, ri16_le, rf32_le, ri2) with --if",
+                "Q is constant ({}): looks like real data read as complex; try a real format (ri8, ri16_le, rf32_le, ri2) with an IF",
                 q.mean
             ));
         }
@@ -143,7 +143,7 @@ pub(crate) fn notes(r: &InfoReport, format: &SampleFormat) -> Vec<String> {
         }
         if s.peak_bin_over_median_db > LINE_LIMIT_DB {
             notes.push(format!(
-                "narrowband line at {:.4} MHz, {:.1} dB above the median bin: interference, a spur or an IF carrier (is --if right?)",
+                "narrowband line at {:.4} MHz, {:.1} dB above the median bin: interference, a spur or an IF carrier (is the IF given right?)",
                 s.peak_bin_hz / 1e6,
                 s.peak_bin_over_median_db
             ));

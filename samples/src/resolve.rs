@@ -203,7 +203,9 @@ pub fn resolve(cfg: &SourceConfig) -> Result<Resolved, SampleError> {
     let format = match (&cfg.format, described) {
         (Some(f), Some((Ok(d), source))) => {
             if *f != d {
-                warnings.push(format!("--format {f} overrides {d} from the {source}"));
+                warnings.push(format!(
+                    "the sample format given, {f}, overrides {d} from the {source}"
+                ));
             }
             f.clone()
         }
@@ -221,7 +223,9 @@ pub fn resolve(cfg: &SourceConfig) -> Result<Resolved, SampleError> {
     let fs_hz = match (cfg.fs_hz, described_fs) {
         (Some(fs), Some(d)) => {
             if fs != d {
-                warnings.push(format!("--fs {fs} Hz overrides {d} Hz from the metadata"));
+                warnings.push(format!(
+                    "the sampling rate given, {fs} Hz, overrides {d} Hz from the metadata"
+                ));
             }
             fs
         }

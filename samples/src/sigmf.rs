@@ -271,10 +271,10 @@ impl SigmfMeta {
                 .map_err(|_| SampleError::SigmfInvalid {
                     path: meta_path.to_path_buf(),
                     reason: format!(
-                        "core:datatype {:?} is not one gpsrx reads: give --format, one of {}",
-                        self.datatype,
-                        SampleFormat::SUPPORTED.join(", ")
-                    ),
+                    "core:datatype {:?} is not one gpsrx reads: give the sample format, one of {}",
+                    self.datatype,
+                    SampleFormat::SUPPORTED.join(", ")
+                ),
                 })?;
         if let (SampleFormat::Packed2 { map, .. }, Some(m)) = (&mut format, self.packed_map) {
             *map = m;

@@ -237,7 +237,7 @@ fn open_stream_path(cfg: &SourceConfig) -> Result<Box<dyn SampleSource>, SampleE
         return Err(SampleError::NotStreamable {
             path: path.clone(),
             reason: "SigMF metadata and WAV headers are read from regular files only: \
-                     stream the raw samples instead and give --format and --fs"
+                     stream the raw samples instead and give their format and sampling rate"
                 .to_string(),
         });
     }

@@ -75,16 +75,11 @@ impl StreamPlan {
     /// Checks `cfg` for streaming: format and rate given, rate and IF usable, times valid.
     pub(crate) fn new(cfg: &SourceConfig) -> Result<Self, SampleError> {
         let name = stream_name(&cfg.path);
-        let missing = match (&cfg.format, cfg.fs_hz) {
-            (Some(_), Some(_)) => None,
-            (None, Some(_)) => Some("--format"),
-            (Some(_), None) => Some("--fs"),
-            (None, None) => Some("--format and --fs"),
-        };
         let (Some(format), Some(fs_hz)) = (&cfg.format, cfg.fs_hz) else {
             return Err(SampleError::StreamNeedsFormatAndRate {
                 stream: name.display().to_string(),
-                missing: missing.unwrap_or("--format and --fs"),
+                format_missing: cfg.format.is_none(),
+                rate_missing: cfg.fs_hz.is_none(),
             });
         };
         validate_format_and_rates(&name, format, fs_hz, cfg.if_hz)?;

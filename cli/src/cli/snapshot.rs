@@ -8,9 +8,10 @@ pub struct SnapshotArgs {
     /// The snapshots: a SnapperGPS JSON file (`.json`: many snapshots with their timestamps),
     /// or a raw/WAV/SigMF recording holding one snapshot (needs --time unless SigMF).
     pub input: PathBuf,
-    /// RINEX navigation file (broadcast ephemerides of the day; RINEX 2 or 3).
+    /// RINEX navigation file (broadcast ephemerides of the day; RINEX 2 or 3). Needed: without
+    /// it the command says so.
     #[arg(long, value_name = "FILE")]
-    pub nav: PathBuf,
+    pub nav: Option<PathBuf>,
     /// GPS time of the first sample, WEEK:TOW (full week, seconds of week): for a raw
     /// recording; with a SnapperGPS file it replaces the first timestamp (the others keep
     /// their spacing).
@@ -40,6 +41,11 @@ pub struct SnapshotArgs {
     /// Largest receiver speed, m/s (widens the Doppler checks: 50 m/s adds 263 Hz).
     #[arg(long, value_name = "M/S", default_value_t = 50.0)]
     pub max_speed: f64,
+    /// Smooth the horizontal track across consecutive snapshots (a Rauch-Tung-Striebel
+    /// smoother, constant velocity) with this acceleration sigma, m/s^2 (a walker about 0.5).
+    /// Off by default: every snapshot is positioned alone.
+    #[arg(long, value_name = "M/S2")]
+    pub smooth_accel: Option<f64>,
     /// Coherent integration, ms (default: 1 ms below 40 ms of samples, else 10 ms).
     #[arg(long, value_name = "MS")]
     pub coherent_ms: Option<u32>,

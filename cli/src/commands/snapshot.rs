@@ -7,6 +7,7 @@ use gpsrx_nav::pvt::HeightConstraint;
 use gpsrx_nav::{Llh, Vector3};
 use gpsrx_receiver::snapshot::driver::Seed;
 use gpsrx_receiver::snapshot::output::{self, Truth};
+use gpsrx_receiver::snapshot::smooth::{smooth_track, SmoothOptions, DEFAULT_RANGE_SIGMA_M};
 use gpsrx_receiver::snapshot::snappergps::read_snappergps;
 use gpsrx_receiver::snapshot::{
     read_raw_snapshot, SampleSpec, Snapshot, SnapshotOptions, SnapshotProcessor,
@@ -19,8 +20,12 @@ pub use crate::cli::SnapshotArgs;
 
 /// Runs `gpsrx snapshot`.
 pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
-    let nav = gpsrx_nav::read_rinex_nav(&args.nav)
-        .with_context(|| format!("cannot read the navigation file {}", args.nav.display()))?;
+    let nav = match &args.nav {
+        Some(path) => gpsrx_nav::read_rinex_nav(path)
+            .with_context(|| format!("cannot read the navigation file {}", path.display()))?,
+        // The library says what is missing; the error's hint names --nav.
+        None => gpsrx_nav::NavData::default(),
+    };
     let llh = parse_llh(&args.approx_llh)?;
     let time = args.time.as_deref().map(parse_time).transpose()?;
     let snapshots = read_input(args, time)?;
@@ -53,7 +58,7 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
         h_m: llh.h_m,
         sigma_m: args.height_sigma,
     });
-    let mut processor = SnapshotProcessor::new(&nav, opts);
+    let mut processor = SnapshotProcessor::new(&nav, opts)?;
     let started = std::time::Instant::now();
     let n = snapshots.len();
     let outcomes = processor.run(&snapshots, seed, |o| {
@@ -61,6 +66,18 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
             tracing::info!("snapshot {} of {n}", o.index + 1);
         }
     });
+    let mut outcomes = outcomes;
+    let smoothed = match args.smooth_accel {
+        Some(a) if a.is_finite() && a > 0.0 => Some(smooth_track(
+            &mut outcomes,
+            &SmoothOptions {
+                accel_sigma_mps2: a,
+                range_sigma_m: DEFAULT_RANGE_SIGMA_M,
+            },
+        )),
+        Some(a) => bail!("--smooth-accel {a}: give a positive acceleration in m/s^2"),
+        None => None,
+    };
     let elapsed_s = started.elapsed().as_secs_f64();
     let truth = truth(args)?;
     let errors = truth
@@ -87,6 +104,13 @@ pub fn run(args: &SnapshotArgs) -> anyhow::Result<()> {
         elapsed_s,
         s.snapshots as f64 / elapsed_s.max(1e-9)
     )?;
+    if let Some(moved) = smoothed {
+        writeln!(
+            out,
+            "smoothed {moved} fixes across snapshots (acceleration sigma {} m/s^2)",
+            args.smooth_accel.unwrap_or_default()
+        )?;
+    }
     if n == 1 {
         let o = &outcomes[0];
         if let Some(l) = o.llh {

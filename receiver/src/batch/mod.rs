@@ -26,7 +26,7 @@ pub fn process(spec: &RecordingSpec, out_root: &Path) -> BatchRow {
     match run_recording_to(spec, &out) {
         Ok((summary, warnings)) => BatchRow::done(&spec.name, &path, &summary, &warnings),
         Err(e) => {
-            let message = error_chain(&e);
+            let message = crate::error_message(&e);
             tracing::warn!("{}: {message}", spec.name);
             BatchRow::failed(&spec.name, &path, message)
         }
@@ -48,19 +48,4 @@ pub fn run_batch(
             row
         })
         .collect()
-}
-
-/// The error and its causes on one line, each text once.
-pub fn error_chain(e: &dyn std::error::Error) -> String {
-    let mut text = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let t = c.to_string();
-        if !text.contains(&t) {
-            text.push_str(": ");
-            text.push_str(&t);
-        }
-        cause = c.source();
-    }
-    text
 }

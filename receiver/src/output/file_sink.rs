@@ -202,7 +202,7 @@ impl Sink for FileSink {
             }
             None if !self.obs_backlog.is_empty() && !self.obs_week_known => {
                 tracing::warn!(
-                    "observables.rnx not written: the GPS week was never known (no subframe 1 decoded, no SigMF core:datetime, --week or --nav) and RINEX epochs need a date; give --week WEEK or --nav FILE ({} epochs of observables left out)",
+                    "observables.rnx not written: the GPS week was never known (no subframe 1 decoded, no SigMF core:datetime, no week or navigation data given) and RINEX epochs need a date; give the GPS week or the navigation data ({} epochs of observables left out)",
                     self.obs_backlog.len() + self.obs_dropped
                 );
             }

@@ -17,6 +17,7 @@ use super::measure::{
     SnapshotAcquisition,
 };
 use super::solve::{predict_missed, residual_rms_m, solve_snapshot, SnapshotQuality, SolveOptions};
+use super::SnapshotError;
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine};
 use gpsrx_nav::pvt::CoarseTimeSolution;
 use gpsrx_nav::pvt::{PvtOptions, Weighting};
@@ -119,11 +120,21 @@ pub struct SnapshotOutcome {
 impl SnapshotOutcome {
     fn none(s: &Snapshot, apriori_time: Option<GpsTime>, reason: String) -> Self {
         SnapshotOutcome {
-            index: s.index,
             label: s.label.clone(),
             apriori_time,
-            quality: SnapshotQuality::None,
             reason,
+            ..Self::empty(s.index)
+        }
+    }
+
+    /// A row of quality `none` with nothing known, for the snapshot at `index`.
+    pub(crate) fn empty(index: usize) -> Self {
+        SnapshotOutcome {
+            index,
+            label: String::new(),
+            apriori_time: None,
+            quality: SnapshotQuality::None,
+            reason: String::new(),
             time: None,
             time_correction_s: None,
             llh: None,
@@ -158,16 +169,20 @@ pub struct SnapshotProcessor<'a> {
 
 impl<'a> SnapshotProcessor<'a> {
     /// A processor with the ephemerides of `nav`. The ionosphere of `nav` is used when the
-    /// options have none.
-    pub fn new(nav: &'a NavData, mut opts: SnapshotOptions) -> Self {
+    /// options have none. Without a single GPS ephemeris in `nav` no satellite can be
+    /// predicted: [`SnapshotError::NoEphemerides`].
+    pub fn new(nav: &'a NavData, mut opts: SnapshotOptions) -> Result<Self, SnapshotError> {
+        if nav.ephemerides.is_empty() {
+            return Err(SnapshotError::NoEphemerides);
+        }
         if opts.solve.pvt.iono.is_none() {
             opts.solve.pvt.iono = nav.iono;
         }
-        Self {
+        Ok(Self {
             nav,
             opts,
             engines: HashMap::new(),
-        }
+        })
     }
 
     /// Processes `snapshots` in order from `seed` (module docs: seeding), then, when the
@@ -238,7 +253,7 @@ impl<'a> SnapshotProcessor<'a> {
             .map(|t| t.add_seconds(seed.time_correction_s))
             .or(seed.time);
         let Some(t_a) = apriori_time else {
-            let reason = "no time: give --time WEEK:TOW".into();
+            let reason = "no a-priori time: the snapshot carries none and none was given".into();
             return (SnapshotOutcome::none(s, None, reason), None);
         };
         if let Some(reason) = unusable(s) {
@@ -336,7 +351,13 @@ impl<'a> SnapshotProcessor<'a> {
             &acq.predicted,
             &have,
         );
-        let extra = look_at_predicted(&s.samples, s.fs_hz, offset, &missed);
+        let extra = look_at_predicted(
+            &s.samples,
+            s.fs_hz,
+            offset,
+            &missed,
+            self.opts.measure.code_band_hz,
+        );
         if extra.is_empty() {
             return o;
         }
@@ -361,7 +382,7 @@ impl<'a> SnapshotProcessor<'a> {
         if pred.len() < gpsrx_nav::pvt::coarse_time::MIN_SATELLITES {
             return Err(format!(
                 "{} satellites with an ephemeris above the horizon at the a-priori time: \
-                 check --nav and --time",
+                 check the navigation data and the a-priori time",
                 pred.len()
             ));
         }
@@ -392,7 +413,7 @@ impl<'a> SnapshotProcessor<'a> {
             engine,
             &cfg,
             self.opts.fe_offset_max_hz,
-            self.opts.measure.max_speed_mps,
+            &self.opts.measure,
         )
         .map_err(|e| e.to_string())
     }

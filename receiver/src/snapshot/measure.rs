@@ -32,6 +32,7 @@ use gpsrx_dsp::Prn;
 use gpsrx_nav::{GpsTime, HealthPolicy, NavData, Vector3};
 use num_complex::Complex32;
 
+use super::fine_phase::band_limited_code_phase;
 use crate::pipeline::visibility;
 
 /// A detection must agree with the predicted Doppler plus the common offset to this, Hz, plus
@@ -47,6 +48,8 @@ pub fn doppler_tolerance_hz(max_speed_mps: f64) -> f64 {
 }
 /// Half-width of the second, narrow search around the predicted Doppler, Hz.
 pub const NARROW_WINDOW_HZ: f64 = 150.0;
+/// The default band of the matched replica, Hz (see [`MeasureOptions::code_band_hz`]).
+pub const DEFAULT_CODE_BAND_HZ: f64 = 1.75e6;
 /// Detections needed to estimate the common offset.
 pub const MIN_FOR_OFFSET: usize = 2;
 
@@ -107,6 +110,10 @@ pub struct MeasureOptions {
     pub pfa: f64,
     /// Largest receiver speed, m/s: widens the Doppler tolerance and the narrow search.
     pub max_speed_mps: f64,
+    /// Band of the matched replica of the final code-phase estimate, Hz
+    /// ([`super::fine_phase`]); `None`: the parabola fit of
+    /// [`gpsrx_dsp::acquisition::code_fit`] alone.
+    pub code_band_hz: Option<f64>,
 }
 
 impl Default for MeasureOptions {
@@ -118,6 +125,7 @@ impl Default for MeasureOptions {
             elevation_mask_deg: 5.0,
             pfa: 1e-4,
             max_speed_mps: 50.0,
+            code_band_hz: Some(DEFAULT_CODE_BAND_HZ),
         }
     }
 }
@@ -214,9 +222,9 @@ pub fn acquire_snapshot(
     wide: &AcquisitionEngine,
     narrow_config: &AcqConfig,
     fe_offset_max_hz: f64,
-    max_speed_mps: f64,
+    opts: &MeasureOptions,
 ) -> Result<SnapshotAcquisition, gpsrx_dsp::acquisition::AcqError> {
-    let tol = doppler_tolerance_hz(max_speed_mps);
+    let tol = doppler_tolerance_hz(opts.max_speed_mps);
     let narrow_hz = NARROW_WINDOW_HZ + (tol - DOPPLER_TOLERANCE_HZ);
     let targets: Vec<SearchTarget> = pred.iter().map(|p| SearchTarget::full(p.prn)).collect();
     let mut results = wide.search(samples, &targets)?;
@@ -271,6 +279,7 @@ pub fn acquire_snapshot(
         ) {
             s.code_phase_samples = tau;
         }
+        s.code_phase_samples = refine(samples, wide.fs_hz(), s, opts.code_band_hz);
     }
     Ok(acq)
 }
@@ -302,6 +311,7 @@ pub fn look_at_predicted(
     fs_hz: f64,
     offset_hz: f64,
     missed: &[PredictedPhase],
+    code_band_hz: Option<f64>,
 ) -> Vec<SatCodePhase> {
     let per_chip = fs_hz / gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
     let period = fs_hz * 1e-3;
@@ -318,16 +328,35 @@ pub fn look_at_predicted(
             }
             let (ratio, k) = peak_to_noise(samples, fs_hz, m.prn, tau, dopplers, 1000)?;
             let threshold = detection_threshold(k as u32, PREDICTED_PFA, 1) / k as f64;
-            (ratio >= threshold).then(|| SatCodePhase {
+            let mut s = SatCodePhase {
                 prn: m.prn,
                 code_phase_samples: tau,
                 doppler_seen_hz: seen,
                 doppler_hz: m.doppler_hz,
                 cn0_dbhz: 10.0 * ((ratio - 1.0).max(1e-3) / 1e-3).log10(),
                 elevation_deg: m.elevation_deg,
-            })
+            };
+            s.code_phase_samples = refine(samples, fs_hz, &s, code_band_hz);
+            (ratio >= threshold).then_some(s)
         })
         .collect()
+}
+
+/// The code phase of `s` from the band-limited matched replica when `band_hz` is set and the
+/// rate allows it ([`super::fine_phase`]), else as it is.
+fn refine(samples: &[Complex32], fs_hz: f64, s: &SatCodePhase, band_hz: Option<f64>) -> f64 {
+    band_hz
+        .and_then(|b| {
+            band_limited_code_phase(
+                samples,
+                fs_hz,
+                s.prn,
+                s.code_phase_samples,
+                (s.doppler_seen_hz, s.doppler_hz),
+                b,
+            )
+        })
+        .unwrap_or(s.code_phase_samples)
 }
 
 fn detections(results: &[AcqResult]) -> impl Iterator<Item = &AcqResult> {

@@ -6,7 +6,9 @@
 //!   (many snapshots, device timestamps) and their truth files;
 //! - [`measure`]: assisted acquisition of one snapshot (sub-sample code phase, common
 //!   front-end offset, narrow second search, false-peak rejection);
+//! - [`fine_phase`]: the sub-sample code phase from a band-limited matched replica;
 //! - [`solve`]: the coarse-time fix ([`gpsrx_nav::pvt::coarse_time`]) and its checks;
+//! - [`smooth`]: optional smoothing of the track across consecutive snapshots;
 //! - [`driver`]: a sequence of snapshots, each good fix seeding the next;
 //! - [`clock`]: the device clock's error from the sequence's fixes (a second pass);
 //! - [`output`]: `snapshots.csv`, the GeoJSON track, errors against a truth.
@@ -20,9 +22,11 @@
 
 pub mod clock;
 pub mod driver;
+pub mod fine_phase;
 pub mod input;
 pub mod measure;
 pub mod output;
+pub mod smooth;
 pub mod snappergps;
 pub mod solve;
 
@@ -43,6 +47,12 @@ pub enum SnapshotError {
         /// What went wrong.
         reason: String,
     },
+    /// No navigation data with a GPS ephemeris were given: no satellite can be predicted.
+    #[error(
+        "no navigation data were given (no GPS ephemeris): snapshot positioning needs the \
+         broadcast ephemerides of the day, from a RINEX navigation file"
+    )]
+    NoEphemerides,
     /// An option out of range.
     #[error("{0}")]
     Option(String),

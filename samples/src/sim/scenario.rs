@@ -582,14 +582,14 @@ impl Scenario {
         }
         if fs > MAX_FS_HZ {
             return bad(format!(
-                "[output] fs_hz (--fs) = {fs} Hz is above the simulator's limit of {} MHz (a GPS L1 C/A receiver needs a few MHz, at most a few tens): use a lower rate",
+                "[output] fs_hz = {fs} Hz is above the simulator's limit of {} MHz (a GPS L1 C/A receiver needs a few MHz, at most a few tens): use a lower rate",
                 MAX_FS_HZ / 1e6
             ));
         }
         let samples = self.duration_s * fs;
         if samples > MAX_SAMPLES {
             return bad(format!(
-                "duration_s x fs_hz = {} s x {fs} Hz = {samples:.3e} samples is above the simulator's limit of {MAX_SAMPLES:.0e} samples (e.g. 1000 s at 100 MHz, 13.5 h at 2.048 MHz): shorten duration_s (--duration) or lower fs_hz (--fs)",
+                "duration_s x fs_hz = {} s x {fs} Hz = {samples:.3e} samples is above the simulator's limit of {MAX_SAMPLES:.0e} samples (e.g. 1000 s at 100 MHz, 13.5 h at 2.048 MHz): shorten duration_s or lower fs_hz",
                 self.duration_s
             ));
         }

@@ -189,7 +189,7 @@ impl WeakPullInConfig {
                 return Err(ConfigError::OutOfRange {
                     field,
                     value,
-                    valid: "see [tracking.weak_pull_in] in `gpsrx config --default`: a finite \
+                    valid: "see the defaults of [tracking.weak_pull_in]: a finite \
                             C/N0 in dB-Hz, times >= 0 s (patience 1 to 600 s), 0 < p < 1"
                         .into(),
                 });
