@@ -14,7 +14,7 @@
 
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::{Prn, SampleSlice};
-use gpsrx_receiver::pipeline::search_schedule::{cost_s, fixed_cost_s, level_config, LEVELS};
+use gpsrx_receiver::pipeline::channels::{cost_s, fixed_cost_s, level_config, LEVELS};
 use std::hint::black_box;
 
 /// Agreement asked for: measured within this fraction of the model.

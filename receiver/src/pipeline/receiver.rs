@@ -9,15 +9,15 @@
 
 use crate::config::ReceiverConfig;
 use crate::landmarks::LandmarkObservation;
-use crate::pipeline::aid_monitor::{AidMonitor, AidingStats, GatedAid};
+use crate::pipeline::aiding::monitor::{AidMonitor, AidingStats, GatedAid};
 use crate::pipeline::aiding::InsFeedForward;
-use crate::pipeline::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
-use crate::pipeline::dating::WeekReference;
+use crate::pipeline::channels::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
+use crate::pipeline::channels::ring::{block_samples, SampleWindow};
+use crate::pipeline::channels::search_schedule::SearchBudget;
 use crate::pipeline::navigation::{BlockEvent, NavigationProcessor};
 use crate::pipeline::profile::{add_timed, StageTimes};
-use crate::pipeline::ring::{block_samples, SampleWindow};
-use crate::pipeline::search_schedule::SearchBudget;
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
+use crate::pipeline::timing::dating::WeekReference;
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult};
 use gpsrx_dsp::Prn;
 use gpsrx_ins_aiding::InsTrack;
@@ -205,7 +205,7 @@ pub struct RunSummary {
     /// Mean PDOP.
     pub mean_pdop: Option<f64>,
     /// With `--ins`: how much of the recording was aided, and how often the INS was rejected
-    /// for disagreeing with the tracked Doppler ([`crate::pipeline::aid_monitor`]).
+    /// for disagreeing with the tracked Doppler ([`crate::pipeline::aiding::monitor`]).
     pub ins_aiding: Option<InsAidingSummary>,
     /// Where the wall time went, stage by stage ([`crate::pipeline::profile`]).
     pub profile: StageTimes,
@@ -600,7 +600,7 @@ impl Receiver {
     /// [`Receiver::deliver`], its wall time added to the navigation stage.
     fn timed_deliver(
         &mut self,
-        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
@@ -615,7 +615,7 @@ impl Receiver {
     /// read so far, or of the block processed).
     fn deliver(
         &mut self,
-        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
@@ -629,7 +629,7 @@ impl Receiver {
     /// end of the source).
     fn deliver_while_reading(
         &mut self,
-        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
         source: &mut dyn SampleSource,
         sink: &mut dyn Sink,
     ) -> Result<usize, ReceiverError> {
@@ -667,7 +667,7 @@ impl Receiver {
     /// what a search found, and the samples no one needs any more dropped.
     fn end_round(
         &mut self,
-        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {

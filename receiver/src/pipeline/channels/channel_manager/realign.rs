@@ -1,12 +1,12 @@
 //! Code realignment: when the prompt power of several satellites collapsed at once
-//! ([`crate::pipeline::code_jump`]: samples lost by a fraction of a code period, or tenths of a
+//! ([`crate::pipeline::timing::code_jump`]: samples lost by a fraction of a code period, or tenths of a
 //! second), every tracked satellite is searched at once in a narrow window around the Doppler
 //! it held, and the channels whose code shifts one gap length explains are moved onto it
 //! ([`gpsrx_tracking::Channel::realign_code`]).
 
 use super::{ChannelManager, DueSearch, SearchOutcome};
-use crate::pipeline::code_jump::{fit_code_gap, Collapse, CollapsedSat, POWER_REPORTS};
-use crate::pipeline::ring::SampleView;
+use crate::pipeline::channels::ring::SampleView;
+use crate::pipeline::timing::code_jump::{fit_code_gap, Collapse, CollapsedSat, POWER_REPORTS};
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::Prn;
 use gpsrx_tracking::ChannelState;
@@ -42,7 +42,7 @@ pub struct Realigned {
     pub prns: Vec<u8>,
     /// The first sample after the move (the next code period of the channels).
     pub at_sample: u64,
-    /// The code moved by more than a gap of up to [`crate::pipeline::code_jump::MAX_GAP_S`]
+    /// The code moved by more than a gap of up to [`crate::pipeline::timing::code_jump::MAX_GAP_S`]
     /// explains (on at least three satellites): samples of an unknown, longer length were lost,
     /// and the receiver time must be re-established from the signal.
     pub length_unknown: bool,
@@ -127,7 +127,7 @@ impl ChannelManager {
     /// the others keep their loops.
     ///
     /// When at least three satellites are found again at a moved code that no gap up to
-    /// [`crate::pipeline::code_jump::MAX_GAP_S`] explains, samples of a longer, unknown length
+    /// [`crate::pipeline::timing::code_jump::MAX_GAP_S`] explains, samples of a longer, unknown length
     /// were lost ([`Realigned::length_unknown`]): every satellite found is moved onto its code,
     /// at the Doppler the search found (the Doppler held before may have drifted over the gap).
     pub fn realign(&mut self, outcome: SearchOutcome) -> Option<Realigned> {
@@ -156,16 +156,17 @@ impl ChannelManager {
         let tol = (0.05 * self.fs_hz / gpsrx_dsp::constants::CA_CHIP_RATE_HZ).max(2.0);
         let fit = fit_code_gap(&shifts, self.fs_hz, tol);
         let unexplained = unexplained_moves(&shifts, fit.as_ref(), tol);
-        let length_unknown = unexplained.len() >= crate::pipeline::code_jump::MIN_SATELLITES;
+        let length_unknown =
+            unexplained.len() >= crate::pipeline::timing::code_jump::MIN_SATELLITES;
         let (shortest_gap_s, prns) = match fit {
             _ if length_unknown => {
                 tracing::debug!(
                     "code realignment: the code of {unexplained:?} moved by more than a gap of up to {} s explains: {shifts:?}",
-                    crate::pipeline::code_jump::MAX_GAP_S
+                    crate::pipeline::timing::code_jump::MAX_GAP_S
                 );
                 let moved = shifts.iter().filter(|(_, s)| code_moved(s, tol));
                 (
-                    crate::pipeline::code_jump::MAX_GAP_S,
+                    crate::pipeline::timing::code_jump::MAX_GAP_S,
                     moved.map(|(p, _)| *p).collect(),
                 )
             }
@@ -197,7 +198,7 @@ impl ChannelManager {
                 at_sample = at_sample.max(ch.next_span().0);
             }
         }
-        (moved.len() >= crate::pipeline::code_jump::MIN_SATELLITES).then(|| {
+        (moved.len() >= crate::pipeline::timing::code_jump::MIN_SATELLITES).then(|| {
             let shift_samples = shifts
                 .iter()
                 .find(|(p, _)| *p == moved[0])
@@ -216,14 +217,14 @@ impl ChannelManager {
 
 /// Whether a code shift moved the code (by more than `tol_samples`, modulo its period).
 fn code_moved(s: &gpsrx_tracking::CodeShift, tol_samples: f64) -> bool {
-    crate::pipeline::gap_length::nearest_remainder(s.shift_samples, s.period_samples).abs()
+    crate::pipeline::timing::gap_length::nearest_remainder(s.shift_samples, s.period_samples).abs()
         > tol_samples
 }
 
 /// The satellites whose code moved but which the fitted gap (if any) does not explain.
 fn unexplained_moves(
     shifts: &[(u8, gpsrx_tracking::CodeShift)],
-    fit: Option<&crate::pipeline::code_jump::CodeGap>,
+    fit: Option<&crate::pipeline::timing::code_jump::CodeGap>,
     tol_samples: f64,
 ) -> Vec<u8> {
     shifts
@@ -254,7 +255,7 @@ mod tests {
     use super::*;
     use gpsrx_tracking::CodeShift;
 
-    use crate::pipeline::code_jump::shifts_after;
+    use crate::pipeline::timing::code_jump::shifts_after;
 
     #[test]
     fn code_moves_of_a_gap_longer_than_the_fit_reaches_are_left_unexplained() {

@@ -245,6 +245,7 @@ impl Scheduler {
     }
 
     /// The modelled CPU time left, s.
+    #[cfg(test)]
     pub fn tokens_s(&self) -> f64 {
         self.tokens_s
     }

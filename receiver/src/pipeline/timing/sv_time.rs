@@ -5,11 +5,11 @@
 //! takes the predicted time rounded to the 20 ms bit, so fixes resume without waiting for
 //! frame sync. After lost samples ([`GapRecovery`]) the prediction is off by the gap: its
 //! length is resolved from the new bit edges and the carrier-phase steps
-//! ([`crate::pipeline::gap_length`]) and every time moved over it, or, when that cannot be
+//! ([`crate::pipeline::timing::gap_length`]) and every time moved over it, or, when that cannot be
 //! done, the times become rough hints for a fast frame sync ([`NavDecoder::hint_time`]).
 
-use crate::pipeline::gap_length::nearest_remainder;
-use crate::pipeline::navdata::NavDecoder;
+use crate::pipeline::navigation::navdata::NavDecoder;
+use crate::pipeline::timing::gap_length::nearest_remainder;
 use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_tracking::ChannelEpoch;
 use std::collections::BTreeMap;
@@ -40,8 +40,8 @@ pub struct GapRecovery {
     pub before: Option<(f64, f64, f64)>,
     /// The carrier-phase steps at the gap: with them, the SV times
     /// are kept and carried over the gap once its length is resolved
-    /// ([`crate::pipeline::gap_length`]); without, the time comes from frame sync.
-    pub steps: Vec<crate::pipeline::carrier_step::PhaseStep>,
+    /// ([`crate::pipeline::timing::gap_length`]); without, the time comes from frame sync.
+    pub steps: Vec<crate::pipeline::timing::carrier_step::PhaseStep>,
     /// Per PRN: how far the SV time kept falls off the channel's new bit edge (ms), and the
     /// satellite's SV time rate.
     pub edge_offsets: BTreeMap<u8, (f64, f64)>,
@@ -65,11 +65,11 @@ impl GapRecovery {
     pub fn new(
         t_s: f64,
         before: Option<(f64, f64, f64)>,
-        steps: Vec<crate::pipeline::carrier_step::PhaseStep>,
+        steps: Vec<crate::pipeline::timing::carrier_step::PhaseStep>,
         code_from_s: Option<f64>,
     ) -> Self {
         let unresolved =
-            steps.len() < crate::pipeline::gap_length::MIN_STEPS && code_from_s.is_none();
+            steps.len() < crate::pipeline::timing::gap_length::MIN_STEPS && code_from_s.is_none();
         Self {
             t_s,
             before,
@@ -85,12 +85,12 @@ impl GapRecovery {
 
     /// Takes the offset `off_ms` of `prn`'s kept SV time from its new bit edge and the
     /// satellite's SV time rate at stream time `now_s`; once
-    /// [`crate::pipeline::discontinuity::MIN_SATELLITES`] offsets agree (0.1 ms), resolves the
+    /// [`crate::pipeline::timing::discontinuity::MIN_SATELLITES`] offsets agree (0.1 ms), resolves the
     /// length from the carrier-phase steps and, once settled, the code offsets
-    /// ([`crate::pipeline::gap_length::choose`]), or gives up after [`GAP_RESOLVE_S`].
+    /// ([`crate::pipeline::timing::gap_length::choose`]), or gives up after [`GAP_RESOLVE_S`].
     /// Returns whether the length was just resolved.
     pub fn add_edge_offset(&mut self, prn: u8, off_ms: f64, rate: f64, now_s: f64) -> bool {
-        use crate::pipeline::gap_length::{choose, estimate_from_code};
+        use crate::pipeline::timing::gap_length::{choose, estimate_from_code};
         self.edge_offsets.insert(prn, (off_ms, rate));
         let agreeing: Vec<(f64, f64)> = self
             .edge_offsets
@@ -98,7 +98,7 @@ impl GapRecovery {
             .filter(|o| (o.0 - off_ms).abs() < 0.1)
             .copied()
             .collect();
-        if agreeing.len() >= crate::pipeline::discontinuity::MIN_SATELLITES {
+        if agreeing.len() >= crate::pipeline::timing::discontinuity::MIN_SATELLITES {
             let mean = agreeing.iter().map(|o| o.0).sum::<f64>() / agreeing.len() as f64;
             // The kept time is g late: it falls -g (mod 20 ms) off the true bit edge.
             let offset = (-mean).rem_euclid(20.0);

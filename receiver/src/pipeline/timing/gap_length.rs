@@ -28,7 +28,7 @@ pub fn nearest_remainder(x: f64, period: f64) -> f64 {
     x - (x / period).round() * period
 }
 
-use crate::pipeline::carrier_step::PhaseStep;
+use crate::pipeline::timing::carrier_step::PhaseStep;
 
 /// Spread of a measured phase step, rad.
 pub const STEP_SIGMA_RAD: f64 = 0.25;

@@ -10,7 +10,7 @@
 //! dates an output ([`WeekReference::known`] is false: `gps_week` is left empty, the NMEA date
 //! too, and `observables.rnx` waits for the decoded week).
 
-use crate::pipeline::navdata::current_gps_week;
+use crate::pipeline::navigation::navdata::current_gps_week;
 use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_nav::time::GpsTime;
 use gpsrx_samples::sigmf::RecordingStart;

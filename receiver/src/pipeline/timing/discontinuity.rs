@@ -18,8 +18,8 @@
 //! instant are summed and tested ([`DiscontinuityMonitor::evaluate`]); a satellite whose prompt
 //! power collapsed is not counted (a blockage, not lost samples).
 
-use crate::pipeline::carrier_step::{phase_step, NcoPoint, PhaseStep};
-use crate::pipeline::gap_length::nearest_remainder;
+use crate::pipeline::timing::carrier_step::{phase_step, NcoPoint, PhaseStep};
+use crate::pipeline::timing::gap_length::nearest_remainder;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use num_complex::Complex64;
 use std::collections::{BTreeMap, VecDeque};
@@ -44,7 +44,7 @@ pub const STEADY_REPORTS: u32 = 50;
 /// Weakest C/N0 watched, dB-Hz (below it the phase noise hides the jumps).
 pub const MIN_CN0_DBHZ: f64 = 30.0;
 /// Reports before a jump that give the carrier's phase, frequency and rate there
-/// ([`crate::pipeline::carrier_step`]: up to a second).
+/// ([`crate::pipeline::timing::carrier_step`]: up to a second).
 pub const PRE_REPORTS: usize = 1000;
 /// Reports after a jump over which its step is averaged.
 pub const POST_REPORTS: usize = 32;
@@ -66,7 +66,7 @@ pub struct Discontinuity {
     /// Satellites watched at the time.
     pub watched: usize,
     /// Per satellite: the step of its carrier phase over the jump
-    /// ([`crate::pipeline::carrier_step`]).
+    /// ([`crate::pipeline::timing::carrier_step`]).
     pub steps: Vec<PhaseStep>,
 }
 

@@ -9,7 +9,7 @@
 //! [`CollapseMonitor`] watches every strong 1 ms channel's prompt power against its own level
 //! and reports a collapse of [`MIN_SATELLITES`] or more satellites within [`CLUSTER_S`]: the
 //! channel manager then searches every tracked satellite's code at its Doppler
-//! ([`crate::pipeline::channel_manager`]). A blockage collapses the power too; the search then
+//! ([`crate::pipeline::channels::channel_manager`]). A blockage collapses the power too; the search then
 //! finds nothing (or the code where it was) and nothing is moved.
 //!
 //! Per satellite, the mean prompt power of the last [`POWER_REPORTS`] reports is compared with
@@ -17,7 +17,7 @@
 //! floor is `S / (1 + C/N0 T)`; the threshold is their geometric mean `S / sqrt(1 + C/N0 T)`,
 //! so that both sides have a margin of `sqrt(1 + C/N0 T)` (2.2 at [`MIN_CN0_DBHZ`], 1 ms).
 
-use crate::pipeline::gap_length::nearest_remainder;
+use crate::pipeline::timing::gap_length::nearest_remainder;
 use gpsrx_tracking::{ChannelEpoch, ChannelState, CodeShift};
 use std::collections::{BTreeMap, VecDeque};
 

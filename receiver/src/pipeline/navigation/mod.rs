@@ -6,25 +6,31 @@
 //! ephemerides, the receiver clock kept within 0.5 ms of GPS time by whole-millisecond steps,
 //! and the aiding feedback (ephemerides, fixes and the time origin to the INS feed-forward).
 
+pub(crate) mod fix_output;
+pub(crate) mod navdata;
+pub(crate) mod observables;
+pub(crate) mod smoothing;
+
+pub use navdata::{NavDecoder, NavEvent};
+
 use crate::config::{IonoModel, RunSettings, TropoModel};
 use crate::landmarks::LandmarkObservation;
-use crate::output::{ChannelRow, FixQuality};
 use crate::pipeline::aiding::InsFeedForward;
-use crate::pipeline::channel_manager::Realigned;
-use crate::pipeline::coarse_fix::{CoarseFixer, CoarseRefusal};
-use crate::pipeline::code_jump::{Collapse, CollapseMonitor};
-use crate::pipeline::discontinuity::{Discontinuity, DiscontinuityMonitor};
-pub use crate::pipeline::fix_output::FixStats;
-use crate::pipeline::fix_output::{fix_of, obs_epoch, passes_integrity};
-use crate::pipeline::long_gap::LongGapRecovery;
-use crate::pipeline::navdata::{NavDecoder, NavEvent};
-use crate::pipeline::observables::{ObservableBuilder, ObservableEpoch};
-use crate::pipeline::quick_sync::{QuickSync, TowCandidate};
-use crate::pipeline::search_schedule::Visibility;
+use crate::pipeline::channels::channel_manager::Realigned;
+use crate::pipeline::channels::search_schedule::Visibility;
+pub use crate::pipeline::navigation::fix_output::FixStats;
+use crate::pipeline::navigation::fix_output::{fix_of, obs_epoch, passes_integrity};
+use crate::pipeline::navigation::observables::{ObservableBuilder, ObservableEpoch};
+use crate::pipeline::sink::{ChannelRow, FixQuality};
 use crate::pipeline::sink::{
     FixReport, NavigationEnd, ObservablesReport, Progress, ReceiverEvent, Sink, SinkError,
 };
-use crate::pipeline::sv_time::{CarryNote, GapRecovery, SvTimeKeeper};
+use crate::pipeline::timing::coarse_fix::{CoarseFixer, CoarseRefusal};
+use crate::pipeline::timing::code_jump::{Collapse, CollapseMonitor};
+use crate::pipeline::timing::discontinuity::{Discontinuity, DiscontinuityMonitor};
+use crate::pipeline::timing::long_gap::LongGapRecovery;
+use crate::pipeline::timing::quick_sync::{QuickSync, TowCandidate};
+use crate::pipeline::timing::sv_time::{CarryNote, GapRecovery, SvTimeKeeper};
 use gpsrx_nav::atmosphere::KlobucharParams;
 use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
 use gpsrx_nav::ephemeris::{Ephemeris, HealthPolicy};
@@ -202,7 +208,7 @@ impl NavigationProcessor {
         self
     }
 
-    /// Enables the coarse-time first fix ([`crate::pipeline::coarse_fix`]) when the settings
+    /// Enables the coarse-time first fix ([`crate::pipeline::timing::coarse_fix`]) when the settings
     /// hold an approximate position, `start` (the approximate GPS time of sample 0: `--time`,
     /// else the recording's date) is known and a navigation file gives the ephemerides;
     /// says why not when the position is given without the rest.
@@ -289,7 +295,7 @@ impl NavigationProcessor {
             );
             self.forget_time(t_s, Vec::new(), None);
             let settled =
-                r.at_sample as f64 + crate::pipeline::long_gap::CODE_SETTLE_S * self.fs_hz;
+                r.at_sample as f64 + crate::pipeline::timing::long_gap::CODE_SETTLE_S * self.fs_hz;
             self.fixes_from_sample = self.fixes_from_sample.max(settled);
             return sink.event(&ReceiverEvent::SampleGap { t_s });
         }
@@ -325,7 +331,7 @@ impl NavigationProcessor {
 
     /// Says whether the reference week may date the outputs (true unless set here): when
     /// not, times before subframe 1 is decoded carry [`crate::output::Fix::week_known`] and
-    /// [`ObservablesReport::week_known`] false ([`crate::pipeline::dating`]).
+    /// [`ObservablesReport::week_known`] false ([`crate::pipeline::timing::dating`]).
     pub fn with_reference_week_known(mut self, known: bool) -> Self {
         self.reference_week_known = known;
         self
@@ -341,7 +347,7 @@ impl NavigationProcessor {
     /// with a fix (position, velocity, clock bias and drift) and the satellite's ephemeris
     /// (decoded or from `--nav`), whether it is above the horizon and its Doppler within
     /// [`PREDICTED_DOPPLER_HZ`] plus [`PREDICTED_DOPPLER_RATE_HZ_S`] per second since the fix
-    /// ([`crate::pipeline::visibility`]); else nothing.
+    /// ([`crate::pipeline::channels::visibility`]); else nothing.
     pub fn visibility(&self, prn: u8, t_stream_s: f64) -> Visibility {
         let Some((rx, t, drift, half_width_hz)) = self.prediction_origin(t_stream_s) else {
             // With ephemerides from `--nav`, the first fix (a few seconds away) will tell.
@@ -366,7 +372,7 @@ impl NavigationProcessor {
                 None => return Visibility::Unknown,
             },
         };
-        match crate::pipeline::visibility::predict_seen(&seen, &rx, drift) {
+        match crate::pipeline::channels::visibility::predict_seen(&seen, &rx, drift) {
             Some(p) if p.elevation_deg < BELOW_HORIZON_DEG => Visibility::Below,
             Some(p) => Visibility::Visible {
                 doppler_hz: p.doppler_hz,
@@ -638,7 +644,7 @@ impl NavigationProcessor {
 
     /// A TLM and HOW found while unsynchronised: frame sync on it (and on the waiting
     /// candidates it agrees with) once another satellite confirms its time
-    /// ([`crate::pipeline::quick_sync`]).
+    /// ([`crate::pipeline::timing::quick_sync`]).
     fn on_tow_candidate(&mut self, c: TowCandidate, sink: &mut dyn Sink) -> Result<(), SinkError> {
         let known: Vec<(u8, u64, f64)> = self
             .decoders
@@ -788,7 +794,7 @@ impl NavigationProcessor {
     fn forget_time(
         &mut self,
         t_s: f64,
-        steps: Vec<crate::pipeline::carrier_step::PhaseStep>,
+        steps: Vec<crate::pipeline::timing::carrier_step::PhaseStep>,
         code_from_s: Option<f64>,
     ) {
         for dec in self.decoders.values_mut() {
@@ -808,7 +814,7 @@ impl NavigationProcessor {
     }
 
     /// A carried SV time refused at `t_s` for `prn`, `off_ms` off the bit edge: when
-    /// [`crate::pipeline::discontinuity::MIN_SATELLITES`] satellites are refused within 2 s by
+    /// [`crate::pipeline::timing::discontinuity::MIN_SATELLITES`] satellites are refused within 2 s by
     /// the same offset (0.1 ms), samples were lost during the outage (that offset plus a
     /// whole number of 20 ms bits): reported as a gap.
     fn on_refused(
@@ -828,7 +834,7 @@ impl NavigationProcessor {
             .iter()
             .filter(|r| (r.2 - off_ms).abs() < 0.1)
             .count();
-        if agreeing >= crate::pipeline::discontinuity::MIN_SATELLITES {
+        if agreeing >= crate::pipeline::timing::discontinuity::MIN_SATELLITES {
             let offsets: Vec<(u8, f64, f64)> = self
                 .sv_time
                 .refused
@@ -903,7 +909,7 @@ impl NavigationProcessor {
     fn start_long_gap(&mut self) {
         let with_eph = self.decoders.values().filter(|d| d.ephemeris.is_some());
         let eph = self.nav_assist.is_some()
-            || with_eph.count() >= crate::pipeline::coarse_fix::MIN_SATELLITES;
+            || with_eph.count() >= crate::pipeline::timing::coarse_fix::MIN_SATELLITES;
         let origin = self.builder.rx_time_origin();
         let gap = self.sv_time.gap.as_ref();
         let Some(start) = self.long_gap.begin(gap, self.fs_hz, origin, eph) else {
@@ -922,7 +928,7 @@ impl NavigationProcessor {
     /// by the whole milliseconds of the time lost ([`LongGapRecovery::clock_step_ms`]).
     fn step_clock_to_coarse_time(
         &mut self,
-        out: &crate::pipeline::coarse_fix::CoarseOutcome,
+        out: &crate::pipeline::timing::coarse_fix::CoarseOutcome,
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
         let origin = self.builder.rx_time_origin();

@@ -1,0 +1,25 @@
+//! Timing wing: receiver time and the satellites' SV times, across losses of the signal, lost
+//! samples and long gaps.
+//!
+//! - `sv_time`: SV times kept across losses of the signal and lost samples;
+//! - `discontinuity`: lost samples found by a carrier-phase jump common to the satellites;
+//! - `code_jump`: lost samples found by a code jump (prompt power collapsing together);
+//! - `carrier_step`: a satellite's carrier-phase step over lost samples;
+//! - `gap_length`: the length of lost time from the bit edges and carrier-phase steps;
+//! - `long_gap`: the receiver time re-established after a gap too long to measure;
+//! - `quick_sync`: frame sync from one TLM and HOW, confirmed across satellites;
+//! - `coarse_fix`: the first fix from code phases alone (approximate time and position);
+//! - `dating`: which GPS week labels receiver time before subframe 1 is decoded
+//!   ([`WeekReference`]).
+
+pub(crate) mod carrier_step;
+pub(crate) mod coarse_fix;
+pub(crate) mod code_jump;
+pub(crate) mod dating;
+pub(crate) mod discontinuity;
+pub(crate) mod gap_length;
+pub(crate) mod long_gap;
+pub(crate) mod quick_sync;
+pub(crate) mod sv_time;
+
+pub use dating::{WeekReference, WeekSource};
