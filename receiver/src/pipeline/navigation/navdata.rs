@@ -276,7 +276,7 @@ impl NavDecoder {
             return;
         };
         let sv_ms = sv * 1e3;
-        let off = crate::pipeline::timing::gap_length::nearest_remainder(sv_ms, 20.0);
+        let off = crate::pipeline::timing::modulo::nearest_remainder(sv_ms, 20.0);
         if off.abs() > 0.5 {
             events.push(NavEvent::BitEdgeMismatch { offset_ms: off });
             self.reset_sync();

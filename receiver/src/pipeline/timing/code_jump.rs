@@ -17,7 +17,7 @@
 //! floor is `S / (1 + C/N0 T)`; the threshold is their geometric mean `S / sqrt(1 + C/N0 T)`,
 //! so that both sides have a margin of `sqrt(1 + C/N0 T)` (2.2 at [`MIN_CN0_DBHZ`], 1 ms).
 
-use crate::pipeline::timing::gap_length::nearest_remainder;
+use crate::pipeline::timing::modulo::nearest_remainder;
 use gpsrx_tracking::{ChannelEpoch, ChannelState, CodeShift};
 use std::collections::{BTreeMap, VecDeque};
 

@@ -19,7 +19,7 @@
 //! power collapsed is not counted (a blockage, not lost samples).
 
 use crate::pipeline::timing::carrier_step::{phase_step, NcoPoint, PhaseStep};
-use crate::pipeline::timing::gap_length::nearest_remainder;
+use crate::pipeline::timing::modulo::nearest_remainder;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use num_complex::Complex64;
 use std::collections::{BTreeMap, VecDeque};

@@ -6,6 +6,7 @@
 //! - `code_jump`: lost samples found by a code jump (prompt power collapsing together);
 //! - `carrier_step`: a satellite's carrier-phase step over lost samples;
 //! - `gap_length`: the length of lost time from the bit edges and carrier-phase steps;
+//! - `modulo`: remainders modulo a period (phase, data bit, code period);
 //! - `long_gap`: the receiver time re-established after a gap too long to measure;
 //! - `quick_sync`: frame sync from one TLM and HOW, confirmed across satellites;
 //! - `coarse_fix`: the first fix from code phases alone (approximate time and position);
@@ -19,6 +20,7 @@ pub(crate) mod dating;
 pub(crate) mod discontinuity;
 pub(crate) mod gap_length;
 pub(crate) mod long_gap;
+pub(crate) mod modulo;
 pub(crate) mod quick_sync;
 pub(crate) mod sv_time;
 

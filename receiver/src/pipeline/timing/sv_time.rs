@@ -9,7 +9,7 @@
 //! done, the times become rough hints for a fast frame sync ([`NavDecoder::hint_time`]).
 
 use crate::pipeline::navigation::navdata::NavDecoder;
-use crate::pipeline::timing::gap_length::nearest_remainder;
+use crate::pipeline::timing::modulo::nearest_remainder;
 use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_tracking::ChannelEpoch;
 use std::collections::BTreeMap;
@@ -188,15 +188,16 @@ impl SvClock {
     }
 }
 
-/// The satellites' SV times and the gap being recovered from.
+/// The satellites' SV times and the gap being recovered from: the one place that keeps them
+/// (navigation asks and tells it, never edits its state).
 #[derive(Debug, Default)]
 pub struct SvTimeKeeper {
     /// Per PRN: its SV time, kept over a loss of the signal.
-    pub clocks: BTreeMap<u8, SvClock>,
+    clocks: BTreeMap<u8, SvClock>,
     /// A gap being recovered from.
-    pub gap: Option<GapRecovery>,
+    gap: Option<GapRecovery>,
     /// Carried SV times refused at the new bit edge: `(stream time s, PRN, offset ms)`.
-    pub refused: Vec<(f64, u8, f64)>,
+    refused: Vec<(f64, u8, f64)>,
     /// Per PRN: the clock as it was, every [`SNAPSHOT_S`] over the last [`SNAPSHOTS`] of them
     /// (to go back to before lost samples found late, [`SvTimeKeeper::rewind`]).
     history: BTreeMap<u8, std::collections::VecDeque<SvClock>>,
@@ -208,6 +209,106 @@ const SNAPSHOT_S: f64 = 0.01;
 const SNAPSHOTS: usize = 30;
 
 impl SvTimeKeeper {
+    /// The gap being recovered from, if any.
+    pub fn gap(&self) -> Option<&GapRecovery> {
+        self.gap.as_ref()
+    }
+
+    /// Samples were lost at stream time `t_s` (samples at `fs_hz`): every clock goes back to
+    /// a little before it (its instant is known to a few milliseconds), and the gap is kept
+    /// to be measured ([`GapRecovery::new`] with the clock of the last fix `before`, the
+    /// carrier-phase `steps` and `code_from_s`); a gap whose length cannot be resolved makes
+    /// every SV time rough.
+    pub fn start_gap(
+        &mut self,
+        t_s: f64,
+        fs_hz: f64,
+        before: Option<(f64, f64, f64)>,
+        steps: Vec<crate::pipeline::timing::carrier_step::PhaseStep>,
+        code_from_s: Option<f64>,
+    ) {
+        self.rewind(((t_s - 0.003) * fs_hz).max(0.0) as u64);
+        let gap = GapRecovery::new(t_s, before, steps, code_from_s);
+        if gap.unresolved {
+            self.make_rough(None);
+        }
+        self.gap = Some(gap);
+    }
+
+    /// A gap at `t_s` (with the clock of the last fix `before`) unless one is being recovered
+    /// from already: its length will come from the clock bias of the next valid fix.
+    pub fn ensure_gap(&mut self, t_s: f64, before: Option<(f64, f64, f64)>) {
+        self.gap
+            .get_or_insert_with(|| GapRecovery::new(t_s, before, Vec::new(), None));
+    }
+
+    /// The carrier-phase steps over a code jump, measured once the phase loops hold again,
+    /// for the gap being recovered from.
+    pub fn set_gap_steps(&mut self, steps: Vec<crate::pipeline::timing::carrier_step::PhaseStep>) {
+        if let Some(gap) = self.gap.as_mut() {
+            gap.steps = steps;
+        }
+    }
+
+    /// A receiver clock step of `step_ms` made while a gap is recovered from (counted in
+    /// its length from the clock bias, [`GapRecovery::length_from_bias_ms`]).
+    pub fn note_clock_step(&mut self, step_ms: i64) {
+        if let Some(gap) = self.gap.as_mut() {
+            gap.stepped_ms += step_ms;
+        }
+    }
+
+    /// The gap being recovered from, taken once the receiver time is re-established (a valid
+    /// fix), if its length was not resolved on the way.
+    pub fn take_unmeasured_gap(&mut self) -> Option<GapRecovery> {
+        self.gap.take().filter(|g| g.length_ms.is_none())
+    }
+
+    /// A carried SV time of `prn` refused at `t_s`, `off_ms` off its new bit edge. When
+    /// [`crate::pipeline::timing::discontinuity::MIN_SATELLITES`] satellites were refused
+    /// within 2 s by the same offset (0.1 ms), samples were lost during the outage: returns how
+    /// many agree and their `(PRN, offset ms, SV time rate)` (and forgets the refusals).
+    pub fn note_refusal(
+        &mut self,
+        t_s: f64,
+        prn: u8,
+        off_ms: f64,
+    ) -> Option<(usize, Vec<(u8, f64, f64)>)> {
+        self.refused.retain(|r| t_s - r.0 < 2.0 && r.1 != prn);
+        self.refused.push((t_s, prn, off_ms));
+        let agreeing = self
+            .refused
+            .iter()
+            .filter(|r| (r.2 - off_ms).abs() < 0.1)
+            .count();
+        if agreeing < crate::pipeline::timing::discontinuity::MIN_SATELLITES {
+            return None;
+        }
+        let offsets: Vec<(u8, f64, f64)> = self
+            .refused
+            .iter()
+            .filter(|r| (r.2 - off_ms).abs() < 0.1)
+            .filter_map(|r| self.clocks.get(&r.1).map(|c| (r.1, r.2, c.rate)))
+            .collect();
+        self.refused.clear();
+        Some((agreeing, offsets))
+    }
+
+    /// The offsets `(PRN, offset ms, rate)` of refused carried times handed to the gap being
+    /// recovered from at `t_s` ([`GapRecovery::add_edge_offset`]): its length, if that
+    /// resolved it.
+    pub fn add_edge_offsets(&mut self, offsets: Vec<(u8, f64, f64)>, t_s: f64) -> Option<f64> {
+        let mut resolved = None;
+        if let Some(gap) = self.gap.as_mut() {
+            for (p, o, r) in offsets {
+                if gap.add_edge_offset(p, o, r, t_s) {
+                    resolved = gap.length_ms;
+                }
+            }
+        }
+        resolved
+    }
+
     /// Moves every kept SV time over a gap of `length_ms` of receiver time (once its length is
     /// known): each satellite's SV time ran `length r` meanwhile; they are exact again.
     pub fn move_over_gap(&mut self, length_ms: f64) {

@@ -217,7 +217,7 @@ impl ChannelManager {
 
 /// Whether a code shift moved the code (by more than `tol_samples`, modulo its period).
 fn code_moved(s: &gpsrx_tracking::CodeShift, tol_samples: f64) -> bool {
-    crate::pipeline::timing::gap_length::nearest_remainder(s.shift_samples, s.period_samples).abs()
+    crate::pipeline::timing::modulo::nearest_remainder(s.shift_samples, s.period_samples).abs()
         > tol_samples
 }
 

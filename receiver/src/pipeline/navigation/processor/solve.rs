@@ -233,7 +233,7 @@ impl NavigationProcessor {
                 t_stream_s,
             });
         }
-        if let Some(gap) = self.sv_time.gap.take().filter(|g| g.length_ms.is_none()) {
+        if let Some(gap) = self.sv_time.take_unmeasured_gap() {
             let length = gap.length_from_bias_ms(t_stream_s, sol.clock_bias_m);
             match length {
                 Some(ms) => tracing::warn!(

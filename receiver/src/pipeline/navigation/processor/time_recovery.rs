@@ -6,7 +6,6 @@ use super::{NavigationProcessor, CODE_SETTLE_AFTER_REALIGN_S, PHASE_SETTLE_AFTER
 use crate::pipeline::channels::channel_manager::Realigned;
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
 use crate::pipeline::timing::quick_sync::QuickSync;
-use crate::pipeline::timing::sv_time::GapRecovery;
 use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
 use gpsrx_tracking::ChannelEpoch;
 
@@ -57,9 +56,7 @@ impl NavigationProcessor {
         }
         let steps = self.monitor.phase_steps(prns, *jump, Some(*from));
         tracing::debug!("carrier-phase steps over the code jump: {steps:?}");
-        if let Some(gap) = self.sv_time.gap.as_mut() {
-            gap.steps = steps;
-        }
+        self.sv_time.set_gap_steps(steps);
         self.pending_steps = None;
     }
 
@@ -79,16 +76,9 @@ impl NavigationProcessor {
         for dec in self.decoders.values_mut() {
             dec.reset_sync();
         }
-        // The clocks as they were a little before the gap (its instant is known to a few
-        // milliseconds).
         self.sv_time
-            .rewind(((t_s - 0.003) * self.fs_hz).max(0.0) as u64);
-        let gap = GapRecovery::new(t_s, self.last_clock, steps, code_from_s);
-        if gap.unresolved {
-            self.sv_time.make_rough(None);
-        }
+            .start_gap(t_s, self.fs_hz, self.last_clock, steps, code_from_s);
         self.builder.note_gap(t_s);
-        self.sv_time.gap = Some(gap);
         self.prior = None;
     }
 
@@ -103,50 +93,26 @@ impl NavigationProcessor {
         off_ms: f64,
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
-        self.sv_time
-            .refused
-            .retain(|r| t_s - r.0 < 2.0 && r.1 != prn);
-        self.sv_time.refused.push((t_s, prn, off_ms));
-        let agreeing = self
-            .sv_time
-            .refused
-            .iter()
-            .filter(|r| (r.2 - off_ms).abs() < 0.1)
-            .count();
-        if agreeing >= crate::pipeline::timing::discontinuity::MIN_SATELLITES {
-            let offsets: Vec<(u8, f64, f64)> = self
-                .sv_time
-                .refused
-                .iter()
-                .filter(|r| (r.2 - off_ms).abs() < 0.1)
-                .filter_map(|r| self.sv_time.clocks.get(&r.1).map(|c| (r.1, r.2, c.rate)))
-                .collect();
-            self.sv_time.refused.clear();
+        let Some((agreeing, offsets)) = self.sv_time.note_refusal(t_s, prn, off_ms) else {
+            return Ok(());
+        };
+        tracing::warn!(
+            "{t_s:.3} s: samples lost during the outage: the SV times carried over it are {:.3} ms (modulo 20 ms) off the new bit edges of {agreeing} satellites",
+            -off_ms
+        );
+        // The new channels' code has settled by their bit edges: the code offsets measure
+        // the gap at once.
+        self.forget_time(t_s, Vec::new(), Some(t_s));
+        sink.event(&ReceiverEvent::SampleGap { t_s })?;
+        let resolved = self.sv_time.add_edge_offsets(offsets, t_s);
+        if let Some(length_ms) = resolved {
             tracing::warn!(
-                "{t_s:.3} s: samples lost during the outage: the SV times carried over it are {:.3} ms (modulo 20 ms) off the new bit edges of {agreeing} satellites",
-                -off_ms
+                "{t_s:.3} s: the samples lost were {length_ms:.3} ms of signal (from the code of the new channels): SV times carried over the gap"
             );
-            // The new channels' code has settled by their bit edges: the code offsets measure
-            // the gap at once.
-            self.forget_time(t_s, Vec::new(), Some(t_s));
-            sink.event(&ReceiverEvent::SampleGap { t_s })?;
-            let mut resolved = None;
-            if let Some(gap) = self.sv_time.gap.as_mut() {
-                for (p, o, r) in offsets {
-                    if gap.add_edge_offset(p, o, r, t_s) {
-                        resolved = gap.length_ms;
-                    }
-                }
-            }
-            if let Some(length_ms) = resolved {
-                tracing::warn!(
-                    "{t_s:.3} s: the samples lost were {length_ms:.3} ms of signal (from the code of the new channels): SV times carried over the gap"
-                );
-                self.sv_time.move_over_gap(length_ms);
-                sink.event(&ReceiverEvent::GapMeasured { t_s, length_ms })?;
-                self.lost_for_aid_ms += length_ms;
-                self.step_clock_over_gap(t_s, length_ms, sink)?;
-            }
+            self.sv_time.move_over_gap(length_ms);
+            sink.event(&ReceiverEvent::GapMeasured { t_s, length_ms })?;
+            self.lost_for_aid_ms += length_ms;
+            self.step_clock_over_gap(t_s, length_ms, sink)?;
         }
         Ok(())
     }
@@ -178,9 +144,7 @@ impl NavigationProcessor {
         self.builder.restart();
         self.failed_in_row = 0;
         let before = self.last_clock;
-        self.sv_time
-            .gap
-            .get_or_insert_with(|| GapRecovery::new(t_s, before, Vec::new(), None));
+        self.sv_time.ensure_gap(t_s, before);
     }
 
     /// Once the length of the gap being recovered from cannot be measured: the time comes
@@ -190,7 +154,7 @@ impl NavigationProcessor {
         let eph = self.nav_assist.is_some()
             || with_eph.count() >= crate::pipeline::timing::coarse_fix::MIN_SATELLITES;
         let origin = self.builder.rx_time_origin();
-        let gap = self.sv_time.gap.as_ref();
+        let gap = self.sv_time.gap();
         let Some(start) = self.long_gap.begin(gap, self.fs_hz, origin, eph) else {
             return;
         };
@@ -215,9 +179,7 @@ impl NavigationProcessor {
             return Ok(());
         };
         self.builder.step_clock_ms(step);
-        if let Some(gap) = self.sv_time.gap.as_mut() {
-            gap.stepped_ms += step;
-        }
+        self.sv_time.note_clock_step(step);
         tracing::info!("receiver clock stepped by {step} ms to the coarse time");
         sink.event(&ReceiverEvent::ClockStep { ms: step })
     }
@@ -238,9 +200,7 @@ impl NavigationProcessor {
             return Ok(());
         }
         self.builder.step_clock_ms(step);
-        if let Some(gap) = self.sv_time.gap.as_mut() {
-            gap.stepped_ms += step;
-        }
+        self.sv_time.note_clock_step(step);
         if let Some((t, b, d)) = self.last_clock {
             // The clock of the last fix, on the stepped time scale.
             self.last_clock = Some((t, b + step as f64 * 1e-3 * SPEED_OF_LIGHT_MPS, d));
@@ -259,8 +219,7 @@ impl NavigationProcessor {
         e: &ChannelEpoch,
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
-        let (Some(gap), Some(t0)) = (self.sv_time.gap.as_mut(), self.builder.rx_time_origin())
-        else {
+        let (Some(_), Some(t0)) = (self.sv_time.gap(), self.builder.rx_time_origin()) else {
             return Ok(());
         };
         let Some(dec) = self.decoders.get(&e.prn) else {
@@ -277,7 +236,7 @@ impl NavigationProcessor {
             return Ok(());
         }
         let step = -((tau - 0.075) * 1e3).round() as i64;
-        gap.stepped_ms += step;
+        self.sv_time.note_clock_step(step);
         self.builder.step_clock_ms(step);
         tracing::info!("receiver clock stepped by {step} ms to re-establish the time");
         sink.event(&ReceiverEvent::ClockStep { ms: step })
