@@ -106,7 +106,7 @@ pub enum AssistanceError {
         source: gpsrx_nav::rinex_nav::RinexError,
     },
     /// The navigation file holds no GPS ephemeris.
-    #[error("the navigation file {path} holds no GPS ephemeris (a header only, or no GPS records): give a broadcast navigation file with ephemeris records (e.g. brdcDDD0.YYn for the day of the recording), or leave out --nav to decode the ephemerides from the signal")]
+    #[error("the navigation file {path} holds no GPS ephemeris (a header only, or no GPS records): give a broadcast navigation file with ephemeris records (e.g. brdcDDD0.YYn for the day of the recording), or give no navigation file, to decode the ephemerides from the signal")]
     NavWithoutEphemeris {
         /// The file.
         path: String,
@@ -147,7 +147,7 @@ impl Assistance {
                 let track = gpsrx_ins_aiding::read_ins_csv(path, files.ins_max_gap_s)?;
                 let (a, b) = track.span_s();
                 let off = if files.no_aiding {
-                    " (aiding off: --no-aiding)"
+                    " (aiding switched off)"
                 } else {
                     ""
                 };
@@ -794,7 +794,7 @@ fn log_aided_static_offset(tracking: &gpsrx_tracking::ChannelConfig) {
     let bias_mps2 = gpsrx_tracking::aiding::NOMINAL_INS_BIAS_LOS_MPS2;
     match gpsrx_tracking::aiding::static_phase_offset_cycles(loops.pll_order, loops.pll_bw_hz, bias_mps2) {
         Some(c) if c > 0.0 => tracing::info!(
-            "aided loops: 2nd-order PLL at {} Hz: an INS accelerometer bias of 1 mg per axis leaves up to {c:.3} cycle of static phase offset (B / (lambda w0^2); lock allows 0.2, slips at 0.25) until the INS velocity calibration from the fixes takes the drift out (about 15 s of fixes outside manoeuvres); a 3rd-order aided loop leaves none (--aided-pll-order 3)",
+            "aided loops: 2nd-order PLL at {} Hz: an INS accelerometer bias of 1 mg per axis leaves up to {c:.3} cycle of static phase offset (B / (lambda w0^2); lock allows 0.2, slips at 0.25) until the INS velocity calibration from the fixes takes the drift out (about 15 s of fixes outside manoeuvres); a 3rd-order aided loop leaves none",
             loops.pll_bw_hz
         ),
         Some(_) => tracing::info!(
@@ -803,7 +803,7 @@ fn log_aided_static_offset(tracking: &gpsrx_tracking::ChannelConfig) {
             loops.pll_bw_hz
         ),
         None => tracing::warn!(
-            "aided loops: a 1st-order PLL at {} Hz drifts with an INS accelerometer bias (its phase error grows without bound): use --aided-pll-order 2 or 3",
+            "aided loops: a 1st-order PLL at {} Hz drifts with an INS accelerometer bias (its phase error grows without bound): an aided PLL of order 2 or 3 does not",
             loops.pll_bw_hz
         ),
     }

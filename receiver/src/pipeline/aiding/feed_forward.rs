@@ -392,7 +392,7 @@ impl InsFeedForward {
         };
         let Some(eph) = self.ephemeris(prn, t0.add_seconds(t_s)) else {
             self.log_once(prn, "eph", || {
-                format!("G{prn:02}: no ephemeris yet (decoded or --nav), no INS feed-forward")
+                format!("G{prn:02}: no ephemeris yet (none decoded, none in the navigation data given), no INS feed-forward")
             });
             return None;
         };

@@ -221,10 +221,10 @@ impl NavigationProcessor {
                 ));
             }
             (None, _) => tracing::warn!(
-                "--approx-llh without an approximate time (--time WEEK:TOW, or a SigMF core:datetime): no coarse-time fix; the first fix waits for frame sync"
+                "an approximate position was given without an approximate time (none given, none in the recording's metadata): no coarse-time fix; the first fix waits for frame sync"
             ),
             (_, None) => tracing::warn!(
-                "--approx-llh needs the ephemerides of --nav for a coarse-time fix: the first fix waits for frame sync"
+                "an approximate position was given, but no navigation data (ephemerides), which a coarse-time fix needs: the first fix waits for frame sync"
             ),
         }
         self

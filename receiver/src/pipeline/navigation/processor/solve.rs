@@ -27,7 +27,7 @@ impl NavigationProcessor {
             .or_else(|| self.nav_assist.as_ref().and_then(|n| n.iono));
         if known.is_none() && !self.iono_fallback_said {
             tracing::info!(
-                "ionosphere: typical Klobuchar coefficients until subframe 4 page 18 is decoded (or give --nav)"
+                "ionosphere: typical Klobuchar coefficients until subframe 4 page 18 is decoded (no navigation data with them was given)"
             );
             self.iono_fallback_said = true;
         }
@@ -122,7 +122,7 @@ impl NavigationProcessor {
     pub(super) fn log_poor_geometry(&mut self, t_stream_s: f64, pdop: f64, n_sv: usize) {
         if !self.poor_geometry_logged {
             tracing::info!(
-                "{t_stream_s:.2} s: PDOP {pdop:.1} with {n_sv} satellites is above the largest PDOP {} (--max-pdop): fixes flagged invalid until the geometry improves",
+                "{t_stream_s:.2} s: PDOP {pdop:.1} with {n_sv} satellites is above the largest PDOP allowed, {}: fixes flagged invalid until the geometry improves",
                 self.settings.max_pdop
             );
             self.poor_geometry_logged = true;
