@@ -17,6 +17,7 @@ use crate::pipeline::channels::search_schedule::SearchBudget;
 use crate::pipeline::navigation::{BlockEvent, NavigationProcessor};
 use crate::pipeline::profile::{add_timed, StageTimes};
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
+use crate::pipeline::timing::code_jump::plan_realignment;
 use crate::pipeline::timing::dating::WeekReference;
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult};
 use gpsrx_dsp::Prn;
@@ -678,7 +679,13 @@ impl Receiver {
         }
         match found {
             Some(outcome) if outcome.is_realignment() => {
-                if let Some(r) = self.manager.realign(outcome) {
+                // The channels report the code shifts; timing decides what they show.
+                let planned = self.manager.realignment_found(outcome).and_then(|s| {
+                    let plan = plan_realignment(s.shifts(), self.fs_hz)?;
+                    Some((s, plan))
+                });
+                let realigned = planned.and_then(|(s, plan)| self.manager.realign(s, &plan));
+                if let Some(r) = realigned {
                     // The bit edges of every channel moved with the code.
                     self.manager.restart_bit_sync();
                     self.nav

@@ -17,7 +17,7 @@
 
 pub mod realign;
 
-pub use realign::Realigned;
+pub use realign::{RealignSearch, Realigned};
 
 use crate::pipeline::channels::ring::SampleView;
 use crate::pipeline::channels::search_schedule::{
