@@ -20,6 +20,6 @@ pub(crate) mod smoothing;
 pub use fix_output::FixStats;
 pub use navdata::{NavDecoder, NavEvent};
 pub use processor::{
-    BlockEvent, NavigationProcessor, APPROX_DOPPLER_HZ, BELOW_HORIZON_DEG, PENDING_FOR_S,
-    PREDICTED_DOPPLER_HZ, PREDICTED_DOPPLER_RATE_HZ_S,
+    NavigationProcessor, APPROX_DOPPLER_HZ, BELOW_HORIZON_DEG, PENDING_FOR_S, PREDICTED_DOPPLER_HZ,
+    PREDICTED_DOPPLER_RATE_HZ_S,
 };

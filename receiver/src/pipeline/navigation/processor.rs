@@ -20,11 +20,9 @@ use crate::pipeline::navigation::observables::ObservableBuilder;
 use crate::pipeline::sink::ChannelRow;
 use crate::pipeline::sink::{NavigationEnd, Progress, ReceiverEvent, Sink, SinkError};
 use crate::pipeline::timing::coarse_fix::CoarseFixer;
-use crate::pipeline::timing::code_jump::{Collapse, CollapseMonitor};
-use crate::pipeline::timing::discontinuity::{Discontinuity, DiscontinuityMonitor};
-use crate::pipeline::timing::long_gap::LongGapRecovery;
+use crate::pipeline::timing::keeper::{BlockEvent, TimeKeeper};
 use crate::pipeline::timing::quick_sync::QuickSync;
-use crate::pipeline::timing::sv_time::{CarryNote, SvTimeKeeper};
+use crate::pipeline::timing::sv_time::CarryNote;
 use gpsrx_nav::lnav::AlmanacCollector;
 use gpsrx_nav::pvt::{PvtSolution, RaimStatus};
 use gpsrx_nav::rinex_nav::NavData;
@@ -64,18 +62,9 @@ pub struct NavigationProcessor {
     searched: BTreeSet<u8>,
     /// PRNs whose channel reached bit sync or carrier lock in tracking.
     locked: BTreeSet<u8>,
-    /// The satellites' SV times kept over losses and gaps.
-    sv_time: SvTimeKeeper,
-    /// Watches for lost samples: carrier-phase jumps.
-    monitor: DiscontinuityMonitor,
-    /// Watches for lost samples: prompt power collapsing on several satellites at once.
-    collapse: CollapseMonitor,
-    /// After a code realignment: the jump's sample, the satellites moved and the sample from
-    /// which their carrier phase is locked again, for the phase steps over the jump.
-    pending_steps: Option<(u64, Vec<u8>, u64)>,
-    /// The last valid fix: stream time (s), clock bias after any clock step (m), clock drift
-    /// (m/s).
-    last_clock: Option<(f64, f64, f64)>,
+    /// Receiver and SV time across gaps and outages: the SV times, the gap detectors, the
+    /// clock of the last fix and the recovery from long gaps.
+    time: TimeKeeper,
     /// Consecutive solutions that failed the integrity test.
     failed_in_row: u32,
     /// A valid fix came since the receiver time was last forgotten.
@@ -90,8 +79,6 @@ pub struct NavigationProcessor {
     /// Frame sync from one TLM and HOW confirmed across satellites (with ephemerides from a
     /// navigation file, a fix can follow at once).
     quick: Option<QuickSync>,
-    /// The receiver time re-established after samples of unknown length were lost.
-    long_gap: LongGapRecovery,
     /// Signal lost in gaps measured since the INS feed-forward was last told, ms.
     lost_for_aid_ms: f64,
 }
@@ -107,17 +94,6 @@ const CODE_SETTLE_AFTER_REALIGN_S: f64 = 0.5;
 /// Time the phase loops of channels moved onto a code that jumped need to lock again before
 /// the carrier-phase step over the jump is measured, s.
 const PHASE_SETTLE_AFTER_REALIGN_S: f64 = 0.25;
-
-/// What the end of a block found in the reports.
-#[derive(Debug, Clone, PartialEq)]
-pub enum BlockEvent {
-    /// Samples lost by whole milliseconds: the carrier phase jumped on every satellite; the
-    /// channels must find their bit edges again.
-    PhaseJump(Discontinuity),
-    /// The prompt power collapsed on several satellites at once: their code must be searched
-    /// again (samples lost by a fraction of a millisecond, or a blockage).
-    Collapse(Collapse),
-}
 
 /// Doppler uncertainty of a satellite predicted from a fix and an ephemeris, Hz (the fix's
 /// velocity and clock drift are good to a few cm/s: a few hertz; the rest is margin), and its
@@ -174,11 +150,7 @@ impl NavigationProcessor {
             cn0_lost_dbhz,
             searched: BTreeSet::new(),
             locked: BTreeSet::new(),
-            sv_time: SvTimeKeeper::default(),
-            monitor: DiscontinuityMonitor::new(fs_hz),
-            collapse: CollapseMonitor::new(),
-            pending_steps: None,
-            last_clock: None,
+            time: TimeKeeper::new(fs_hz),
             failed_in_row: 0,
             time_trusted: false,
             coarse: None,
@@ -186,7 +158,6 @@ impl NavigationProcessor {
             fixes_from_sample: 0.0,
             quick: nav_assist_given.then(QuickSync::default),
             aided_offset_cycles: None,
-            long_gap: LongGapRecovery::default(),
             lost_for_aid_ms: 0.0,
         }
     }
@@ -240,18 +211,18 @@ impl NavigationProcessor {
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<Option<BlockEvent>, SinkError> {
-        self.measure_pending_steps(end);
-        if let Some(c) = self.collapse.evaluate(end, self.fs_hz) {
-            tracing::info!(
+        let d = match self.time.end_block(end) {
+            None => return Ok(None),
+            Some(BlockEvent::Collapse(c)) => {
+                tracing::info!(
                 "{:.3} s: the prompt power of {} of {} satellites collapsed at once (samples lost, or a blockage): searching their code again",
                 c.sample as f64 / self.fs_hz,
                 c.satellites.len(),
                 c.watched
-            );
-            return Ok(Some(BlockEvent::Collapse(c)));
-        }
-        let Some(d) = self.monitor.evaluate(end) else {
-            return Ok(None);
+                );
+                return Ok(Some(BlockEvent::Collapse(c)));
+            }
+            Some(BlockEvent::PhaseJump(d)) => d,
         };
         let t_s = d.sample as f64 / self.fs_hz;
         tracing::warn!(
@@ -331,8 +302,7 @@ impl NavigationProcessor {
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
         sink.channel_epoch(channel, e)?;
-        self.monitor.push(e);
-        self.collapse.push(e);
+        self.time.push(e);
         self.searched.insert(e.prn);
         let locked = e.bit.is_some() || (e.pll_lock && e.state == ChannelState::Track);
         if locked && e.cn0_dbhz >= self.cn0_lost_dbhz {
@@ -342,7 +312,7 @@ impl NavigationProcessor {
         let usable =
             e.pll_lock && e.state != ChannelState::Lost && e.cn0_dbhz >= self.cn0_lost_dbhz;
         let note = match self.decoders.get_mut(&e.prn) {
-            Some(dec) => self.sv_time.observe(e, dec, self.fs_hz, usable),
+            Some(dec) => self.time.observe(e, dec, usable),
             None => None,
         };
         match note {

@@ -1,6 +1,11 @@
 //! Timing wing: receiver time and the satellites' SV times, across losses of the signal, lost
 //! samples and long gaps.
 //!
+//! Navigation asks one type, [`TimeKeeper`] (`keeper`): it holds the SV times, the gap
+//! detectors, the clock of the last fix and the recovery from long gaps, and says what the end
+//! of a block found ([`BlockEvent`]). The decision on a code realignment's shifts is made here
+//! too (`code_jump::plan_realignment`); the channel manager only carries it out.
+//!
 //! - `sv_time`: SV times kept across losses of the signal and lost samples;
 //! - `discontinuity`: lost samples found by a carrier-phase jump common to the satellites;
 //! - `code_jump`: lost samples found by a code jump (prompt power collapsing together);
@@ -19,9 +24,11 @@ pub(crate) mod code_jump;
 pub(crate) mod dating;
 pub(crate) mod discontinuity;
 pub(crate) mod gap_length;
+pub(crate) mod keeper;
 pub(crate) mod long_gap;
 pub(crate) mod modulo;
 pub(crate) mod quick_sync;
 pub(crate) mod sv_time;
 
 pub use dating::{WeekReference, WeekSource};
+pub use keeper::{BlockEvent, TimeKeeper};

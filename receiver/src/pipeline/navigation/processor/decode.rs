@@ -98,7 +98,7 @@ impl NavigationProcessor {
                             "G{:02}: the bit edges found disagree with the SV time carried over the outage by {offset_ms:.3} ms (samples lost?): waiting for frame sync",
                             e.prn
                         );
-                        self.sv_time.make_rough(Some(e.prn));
+                        self.time.make_rough(Some(e.prn));
                     }
                     _ => {}
                 }
@@ -141,7 +141,7 @@ impl NavigationProcessor {
             .decoders
             .iter()
             .filter(|(_, d)| d.synced())
-            .filter_map(|(&p, _)| self.sv_time.last_known(p).map(|(k, sv)| (p, k, sv)))
+            .filter_map(|(&p, _)| self.time.last_known(p).map(|(k, sv)| (p, k, sv)))
             .collect();
         let Some(quick) = self.quick.as_mut() else {
             return Ok(());
@@ -272,7 +272,7 @@ impl NavigationProcessor {
                     d.reset_sync();
                 }
             }
-            self.sv_time.make_rough(Some(p));
+            self.time.make_rough(Some(p));
         }
         self.builder.restart();
         self.prior = None;

@@ -233,7 +233,7 @@ impl NavigationProcessor {
                 t_stream_s,
             });
         }
-        if let Some(gap) = self.sv_time.take_unmeasured_gap() {
+        if let Some(gap) = self.time.take_unmeasured_gap() {
             let length = gap.length_from_bias_ms(t_stream_s, sol.clock_bias_m);
             match length {
                 Some(ms) => tracing::warn!(
@@ -263,8 +263,9 @@ impl NavigationProcessor {
             tracing::debug!("receiver clock stepped by {step} ms");
             sink.event(&ReceiverEvent::ClockStep { ms: step })?;
         }
-        self.last_clock = Some((t_stream_s, bias_after_m, sol.clock_drift_mps.unwrap_or(0.0)));
-        self.long_gap.note_fix(sol.llh);
+        let drift_mps = sol.clock_drift_mps.unwrap_or(0.0);
+        self.time
+            .note_fix(t_stream_s, bias_after_m, drift_mps, sol.llh);
         if self.stats.first_fix_s.is_none() {
             tracing::info!(
                 "first fix at {:.2} s: {:.7} {:.7} {:.1} m, {} satellites, PDOP {:.1}",

@@ -6,7 +6,6 @@ use super::{NavigationProcessor, CODE_SETTLE_AFTER_REALIGN_S, PHASE_SETTLE_AFTER
 use crate::pipeline::channels::channel_manager::Realigned;
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
 use crate::pipeline::timing::quick_sync::QuickSync;
-use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
 use gpsrx_tracking::ChannelEpoch;
 
 impl NavigationProcessor {
@@ -40,24 +39,9 @@ impl NavigationProcessor {
         );
         self.forget_time(t_s, Vec::new(), Some(t_s + CODE_SETTLE_AFTER_REALIGN_S));
         let settle = (PHASE_SETTLE_AFTER_REALIGN_S * self.fs_hz) as u64;
-        self.monitor.hold_until(r.at_sample + settle);
-        self.pending_steps = Some((r.jump_sample, r.prns.clone(), r.at_sample + settle));
+        self.time
+            .code_realigned(r.jump_sample, r.prns.clone(), r.at_sample + settle);
         sink.event(&ReceiverEvent::SampleGap { t_s })
-    }
-
-    /// The carrier-phase steps over a code jump, once the phase loops of the moved channels
-    /// hold again (up to sample `end`): handed to the gap being recovered from.
-    pub(super) fn measure_pending_steps(&mut self, end: u64) {
-        let Some((jump, prns, from)) = self.pending_steps.as_ref() else {
-            return;
-        };
-        if end < from + (0.02 * self.fs_hz) as u64 {
-            return;
-        }
-        let steps = self.monitor.phase_steps(prns, *jump, Some(*from));
-        tracing::debug!("carrier-phase steps over the code jump: {steps:?}");
-        self.sv_time.set_gap_steps(steps);
-        self.pending_steps = None;
     }
 
     /// After lost samples: every SV time is dropped (the decoders find frame sync again and the
@@ -76,8 +60,7 @@ impl NavigationProcessor {
         for dec in self.decoders.values_mut() {
             dec.reset_sync();
         }
-        self.sv_time
-            .start_gap(t_s, self.fs_hz, self.last_clock, steps, code_from_s);
+        self.time.start_gap(t_s, steps, code_from_s);
         self.builder.note_gap(t_s);
         self.prior = None;
     }
@@ -93,7 +76,7 @@ impl NavigationProcessor {
         off_ms: f64,
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
-        let Some((agreeing, offsets)) = self.sv_time.note_refusal(t_s, prn, off_ms) else {
+        let Some((agreeing, offsets)) = self.time.note_refusal(t_s, prn, off_ms) else {
             return Ok(());
         };
         tracing::warn!(
@@ -104,12 +87,12 @@ impl NavigationProcessor {
         // the gap at once.
         self.forget_time(t_s, Vec::new(), Some(t_s));
         sink.event(&ReceiverEvent::SampleGap { t_s })?;
-        let resolved = self.sv_time.add_edge_offsets(offsets, t_s);
+        let resolved = self.time.add_edge_offsets(offsets, t_s);
         if let Some(length_ms) = resolved {
             tracing::warn!(
                 "{t_s:.3} s: the samples lost were {length_ms:.3} ms of signal (from the code of the new channels): SV times carried over the gap"
             );
-            self.sv_time.move_over_gap(length_ms);
+            self.time.move_over_gap(length_ms);
             sink.event(&ReceiverEvent::GapMeasured { t_s, length_ms })?;
             self.lost_for_aid_ms += length_ms;
             self.step_clock_over_gap(t_s, length_ms, sink)?;
@@ -140,11 +123,10 @@ impl NavigationProcessor {
         for d in self.decoders.values_mut() {
             d.reset_sync();
         }
-        self.sv_time.make_rough(None);
+        self.time.make_rough(None);
         self.builder.restart();
         self.failed_in_row = 0;
-        let before = self.last_clock;
-        self.sv_time.ensure_gap(t_s, before);
+        self.time.ensure_gap(t_s);
     }
 
     /// Once the length of the gap being recovered from cannot be measured: the time comes
@@ -154,8 +136,7 @@ impl NavigationProcessor {
         let eph = self.nav_assist.is_some()
             || with_eph.count() >= crate::pipeline::timing::coarse_fix::MIN_SATELLITES;
         let origin = self.builder.rx_time_origin();
-        let gap = self.sv_time.gap();
-        let Some(start) = self.long_gap.begin(gap, self.fs_hz, origin, eph) else {
+        let Some(start) = self.time.begin_long_gap(origin, eph) else {
             return;
         };
         self.coarse = start.coarse.or(self.coarse.take());
@@ -175,11 +156,11 @@ impl NavigationProcessor {
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
         let origin = self.builder.rx_time_origin();
-        let Some(step) = self.long_gap.clock_step_ms(out, origin) else {
+        let Some(step) = self.time.coarse_clock_step_ms(out, origin) else {
             return Ok(());
         };
         self.builder.step_clock_ms(step);
-        self.sv_time.note_clock_step(step);
+        self.time.note_clock_step(step);
         tracing::info!("receiver clock stepped by {step} ms to the coarse time");
         sink.event(&ReceiverEvent::ClockStep { ms: step })
     }
@@ -200,11 +181,9 @@ impl NavigationProcessor {
             return Ok(());
         }
         self.builder.step_clock_ms(step);
-        self.sv_time.note_clock_step(step);
-        if let Some((t, b, d)) = self.last_clock {
-            // The clock of the last fix, on the stepped time scale.
-            self.last_clock = Some((t, b + step as f64 * 1e-3 * SPEED_OF_LIGHT_MPS, d));
-        }
+        self.time.note_clock_step(step);
+        // The clock of the last fix, on the stepped time scale.
+        self.time.step_last_clock(step);
         tracing::info!("receiver clock stepped by {step} ms over the lost samples");
         sink.event(&ReceiverEvent::ClockStep { ms: step })
     }
@@ -219,7 +198,7 @@ impl NavigationProcessor {
         e: &ChannelEpoch,
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
-        let (Some(_), Some(t0)) = (self.sv_time.gap(), self.builder.rx_time_origin()) else {
+        let (Some(_), Some(t0)) = (self.time.gap(), self.builder.rx_time_origin()) else {
             return Ok(());
         };
         let Some(dec) = self.decoders.get(&e.prn) else {
@@ -236,7 +215,7 @@ impl NavigationProcessor {
             return Ok(());
         }
         let step = -((tau - 0.075) * 1e3).round() as i64;
-        self.sv_time.note_clock_step(step);
+        self.time.note_clock_step(step);
         self.builder.step_clock_ms(step);
         tracing::info!("receiver clock stepped by {step} ms to re-establish the time");
         sink.event(&ReceiverEvent::ClockStep { ms: step })
