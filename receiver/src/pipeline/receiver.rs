@@ -9,8 +9,8 @@
 
 use crate::config::ReceiverConfig;
 use crate::landmarks::LandmarkObservation;
-use crate::pipeline::aiding::monitor::{AidMonitor, AidingStats, GatedAid};
 use crate::pipeline::aiding::InsFeedForward;
+use crate::pipeline::aiding::{AidMonitor, AidingStats, GatedAid};
 use crate::pipeline::channels::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
 use crate::pipeline::channels::ring::{block_samples, SampleWindow};
 use crate::pipeline::channels::search_schedule::SearchBudget;
@@ -207,9 +207,9 @@ pub struct RunSummary {
     /// Mean PDOP.
     pub mean_pdop: Option<f64>,
     /// With `--ins`: how much of the recording was aided, and how often the INS was rejected
-    /// for disagreeing with the tracked Doppler ([`crate::pipeline::aiding::monitor`]).
+    /// for disagreeing with the tracked Doppler ([`crate::pipeline::aiding::AidMonitor`]).
     pub ins_aiding: Option<InsAidingSummary>,
-    /// Where the wall time went, stage by stage ([`crate::pipeline::profile`]).
+    /// Where the wall time went, stage by stage ([`crate::pipeline::StageTimes`]).
     pub profile: StageTimes,
 }
 
@@ -539,7 +539,7 @@ impl Receiver {
         })
     }
 
-    /// Where the wall time went so far ([`crate::pipeline::profile`]).
+    /// Where the wall time went so far ([`crate::pipeline::StageTimes`]).
     pub fn profile(&self) -> StageTimes {
         let work = self.manager.work_times();
         StageTimes {

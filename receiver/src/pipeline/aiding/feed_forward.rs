@@ -298,7 +298,7 @@ impl InsFeedForward {
 
     /// The unfiltered feed-forward Doppler (Hz) of `prn` at receive time `t_s`, without
     /// logging and without the band limiter: what the integrity monitor compares with the
-    /// Doppler of a channel that runs unaided ([`crate::pipeline::aiding::monitor`]). None when
+    /// Doppler of a channel that runs unaided ([`crate::pipeline::aiding::AidMonitor`]). None when
     /// the aid cannot be computed (no GPS time, no ephemeris, outside the INS file).
     pub fn predicted_doppler_hz(&self, prn: u8, t_s: f64) -> Option<f64> {
         let (t0, know) = {

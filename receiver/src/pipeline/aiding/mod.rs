@@ -7,7 +7,7 @@
 //!   ([`GatedAid`] hands the aid on only while it is admitted).
 
 mod feed_forward;
-pub(crate) mod monitor;
+mod monitor;
 
 pub use feed_forward::{InsFeedForward, DRIFT_SMOOTHING_S};
 pub use monitor::{AidMonitor, AidPermission, AidingStats, GatedAid};

@@ -15,7 +15,7 @@ pub(crate) mod fix_output;
 pub(crate) mod navdata;
 pub(crate) mod observables;
 mod processor;
-pub(crate) mod smoothing;
+mod smoothing;
 
 pub use fix_output::FixStats;
 pub use navdata::{NavDecoder, NavEvent};

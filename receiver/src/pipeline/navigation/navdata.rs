@@ -57,7 +57,7 @@ pub enum NavEvent {
     /// While unsynchronised, with [`NavDecoder::report_tow_candidates`]: a telemetry word
     /// with the preamble and a hand-over word ending at the newest bit passed parity. Not yet
     /// trusted: [`NavDecoder::sync_at`] takes it once another satellite confirms it
-    /// ([`crate::pipeline::timing::quick_sync`]).
+    /// (`crate::pipeline::timing::quick_sync`).
     TowCandidate {
         /// `ms_count` of the TLM's first bit.
         first_ms: u64,

@@ -170,7 +170,7 @@ impl NavigationProcessor {
         self
     }
 
-    /// Enables the coarse-time first fix ([`crate::pipeline::timing::coarse_fix`]) when the settings
+    /// Enables the coarse-time first fix (`crate::pipeline::timing::coarse_fix`) when the settings
     /// hold an approximate position, `start` (the approximate GPS time of sample 0: `--time`,
     /// else the recording's date) is known and a navigation file gives the ephemerides;
     /// says why not when the position is given without the rest.
@@ -241,7 +241,7 @@ impl NavigationProcessor {
 
     /// Says whether the reference week may date the outputs (true unless set here): when
     /// not, times before subframe 1 is decoded carry [`crate::output::Fix::week_known`] and
-    /// [`ObservablesReport::week_known`] false ([`crate::pipeline::timing::dating`]).
+    /// [`crate::pipeline::ObservablesReport::week_known`] false ([`crate::pipeline::WeekReference`]).
     pub fn with_reference_week_known(mut self, known: bool) -> Self {
         self.reference_week_known = known;
         self

@@ -42,7 +42,7 @@ pub struct ObservablesReport {
     /// which may be 1024 weeks off).
     pub week_decoded: bool,
     /// Whether `epoch.time.week` is known: decoded, or a reference week that does not come
-    /// from the system clock ([`crate::pipeline::timing::dating`]).
+    /// from the system clock ([`crate::pipeline::WeekReference`]).
     pub week_known: bool,
 }
 
@@ -102,7 +102,7 @@ pub enum ReceiverEvent {
         length_ms: f64,
     },
     /// The satellites' SV times came from their code phases, the approximate time and
-    /// position ([`crate::pipeline::timing::coarse_fix`]), before any time of week was decoded.
+    /// position (`crate::pipeline::timing::coarse_fix`), before any time of week was decoded.
     CoarseTime {
         /// Stream time of the solution, s.
         t_s: f64,

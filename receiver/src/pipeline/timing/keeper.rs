@@ -15,7 +15,7 @@ use crate::pipeline::timing::coarse_fix::CoarseOutcome;
 use crate::pipeline::timing::code_jump::{Collapse, CollapseMonitor};
 use crate::pipeline::timing::discontinuity::{Discontinuity, DiscontinuityMonitor};
 use crate::pipeline::timing::long_gap::{LongGapRecovery, LongGapStart};
-use crate::pipeline::timing::sv_time::{CarryNote, GapRecovery, SvTimeKeeper};
+use crate::pipeline::timing::sv_time::{CarryNote, EdgeOffsets, GapRecovery, SvTimeKeeper};
 use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
 use gpsrx_nav::time::GpsTime;
 use gpsrx_nav::Llh;
@@ -108,7 +108,7 @@ impl TimeKeeper {
     }
 
     /// Keeps the satellite's SV time from a report and carries it over to a new channel
-    /// ([`SvTimeKeeper::observe`]).
+    /// (`SvTimeKeeper::observe`).
     pub fn observe(
         &mut self,
         e: &ChannelEpoch,
@@ -136,14 +136,14 @@ impl TimeKeeper {
 
     /// Samples were lost at stream time `t_s`: the gap is kept to be measured, with the clock
     /// of the last valid fix, the carrier-phase `steps` and `code_from_s`
-    /// ([`SvTimeKeeper::start_gap`]).
+    /// (`SvTimeKeeper::start_gap`).
     pub fn start_gap(&mut self, t_s: f64, steps: Vec<PhaseStep>, code_from_s: Option<f64>) {
         self.sv
             .start_gap(t_s, self.fs_hz, self.last_clock, steps, code_from_s);
     }
 
     /// A gap at `t_s` unless one is being recovered from already
-    /// ([`SvTimeKeeper::ensure_gap`]).
+    /// (`SvTimeKeeper::ensure_gap`).
     pub fn ensure_gap(&mut self, t_s: f64) {
         self.sv.ensure_gap(t_s, self.last_clock);
     }
@@ -159,18 +159,13 @@ impl TimeKeeper {
         self.sv.take_unmeasured_gap()
     }
 
-    /// A carried SV time refused at the new bit edge ([`SvTimeKeeper::note_refusal`]).
-    pub fn note_refusal(
-        &mut self,
-        t_s: f64,
-        prn: u8,
-        off_ms: f64,
-    ) -> Option<(usize, Vec<(u8, f64, f64)>)> {
+    /// A carried SV time refused at the new bit edge (`SvTimeKeeper::note_refusal`).
+    pub fn note_refusal(&mut self, t_s: f64, prn: u8, off_ms: f64) -> Option<(usize, EdgeOffsets)> {
         self.sv.note_refusal(t_s, prn, off_ms)
     }
 
-    /// Offsets of refused carried times for the gap ([`SvTimeKeeper::add_edge_offsets`]).
-    pub fn add_edge_offsets(&mut self, offsets: Vec<(u8, f64, f64)>, t_s: f64) -> Option<f64> {
+    /// Offsets of refused carried times for the gap (`SvTimeKeeper::add_edge_offsets`).
+    pub fn add_edge_offsets(&mut self, offsets: EdgeOffsets, t_s: f64) -> Option<f64> {
         self.sv.add_edge_offsets(offsets, t_s)
     }
 
@@ -201,7 +196,7 @@ impl TimeKeeper {
     }
 
     /// Once the length of the gap being recovered from cannot be measured: how the time comes
-    /// back ([`LongGapRecovery::begin`]).
+    /// back (`LongGapRecovery::begin`).
     pub fn begin_long_gap(
         &mut self,
         rx_origin: Option<GpsTime>,
@@ -213,7 +208,7 @@ impl TimeKeeper {
     }
 
     /// The receiver clock step to a coarse-time outcome while a long gap is recovered from
-    /// ([`LongGapRecovery::clock_step_ms`]).
+    /// (`LongGapRecovery::clock_step_ms`).
     pub fn coarse_clock_step_ms(
         &self,
         outcome: &CoarseOutcome,

@@ -23,7 +23,7 @@ pub(crate) mod coarse_fix;
 pub(crate) mod code_jump;
 pub(crate) mod dating;
 pub(crate) mod discontinuity;
-pub(crate) mod gap_length;
+mod gap_length;
 pub(crate) mod keeper;
 pub(crate) mod long_gap;
 pub(crate) mod modulo;

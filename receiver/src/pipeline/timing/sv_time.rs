@@ -17,6 +17,10 @@ use std::collections::BTreeMap;
 /// How long the length of lost samples is sought after the code offsets may be used, s.
 pub const GAP_RESOLVE_S: f64 = 1.0;
 
+/// Refused carried SV times that agree: per satellite `(PRN, offset of the kept SV time from
+/// the new bit edge ms, SV time rate)`.
+pub type EdgeOffsets = Vec<(u8, f64, f64)>;
+
 /// What [`SvTimeKeeper::observe`] found that must be reported.
 #[derive(Debug, Clone, Copy)]
 pub enum CarryNote {
@@ -268,12 +272,7 @@ impl SvTimeKeeper {
     /// [`crate::pipeline::timing::discontinuity::MIN_SATELLITES`] satellites were refused
     /// within 2 s by the same offset (0.1 ms), samples were lost during the outage: returns how
     /// many agree and their `(PRN, offset ms, SV time rate)` (and forgets the refusals).
-    pub fn note_refusal(
-        &mut self,
-        t_s: f64,
-        prn: u8,
-        off_ms: f64,
-    ) -> Option<(usize, Vec<(u8, f64, f64)>)> {
+    pub fn note_refusal(&mut self, t_s: f64, prn: u8, off_ms: f64) -> Option<(usize, EdgeOffsets)> {
         self.refused.retain(|r| t_s - r.0 < 2.0 && r.1 != prn);
         self.refused.push((t_s, prn, off_ms));
         let agreeing = self
@@ -297,7 +296,7 @@ impl SvTimeKeeper {
     /// The offsets `(PRN, offset ms, rate)` of refused carried times handed to the gap being
     /// recovered from at `t_s` ([`GapRecovery::add_edge_offset`]): its length, if that
     /// resolved it.
-    pub fn add_edge_offsets(&mut self, offsets: Vec<(u8, f64, f64)>, t_s: f64) -> Option<f64> {
+    pub fn add_edge_offsets(&mut self, offsets: EdgeOffsets, t_s: f64) -> Option<f64> {
         let mut resolved = None;
         if let Some(gap) = self.gap.as_mut() {
             for (p, o, r) in offsets {

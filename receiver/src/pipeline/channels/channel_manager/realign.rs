@@ -42,7 +42,7 @@ pub struct Realigned {
     pub prns: Vec<u8>,
     /// The first sample after the move (the next code period of the channels).
     pub at_sample: u64,
-    /// The code moved by more than a gap of up to [`crate::pipeline::timing::code_jump::MAX_GAP_S`]
+    /// The code moved by more than a gap of up to `crate::pipeline::timing::code_jump::MAX_GAP_S`
     /// explains (on at least three satellites): samples of an unknown, longer length were lost,
     /// and the receiver time must be re-established from the signal.
     pub length_unknown: bool,
@@ -121,9 +121,9 @@ impl ChannelManager {
             .position(|c| c.prn() == prn && c.state() != ChannelState::Lost)
     }
 
-    /// The code shifts a realignment search found ([`SearchOutcome::is_realignment`]): per
+    /// The code shifts a realignment search found (`SearchOutcome::is_realignment`): per
     /// satellite with a live channel found again, how far its replica must move onto the
-    /// signal. Timing judges them ([`crate::pipeline::timing::code_jump::plan_realignment`]);
+    /// signal. Timing judges them (`crate::pipeline::timing::code_jump::plan_realignment`);
     /// [`ChannelManager::realign`] carries out its plan. `None` for any other search.
     pub fn realignment_found(&self, outcome: SearchOutcome) -> Option<RealignSearch> {
         let realign = outcome.realign?;
@@ -155,7 +155,7 @@ impl ChannelManager {
     }
 
     /// Moves the channels of `plan` onto the code their realignment search found; returns
-    /// what moved (at least [`crate::pipeline::timing::code_jump::MIN_SATELLITES`], else
+    /// what moved (at least `crate::pipeline::timing::code_jump::MIN_SATELLITES`, else
     /// nothing). The channels that collapsed restart their carrier loop at the Doppler they
     /// held before (when the gap's length is unknown, at the Doppler the search found: the one
     /// held may have drifted over the gap); the others keep their loops.

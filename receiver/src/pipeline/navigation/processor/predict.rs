@@ -14,7 +14,7 @@ impl NavigationProcessor {
     /// with a fix (position, velocity, clock bias and drift) and the satellite's ephemeris
     /// (decoded or from `--nav`), whether it is above the horizon and its Doppler within
     /// [`PREDICTED_DOPPLER_HZ`] plus [`PREDICTED_DOPPLER_RATE_HZ_S`] per second since the fix
-    /// ([`crate::pipeline::channels::visibility`]); else nothing.
+    /// (`crate::pipeline::channels::visibility`); else nothing.
     pub fn visibility(&self, prn: u8, t_stream_s: f64) -> Visibility {
         let Some((rx, t, drift, half_width_hz)) = self.prediction_origin(t_stream_s) else {
             // With ephemerides from `--nav`, the first fix (a few seconds away) will tell.
