@@ -24,7 +24,7 @@ pub(crate) mod code_jump;
 pub(crate) mod dating;
 pub(crate) mod discontinuity;
 mod gap_length;
-pub(crate) mod keeper;
+mod keeper;
 pub(crate) mod long_gap;
 pub(crate) mod modulo;
 pub(crate) mod quick_sync;
