@@ -217,3 +217,30 @@ impl TimeKeeper {
         self.long_gap.clock_step_ms(outcome, rx_origin)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gap_is_measured_against_the_last_fix_on_the_stepped_time_scale() {
+        let mut k = TimeKeeper::new(2.6e6);
+        assert!(k.last_clock().is_none());
+        k.note_fix(5.0, 300.0, 0.0, Llh::from_degrees(37.5, 127.0, 40.0));
+        // The receiver clock stepped by 31 ms over a measured gap: the last fix's bias moves by
+        // c 31 ms on the new time scale.
+        k.step_last_clock(31);
+        let (t, b, d) = k.last_clock().expect("a clock");
+        assert_eq!((t, d), (5.0, 0.0));
+        assert!(
+            (b - (300.0 + 0.031 * SPEED_OF_LIGHT_MPS)).abs() < 1e-6,
+            "{b}"
+        );
+        // A later gap keeps that clock; a second call does not replace the gap.
+        k.ensure_gap(8.0);
+        k.ensure_gap(9.0);
+        let gap = k.gap().expect("a gap");
+        assert_eq!(gap.t_s, 8.0);
+        assert_eq!(gap.before, Some((t, b, d)));
+    }
+}

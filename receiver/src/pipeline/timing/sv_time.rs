@@ -462,3 +462,53 @@ impl SvTimeKeeper {
         note
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refusals_by_one_offset_on_three_satellites_within_two_seconds_are_a_gap() {
+        let mut k = SvTimeKeeper::default();
+        // Two satellites refused by about -9 ms, one by another offset: not yet.
+        assert!(k.note_refusal(10.0, 3, -9.00,).is_none());
+        assert!(k.note_refusal(10.5, 16, -9.05).is_none());
+        assert!(k.note_refusal(10.6, 22, -4.00).is_none());
+        // A third agreeing within 0.1 ms and 2 s: samples lost (no clocks kept: no offsets).
+        let (agreeing, offsets) = k.note_refusal(11.0, 25, -8.99).expect("a gap");
+        assert_eq!(agreeing, 3);
+        assert!(offsets.is_empty());
+        // The refusals are forgotten once reported.
+        assert!(k.note_refusal(11.1, 26, -9.0).is_none());
+        // Refusals older than 2 s do not count.
+        assert!(k.note_refusal(14.0, 29, -9.0).is_none());
+        assert!(k.note_refusal(14.5, 31, -9.0).is_none());
+        assert!(k.note_refusal(16.6, 32, -9.0).is_none());
+    }
+
+    #[test]
+    fn clock_steps_while_recovering_count_in_the_length_from_the_clock_bias() {
+        let mut k = SvTimeKeeper::default();
+        // Last fix at 5 s: bias 300 m, drift 3 m/s.
+        k.start_gap(10.0, 2.6e6, Some((5.0, 300.0, 3.0)), Vec::new(), None);
+        let gap = k.gap().expect("a gap");
+        assert!(
+            gap.unresolved,
+            "no steps, no code: the length comes from the clock bias"
+        );
+        // The receiver time is 31 ms late after the gap: the bias drops by c 31 ms from its
+        // prediction b0 + d (t - t0).
+        let c = SPEED_OF_LIGHT_MPS;
+        let bias = 300.0 + 3.0 * (12.0 - 5.0) - 0.031 * c;
+        let length = gap.length_from_bias_ms(12.0, bias).expect("a length");
+        assert!((length - 31.0).abs() < 1e-6, "{length}");
+        // A 31 ms clock step made meanwhile moves the bias back by as much: still 31 ms.
+        k.note_clock_step(31);
+        let gap = k.take_unmeasured_gap().expect("unmeasured");
+        let length = gap
+            .length_from_bias_ms(12.0, bias + 0.031 * c)
+            .expect("a length");
+        assert!((length - 31.0).abs() < 1e-6, "{length}");
+        assert!(k.gap().is_none());
+    }
+}
