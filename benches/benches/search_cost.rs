@@ -1,5 +1,5 @@
 //! The background search's cost model against its measured CPU time
-//! (`receiver::pipeline::search_schedule`: `fixed_cost_s + sum of cost_s` per batch).
+//! (`gpsrx_receiver::pipeline::channels`, the search schedule: `fixed_cost_s + sum of cost_s` per batch).
 //!
 //! Every level of the background search (1 ms x 10, 10 ms x 13, 10 ms x 50 over +-5 kHz)
 //! at 2.6 and 4 MHz, batches of 1 and 8 absent PRNs on 8-bit noise held as the receiver
@@ -14,7 +14,7 @@
 
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::{Prn, SampleSlice};
-use gpsrx_receiver::pipeline::search_schedule::{cost_s, fixed_cost_s, level_config, LEVELS};
+use gpsrx_receiver::pipeline::channels::{cost_s, fixed_cost_s, level_config, LEVELS};
 use std::hint::black_box;
 
 /// Agreement asked for: measured within this fraction of the model.

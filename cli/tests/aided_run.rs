@@ -548,7 +548,7 @@ fn an_ins_1s_late_is_dropped_in_a_turn_and_the_fixes_are_the_unaided_ones() {
 /// of a 2 Hz loop), and when the aid goes it returns to its unaided 15 Hz loops, in lock.
 #[test]
 fn aided_loops_are_used_while_the_aid_is_on() {
-    use gpsrx_receiver::pipeline::tracker::track;
+    use gpsrx_receiver::pipeline::channels::track;
     use gpsrx_samples::{open_source, SourceConfig};
     use gpsrx_tracking::{Channel, ChannelConfig, ChannelStart, ChannelState, DopplerAid};
 

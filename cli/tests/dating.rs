@@ -197,7 +197,7 @@ fn a_recording_without_a_date_is_never_dated_from_the_system_clock() {
     // --week dates them.
     let with_week = raw_args(&["--week", "2190"]);
     let (_, err) = gpsrx_ok(&strs(&with_week), 2);
-    assert!(err.contains("GPS week 2190 (--week)"), "{err}");
+    assert!(err.contains("GPS week 2190 (as given)"), "{err}");
     assert_epochs_in_truth_span(&rinex_epochs(&out), START.0);
 
     // Nothing: a warning, no observation file (the previous run's is gone too), no week.

@@ -1,7 +1,7 @@
 //! Tracking channels on simulated recordings, against the simulator's truth.
 
 use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
-use gpsrx_receiver::pipeline::tracker::track;
+use gpsrx_receiver::pipeline::channels::track;
 use gpsrx_samples::sim::{Scenario, SimSatellite, Simulator};
 use gpsrx_samples::{open_source, SourceConfig};
 use gpsrx_studies::bandwidth::{
@@ -204,7 +204,7 @@ fn errors_vs_truth(
     data: &Path,
     configs: &[ChannelConfig],
     settle_s: &[f64],
-    aid: Option<gpsrx_receiver::pipeline::tracker::AidSource<'_>>,
+    aid: Option<gpsrx_receiver::pipeline::channels::AidSource<'_>>,
 ) -> ErrorSeries {
     let truth = Truth::new(sim);
     let specs: Vec<ChannelSpec> = sim
@@ -421,7 +421,7 @@ rate_hz = 1.0
             .collect();
         let mut src = open_source(&SourceConfig::new(report.data_path.clone()))
             .unwrap_or_else(|e| panic!("{e}"));
-        let aid: Option<gpsrx_receiver::pipeline::tracker::AidSource<'_>> =
+        let aid: Option<gpsrx_receiver::pipeline::channels::AidSource<'_>> =
             if aided { Some(&truth_aid) } else { None };
         track(src.as_mut(), channels, aid, |_, e| {
             if !in_turn(e.t_rx_s) {
@@ -647,13 +647,14 @@ fn navigation_message_decodes_from_tracked_bits_and_time_tags_the_code() {
     );
     let cfg = ChannelConfig::default();
     let channels = channels_from_truth(&sim, fs, &cfg);
-    let mut decoders: BTreeMap<u8, gpsrx_receiver::pipeline::navdata::NavDecoder> = BTreeMap::new();
+    let mut decoders: BTreeMap<u8, gpsrx_receiver::pipeline::navigation::NavDecoder> =
+        BTreeMap::new();
     let mut time_errors: BTreeMap<u8, f64> = BTreeMap::new();
     let mut src = open_source(&SourceConfig::new(data)).unwrap_or_else(|e| panic!("{e}"));
     track(src.as_mut(), channels, None, |_, e| {
         let dec = decoders
             .entry(e.prn)
-            .or_insert_with(|| gpsrx_receiver::pipeline::navdata::NavDecoder::new(e.prn, 2190));
+            .or_insert_with(|| gpsrx_receiver::pipeline::navigation::NavDecoder::new(e.prn, 2190));
         if let (Some(b), Some(ms)) = (e.bit, e.bit_start_ms) {
             dec.push_bit(b.value, ms);
         }

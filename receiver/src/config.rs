@@ -61,21 +61,21 @@ pub struct RunSettings {
     /// whole run (the background search spends it over its searches of that PRN).
     pub acq_pfa: f64,
     /// CPU time the background search may spend per second of signal, s (modelled:
-    /// [`crate::pipeline::search_schedule`]); a first round of searches may spend
-    /// [`crate::pipeline::search_schedule::BURST_S`] at once. 0: no background search, only
+    /// `crate::pipeline::channels::search_schedule`); a first round of searches may spend
+    /// [`crate::pipeline::channels::BURST_S`] at once. 0: no background search, only
     /// the re-acquisition of lost satellites.
     pub search_budget_s: f64,
     /// Use satellites whose ephemeris says they are unhealthy.
     pub allow_unhealthy: bool,
     /// Full GPS week of the recording: labels times until subframe 1 gives the week, and
     /// resolves the broadcast 10-bit week (default: the recording's date, else the navigation
-    /// file's week; else unknown, see [`crate::pipeline::dating`]).
+    /// file's week; else unknown, see [`crate::pipeline::WeekReference`]).
     pub week: Option<u32>,
     /// PRNs to search for (empty: all 32).
     pub prns: Vec<u8>,
     /// Approximate GPS time of the recording's first sample (`--time WEEK:TOW`; default: the
     /// SigMF `core:datetime`), within a minute: with [`RunSettings::approx_llh`] and `--nav`,
-    /// the first fix comes from the code phases alone ([`crate::pipeline::coarse_fix`]).
+    /// the first fix comes from the code phases alone (`crate::pipeline::timing::coarse_fix`).
     pub approx_time: Option<gpsrx_nav::time::GpsTime>,
     /// Approximate position, `[latitude deg, longitude deg, height m]` (WGS-84), within
     /// 100 km (`--approx-llh LAT,LON,H`).
@@ -99,7 +99,7 @@ impl Default for RunSettings {
             acq_coherent_ms: 1,
             acq_noncoherent: 10,
             acq_pfa: 1e-5,
-            search_budget_s: crate::pipeline::search_schedule::DEFAULT_PER_SIGNAL_S,
+            search_budget_s: crate::pipeline::channels::DEFAULT_PER_SIGNAL_S,
             allow_unhealthy: false,
             week: None,
             prns: Vec::new(),

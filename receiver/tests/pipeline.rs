@@ -263,13 +263,13 @@ fn an_invalid_configuration_names_the_setting() {
 #[test]
 fn the_channel_manager_alone_finds_the_simulated_satellites_at_their_doppler() {
     use gpsrx_dsp::acquisition::AcqConfig;
-    use gpsrx_receiver::pipeline::channel_manager::{ChannelManager, SearchSettings};
+    use gpsrx_receiver::pipeline::channels::{ChannelManager, SearchSettings};
     let sim = simulator(0.5);
     let fs = 2.048e6;
     let settings = SearchSettings {
         acq: AcqConfig::default(),
         weak_fallback: true,
-        background: Some(gpsrx_receiver::pipeline::search_schedule::SearchBudget::default()),
+        background: Some(gpsrx_receiver::pipeline::channels::SearchBudget::default()),
         prns: Vec::new(),
         cold_targets: None,
     };

@@ -24,7 +24,7 @@
 use anyhow::Context;
 use gpsrx_dsp::constants::CA_CODE_LENGTH;
 use gpsrx_dsp::Prn;
-use gpsrx_receiver::pipeline::tracker::{track, AidSource};
+use gpsrx_receiver::pipeline::channels::{track, AidSource};
 use gpsrx_samples::sim::{Scenario, SimSatellite, Simulator};
 use gpsrx_samples::{SampleError, SampleFormat, SampleSource};
 use gpsrx_tracking::{Channel, ChannelConfig, ChannelStart, ChannelState, ConfigError, DopplerAid};

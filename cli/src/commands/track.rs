@@ -135,7 +135,7 @@ pub fn track_file(args: &TrackArgs) -> anyhow::Result<Vec<ChannelSummary>> {
     let search = SearchSettings {
         acq,
         weak_fallback: false,
-        background: Some(gpsrx_receiver::pipeline::search_schedule::SearchBudget::default()),
+        background: Some(gpsrx_receiver::pipeline::channels::SearchBudget::default()),
         prns,
         cold_targets: Some(targets),
     };

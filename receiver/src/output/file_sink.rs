@@ -3,7 +3,7 @@
 //! `pvt.csv` and `pvt.nmea` (flushed at every fix, so a live stream can be followed),
 //! `channels.csv`, `observables.rnx` (RINEX 3; held back until the first fix gives the
 //! header's approximate position, or 300 s of observables with the week known, or the end;
-//! never written while the GPS week is unknown, see [`crate::pipeline::dating`]),
+//! never written while the GPS week is unknown, see [`crate::pipeline::WeekReference`]),
 //! `ephemeris.rnx` (the decoded ephemerides, at the end), `almanac.yuma` (the decoded almanac,
 //! when one was), `track.geojson`, `track.kml` and `track.gpx` (the
 //! fixes, at the end); with [`FileSink::with_plots`], the PNG plots of

@@ -11,8 +11,9 @@
 //! - [`pvt_csv`]: one row per fix (`pvt.csv`) and one row per channel and epoch
 //!   (`channels.csv`).
 //!
-//! The writers take the small, format-neutral input types defined here ([`ObsEpoch`], [`Fix`],
-//! [`ChannelRow`]); the pipeline converts its own types into them. Every writer takes any
+//! The writers take the small, format-neutral products of the pipeline ([`ObsEpoch`], [`Fix`],
+//! [`ChannelRow`], defined with the sink in [`crate::pipeline::sink`] and re-exported here); the
+//! pipeline converts its own types into them. Every writer takes any
 //! [`std::io::Write`] plus the file name used in error messages, and reports failures as
 //! [`OutputError`]. Bad values (NaN, out-of-range numbers) never panic: they are written as
 //! empty fields where the format allows it and reported as errors where it does not.
@@ -28,11 +29,12 @@ pub mod rinex_nav;
 pub mod rinex_obs;
 pub mod yuma;
 
-use gpsrx_nav::{GpsTime, Llh};
+use gpsrx_nav::GpsTime;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
+pub use crate::pipeline::sink::{ChannelRow, Fix, FixQuality, ObsEpoch, SatObs, SatView};
 pub use file_sink::FileSink;
 pub use geojson::write_geojson;
 pub use gpx::write_gpx;
@@ -111,154 +113,6 @@ pub fn create_file(path: &Path) -> Result<BufWriter<File>, OutputError> {
     File::create(path)
         .map(BufWriter::new)
         .map_err(OutputError::io(&path.display().to_string()))
-}
-
-/// Observations of all tracked satellites at one receiver epoch.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ObsEpoch {
-    /// Receiver time of the epoch (GPS time scale, as read from the receiver clock).
-    pub time: GpsTime,
-    /// Receiver clock offset, s, if the writer should report it (RINEX epoch line field).
-    pub clock_offset_s: Option<f64>,
-    /// One entry per satellite.
-    pub sats: Vec<SatObs>,
-}
-
-/// L1 C/A observations of one satellite at one epoch. `None` or non-finite values are written
-/// as blank (not observed).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct SatObs {
-    /// GPS PRN, 1-32 (RINEX allows 1-99).
-    pub prn: u8,
-    /// Pseudorange, m.
-    pub pseudorange_m: Option<f64>,
-    /// Carrier phase, cycles (RINEX sign convention: grows with range).
-    pub carrier_cycles: Option<f64>,
-    /// Doppler, Hz (positive for an approaching satellite).
-    pub doppler_hz: Option<f64>,
-    /// Carrier-to-noise density, dB-Hz.
-    pub cn0_dbhz: Option<f64>,
-    /// Lock was lost (or a cycle slip detected) since the previous epoch of this satellite.
-    pub loss_of_lock: bool,
-    /// The carrier phase may be off by half a cycle (navigation bit sign not yet resolved).
-    pub half_cycle_ambiguous: bool,
-}
-
-/// What kind of solution a [`Fix`] is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum FixQuality {
-    /// Autonomous GNSS fix.
-    Gnss,
-    /// GNSS fused with dead reckoning (a GNSS update within the last moments).
-    Fused,
-    /// Dead-reckoning (propagated or INS-aided) solution.
-    DeadReckoning,
-    /// No valid position.
-    #[default]
-    None,
-}
-
-impl FixQuality {
-    /// Name used in CSV and GeoJSON outputs.
-    pub fn name(self) -> &'static str {
-        match self {
-            FixQuality::Gnss => "gnss",
-            FixQuality::Fused => "fused",
-            FixQuality::DeadReckoning => "dead_reckoning",
-            FixQuality::None => "none",
-        }
-    }
-}
-
-/// One satellite as seen from the fix position.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SatView {
-    /// GPS PRN.
-    pub prn: u8,
-    /// Elevation, degrees.
-    pub el_deg: f64,
-    /// Azimuth, degrees clockwise from north.
-    pub az_deg: f64,
-    /// C/N0, dB-Hz, if tracked.
-    pub cn0_dbhz: Option<f64>,
-}
-
-/// A position, velocity and time solution.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Fix {
-    /// GPS time of the solution (receiver time corrected by the clock bias).
-    pub time: GpsTime,
-    /// Whether `time.week` is known (decoded, configured, or from the recording's date):
-    /// when not, the writers leave the week and the date out (the time of week and of day
-    /// stand).
-    pub week_known: bool,
-    /// ECEF position, m.
-    pub ecef_m: [f64; 3],
-    /// Geodetic position (WGS-84, height above the ellipsoid).
-    pub llh: Llh,
-    /// ECEF velocity, m/s.
-    pub vel_ecef_mps: Option<[f64; 3]>,
-    /// Receiver clock bias, m.
-    pub clock_bias_m: f64,
-    /// Receiver clock drift, m/s.
-    pub clock_drift_mps: Option<f64>,
-    /// Number of satellites used.
-    pub n_sv: usize,
-    /// PRNs used in the solution.
-    pub used_prns: Vec<u8>,
-    /// Position dilution of precision.
-    pub pdop: f64,
-    /// Horizontal dilution of precision.
-    pub hdop: f64,
-    /// Vertical dilution of precision.
-    pub vdop: f64,
-    /// RAIM outcome as text (e.g. `ok`, `excluded G12`, `unavailable`).
-    pub raim: String,
-    /// Solution kind.
-    pub quality: FixQuality,
-    /// One-sigma position uncertainty east, north and up, m, from the solution's covariance
-    /// (`s^2 N^-1` rotated to the local frame, with the variance factor's 95 % upper bound
-    /// `s^2`); `None` when there is none (fused rows).
-    pub sigma_enu_m: Option<[f64; 3]>,
-    /// Satellites in view, for NMEA GSV.
-    pub sats_in_view: Vec<SatView>,
-}
-
-/// Per-channel tracking state at one epoch, one row of `channels.csv`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ChannelRow {
-    /// Receiver time of the epoch; `None` before the time origin is known (frame sync).
-    pub time: Option<GpsTime>,
-    /// Whether `time.week` is known (see [`Fix::week_known`]).
-    pub week_known: bool,
-    /// Seconds from the first sample of the stream (always known).
-    pub t_stream_s: f64,
-    /// Channel number.
-    pub channel: u32,
-    /// GPS PRN tracked.
-    pub prn: u8,
-    /// Channel state name (e.g. `acquiring`, `pull_in`, `tracking`, `lost`).
-    pub state: String,
-    /// C/N0 estimate, dB-Hz.
-    pub cn0_dbhz: Option<f64>,
-    /// Carrier Doppler, Hz.
-    pub doppler_hz: Option<f64>,
-    /// Code phase, chips.
-    pub code_phase_chips: Option<f64>,
-    /// PLL lock indicator (e.g. the cos 2 phi estimate, 1 = locked).
-    pub pll_lock_indicator: Option<f64>,
-    /// Code (DLL) lock declared.
-    pub code_lock: bool,
-    /// Carrier (PLL) lock declared.
-    pub carrier_lock: bool,
-    /// Navigation bit synchronisation achieved.
-    pub bit_sync: bool,
-    /// Subframe (preamble) synchronisation achieved.
-    pub frame_sync: bool,
-    /// While the channel is fed forward by an INS and its aided loop is 2nd order: the static
-    /// phase offset that loop keeps under a nominal accelerometer bias
-    /// (`gpsrx_tracking::aiding::nominal_aided_offset_cycles`), cycles; `None` otherwise.
-    pub predicted_offset_cycles: Option<f64>,
 }
 
 /// A calendar date and time rounded to a number of decimals of the second, without ever

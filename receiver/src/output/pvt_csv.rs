@@ -2,7 +2,7 @@
 //!
 //! Missing or non-finite values are empty cells. The leading columns of `pvt.csv` are fixed
 //! ([`PVT_COLUMNS`]); later columns may be added at the end, so read by name. `gps_week` is
-//! empty while the week is unknown ([`crate::pipeline::dating`]): never a week from the
+//! empty while the week is unknown ([`crate::pipeline::WeekReference`]): never a week from the
 //! system clock.
 
 use super::{create_file, ChannelRow, Fix, OutputError};
@@ -43,7 +43,7 @@ pub const PVT_COLUMNS: [&str; 24] = [
 
 /// Columns of `channels.csv`. `gps_week` and `tow_s` are the receiver time of the row, empty
 /// until it is known (the time of week from frame sync; the week is empty while unknown, see
-/// [`crate::pipeline::dating`]); `t_stream_s` is the time from the first sample, always given;
+/// [`crate::pipeline::WeekReference`]); `t_stream_s` is the time from the first sample, always given;
 /// `predicted_offset_cycles` is the static phase offset an aided 2nd-order loop keeps under a
 /// nominal INS accelerometer bias (empty unaided, or for other loop orders).
 pub const CHANNEL_COLUMNS: [&str; 15] = [

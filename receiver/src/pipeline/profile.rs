@@ -6,9 +6,9 @@
 //! The stages follow the receiver's loop. Serial, on the calling thread, one after the other:
 //! the cold start's search, the parallel rounds, the navigation between rounds and the
 //! completion of the outputs at the end. Within a round the channels and a due search run side
-//! by side on the rayon pool ([`crate::pipeline::channel_manager::ChannelManager::work`]);
+//! by side on the rayon pool ([`crate::pipeline::channels::channel_manager::ChannelManager::work`]);
 //! the next block of the source is read on the pool while the navigation runs
-//! ([`crate::pipeline::ring::SampleWindow::read_during`]; before the cold start, and when the
+//! ([`crate::pipeline::channels::ring::SampleWindow::read_during`]; before the cold start, and when the
 //! receiver is pushed samples, there is no such overlap). Each part is timed from its start to
 //! its end on its own, so parts that overlap can add up to more than their stage, and each
 //! includes the time its own parallel parts waited for a thread.

@@ -9,15 +9,17 @@
 
 use crate::config::ReceiverConfig;
 use crate::landmarks::LandmarkObservation;
-use crate::pipeline::aid_monitor::{AidMonitor, AidingStats, GatedAid};
 use crate::pipeline::aiding::InsFeedForward;
-use crate::pipeline::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
-use crate::pipeline::dating::WeekReference;
-use crate::pipeline::navigation::{BlockEvent, NavigationProcessor};
+use crate::pipeline::aiding::{AidMonitor, AidingStats, GatedAid};
+use crate::pipeline::channels::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
+use crate::pipeline::channels::ring::{block_samples, SampleWindow};
+use crate::pipeline::channels::search_schedule::SearchBudget;
+use crate::pipeline::navigation::NavigationProcessor;
 use crate::pipeline::profile::{add_timed, StageTimes};
-use crate::pipeline::ring::{block_samples, SampleWindow};
-use crate::pipeline::search_schedule::SearchBudget;
 use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
+use crate::pipeline::timing::code_jump::plan_realignment;
+use crate::pipeline::timing::dating::WeekReference;
+use crate::pipeline::timing::BlockEvent;
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult};
 use gpsrx_dsp::Prn;
 use gpsrx_ins_aiding::InsTrack;
@@ -106,7 +108,7 @@ pub enum AssistanceError {
         source: gpsrx_nav::rinex_nav::RinexError,
     },
     /// The navigation file holds no GPS ephemeris.
-    #[error("the navigation file {path} holds no GPS ephemeris (a header only, or no GPS records): give a broadcast navigation file with ephemeris records (e.g. brdcDDD0.YYn for the day of the recording), or leave out --nav to decode the ephemerides from the signal")]
+    #[error("the navigation file {path} holds no GPS ephemeris (a header only, or no GPS records): give a broadcast navigation file with ephemeris records (e.g. brdcDDD0.YYn for the day of the recording), or give no navigation file, to decode the ephemerides from the signal")]
     NavWithoutEphemeris {
         /// The file.
         path: String,
@@ -147,7 +149,7 @@ impl Assistance {
                 let track = gpsrx_ins_aiding::read_ins_csv(path, files.ins_max_gap_s)?;
                 let (a, b) = track.span_s();
                 let off = if files.no_aiding {
-                    " (aiding off: --no-aiding)"
+                    " (aiding switched off)"
                 } else {
                     ""
                 };
@@ -205,9 +207,9 @@ pub struct RunSummary {
     /// Mean PDOP.
     pub mean_pdop: Option<f64>,
     /// With `--ins`: how much of the recording was aided, and how often the INS was rejected
-    /// for disagreeing with the tracked Doppler ([`crate::pipeline::aid_monitor`]).
+    /// for disagreeing with the tracked Doppler ([`crate::pipeline::aiding::AidMonitor`]).
     pub ins_aiding: Option<InsAidingSummary>,
-    /// Where the wall time went, stage by stage ([`crate::pipeline::profile`]).
+    /// Where the wall time went, stage by stage ([`crate::pipeline::StageTimes`]).
     pub profile: StageTimes,
 }
 
@@ -537,7 +539,7 @@ impl Receiver {
         })
     }
 
-    /// Where the wall time went so far ([`crate::pipeline::profile`]).
+    /// Where the wall time went so far ([`crate::pipeline::StageTimes`]).
     pub fn profile(&self) -> StageTimes {
         let work = self.manager.work_times();
         StageTimes {
@@ -600,7 +602,7 @@ impl Receiver {
     /// [`Receiver::deliver`], its wall time added to the navigation stage.
     fn timed_deliver(
         &mut self,
-        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
@@ -615,7 +617,7 @@ impl Receiver {
     /// read so far, or of the block processed).
     fn deliver(
         &mut self,
-        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
@@ -629,7 +631,7 @@ impl Receiver {
     /// end of the source).
     fn deliver_while_reading(
         &mut self,
-        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
         source: &mut dyn SampleSource,
         sink: &mut dyn Sink,
     ) -> Result<usize, ReceiverError> {
@@ -667,7 +669,7 @@ impl Receiver {
     /// what a search found, and the samples no one needs any more dropped.
     fn end_round(
         &mut self,
-        found: Option<crate::pipeline::channel_manager::SearchOutcome>,
+        found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
@@ -678,7 +680,13 @@ impl Receiver {
         }
         match found {
             Some(outcome) if outcome.is_realignment() => {
-                if let Some(r) = self.manager.realign(outcome) {
+                // The channels report the code shifts; timing decides what they show.
+                let planned = self.manager.realignment_found(outcome).and_then(|s| {
+                    let plan = plan_realignment(s.shifts(), self.fs_hz)?;
+                    Some((s, plan))
+                });
+                let realigned = planned.and_then(|(s, plan)| self.manager.realign(s, &plan));
+                if let Some(r) = realigned {
                     // The bit edges of every channel moved with the code.
                     self.manager.restart_bit_sync();
                     self.nav
@@ -794,7 +802,7 @@ fn log_aided_static_offset(tracking: &gpsrx_tracking::ChannelConfig) {
     let bias_mps2 = gpsrx_tracking::aiding::NOMINAL_INS_BIAS_LOS_MPS2;
     match gpsrx_tracking::aiding::static_phase_offset_cycles(loops.pll_order, loops.pll_bw_hz, bias_mps2) {
         Some(c) if c > 0.0 => tracing::info!(
-            "aided loops: 2nd-order PLL at {} Hz: an INS accelerometer bias of 1 mg per axis leaves up to {c:.3} cycle of static phase offset (B / (lambda w0^2); lock allows 0.2, slips at 0.25) until the INS velocity calibration from the fixes takes the drift out (about 15 s of fixes outside manoeuvres); a 3rd-order aided loop leaves none (--aided-pll-order 3)",
+            "aided loops: 2nd-order PLL at {} Hz: an INS accelerometer bias of 1 mg per axis leaves up to {c:.3} cycle of static phase offset (B / (lambda w0^2); lock allows 0.2, slips at 0.25) until the INS velocity calibration from the fixes takes the drift out (about 15 s of fixes outside manoeuvres); a 3rd-order aided loop leaves none",
             loops.pll_bw_hz
         ),
         Some(_) => tracing::info!(
@@ -803,7 +811,7 @@ fn log_aided_static_offset(tracking: &gpsrx_tracking::ChannelConfig) {
             loops.pll_bw_hz
         ),
         None => tracing::warn!(
-            "aided loops: a 1st-order PLL at {} Hz drifts with an INS accelerometer bias (its phase error grows without bound): use --aided-pll-order 2 or 3",
+            "aided loops: a 1st-order PLL at {} Hz drifts with an INS accelerometer bias (its phase error grows without bound): an aided PLL of order 2 or 3 does not",
             loops.pll_bw_hz
         ),
     }

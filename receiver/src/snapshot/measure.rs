@@ -33,7 +33,7 @@ use gpsrx_nav::{GpsTime, HealthPolicy, NavData, Vector3};
 use num_complex::Complex32;
 
 use super::fine_phase::band_limited_code_phase;
-use crate::pipeline::visibility;
+use crate::pipeline::channels::predict_satellite;
 
 /// A detection must agree with the predicted Doppler plus the common offset to this, Hz, plus
 /// the Doppler of the receiver's own speed ([`doppler_tolerance_hz`]).
@@ -158,7 +158,7 @@ pub fn predict_visible(
     let mut p: Vec<Predicted> = Prn::all()
         .filter_map(|prn| {
             let eph = nav.select_with(prn.get(), t, HealthPolicy::PreferHealthy)?;
-            let p = visibility::predict(eph, &rx, t, 0.0)?;
+            let p = predict_satellite(eph, &rx, t, 0.0)?;
             (p.elevation_deg >= mask_deg).then_some(Predicted {
                 prn,
                 doppler_hz: p.doppler_hz,

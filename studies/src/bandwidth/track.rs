@@ -37,7 +37,7 @@ pub(super) fn run_case(
         }
     }
     let aid_fn = |prn: gpsrx_dsp::Prn, t: f64| truth.aid(prn.get(), t);
-    let aid: Option<gpsrx_receiver::pipeline::tracker::AidSource<'_>> =
+    let aid: Option<gpsrx_receiver::pipeline::channels::AidSource<'_>> =
         if aided { Some(&aid_fn) } else { None };
     let mut src = SimSource::new(&sim);
     let traces = if_sim::track_vs_truth(&mut src, &sim, &truth, &specs, aid)?;

@@ -8,7 +8,7 @@ use super::result::{summarise, CaseResult};
 use super::scenario::Prepared;
 use crate::if_sim;
 use gpsrx_dsp::constants::LAMBDA_L1_M;
-use gpsrx_receiver::pipeline::tracker::{track, AidSource};
+use gpsrx_receiver::pipeline::channels::{track, AidSource};
 use gpsrx_samples::SampleFormat;
 use gpsrx_tracking::{Channel, ChannelConfig, ChannelEpoch, ChannelState, LoopConfig};
 

@@ -5,7 +5,7 @@ use anyhow::{bail, Context};
 use gpsrx_core::PosVel;
 use gpsrx_dsp::Prn;
 use gpsrx_nav::{GpsTime, HealthPolicy, Llh, NavData, Vector3};
-use gpsrx_receiver::pipeline::visibility;
+use gpsrx_receiver::pipeline::channels::predict_satellite;
 
 /// What the ephemeris predicts for one satellite at the receiver.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -27,7 +27,7 @@ pub struct Prediction {
 /// Predicted Doppler and elevation of every PRN with an ephemeris valid at `t` (healthy or not,
 /// healthy ones first: [`NavData::select_with`] with [`HealthPolicy::PreferHealthy`]) that is
 /// at least `mask_deg` above the horizon of a static receiver at `rx`
-/// ([`gpsrx_receiver::pipeline::visibility::predict`]). The receiver's own clock drift is
+/// ([`gpsrx_receiver::pipeline::channels::predict_satellite`]). The receiver's own clock drift is
 /// unknown here and adds `-drift * f_L1` to every satellite (1e-6 s/s = -1575 Hz): cover it
 /// with the search window.
 pub fn predict(nav: &NavData, rx: &Llh, t: GpsTime, mask_deg: f64) -> Vec<Prediction> {
@@ -38,7 +38,7 @@ pub fn predict(nav: &NavData, rx: &Llh, t: GpsTime, mask_deg: f64) -> Vec<Predic
     Prn::all()
         .filter_map(|prn| {
             let eph = nav.select_with(prn.get(), t, HealthPolicy::PreferHealthy)?;
-            let p = visibility::predict(eph, &rx, t, 0.0)?;
+            let p = predict_satellite(eph, &rx, t, 0.0)?;
             (p.elevation_deg >= mask_deg).then_some(Prediction {
                 prn,
                 doppler_hz: p.doppler_hz,

@@ -1,5 +1,5 @@
 //! `gpsrx run --profile`: where the run's time went, stage by stage
-//! ([`gpsrx_receiver::pipeline::profile`]), with the process's CPU time and peak resident
+//! ([`gpsrx_receiver::pipeline::StageTimes`]), with the process's CPU time and peak resident
 //! memory.
 
 use gpsrx_receiver::pipeline::StageTimes;

@@ -18,8 +18,8 @@
 //! instant are summed and tested ([`DiscontinuityMonitor::evaluate`]); a satellite whose prompt
 //! power collapsed is not counted (a blockage, not lost samples).
 
-use crate::pipeline::carrier_step::{phase_step, NcoPoint, PhaseStep};
-use crate::pipeline::gap_length::nearest_remainder;
+use crate::pipeline::timing::carrier_step::{phase_step, NcoPoint, PhaseStep};
+use crate::pipeline::timing::modulo::nearest_remainder;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
 use num_complex::Complex64;
 use std::collections::{BTreeMap, VecDeque};
@@ -44,7 +44,7 @@ pub const STEADY_REPORTS: u32 = 50;
 /// Weakest C/N0 watched, dB-Hz (below it the phase noise hides the jumps).
 pub const MIN_CN0_DBHZ: f64 = 30.0;
 /// Reports before a jump that give the carrier's phase, frequency and rate there
-/// ([`crate::pipeline::carrier_step`]: up to a second).
+/// ([`crate::pipeline::timing::carrier_step`]: up to a second).
 pub const PRE_REPORTS: usize = 1000;
 /// Reports after a jump over which its step is averaged.
 pub const POST_REPORTS: usize = 32;
@@ -66,8 +66,25 @@ pub struct Discontinuity {
     /// Satellites watched at the time.
     pub watched: usize,
     /// Per satellite: the step of its carrier phase over the jump
-    /// ([`crate::pipeline::carrier_step`]).
+    /// ([`crate::pipeline::timing::carrier_step`]).
     pub steps: Vec<PhaseStep>,
+    /// What showed it.
+    pub found_by: FoundBy,
+}
+
+/// What showed a discontinuity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FoundBy {
+    /// The carrier phases jumped together at `sample` (this monitor).
+    CarrierPhase,
+    /// The data-bit edges moved together by `offset_ms` somewhere between `sample` and
+    /// `after_sample` ([`crate::pipeline::timing::bit_edge`]).
+    BitEdges {
+        /// The move, ms in 1..20.
+        offset_ms: u64,
+        /// The first sample known to follow the jump.
+        after_sample: u64,
+    },
 }
 
 #[derive(Debug, Default)]
@@ -261,6 +278,7 @@ impl DiscontinuityMonitor {
                     jumped: ats.len(),
                     watched: n,
                     steps,
+                    found_by: FoundBy::CarrierPhase,
                 });
                 break;
             }

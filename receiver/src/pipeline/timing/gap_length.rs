@@ -22,13 +22,8 @@
 //! best score of at least [`MIN_SCORE`] and every other candidate [`MIN_MARGIN`] below it:
 //! otherwise the length is unknown and the time must come from the navigation message.
 
-/// `x` less the nearest multiple of `period`: in [-period/2, period/2] (a phase modulo half a
-/// cycle with `period = pi`, a time within a data bit with `period = 20` ms).
-pub fn nearest_remainder(x: f64, period: f64) -> f64 {
-    x - (x / period).round() * period
-}
-
-use crate::pipeline::carrier_step::PhaseStep;
+use crate::pipeline::timing::carrier_step::PhaseStep;
+use crate::pipeline::timing::modulo::nearest_remainder;
 
 /// Spread of a measured phase step, rad.
 pub const STEP_SIGMA_RAD: f64 = 0.25;

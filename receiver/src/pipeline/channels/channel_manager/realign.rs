@@ -1,12 +1,12 @@
 //! Code realignment: when the prompt power of several satellites collapsed at once
-//! ([`crate::pipeline::code_jump`]: samples lost by a fraction of a code period, or tenths of a
+//! ([`crate::pipeline::timing::code_jump`]: samples lost by a fraction of a code period, or tenths of a
 //! second), every tracked satellite is searched at once in a narrow window around the Doppler
 //! it held, and the channels whose code shifts one gap length explains are moved onto it
 //! ([`gpsrx_tracking::Channel::realign_code`]).
 
 use super::{ChannelManager, DueSearch, SearchOutcome};
-use crate::pipeline::code_jump::{fit_code_gap, Collapse, CollapsedSat, POWER_REPORTS};
-use crate::pipeline::ring::SampleView;
+use crate::pipeline::channels::ring::SampleView;
+use crate::pipeline::timing::code_jump::{Collapse, CollapsedSat, RealignPlan, POWER_REPORTS};
 use gpsrx_dsp::acquisition::{AcqConfig, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::Prn;
 use gpsrx_tracking::ChannelState;
@@ -42,7 +42,7 @@ pub struct Realigned {
     pub prns: Vec<u8>,
     /// The first sample after the move (the next code period of the channels).
     pub at_sample: u64,
-    /// The code moved by more than a gap of up to [`crate::pipeline::code_jump::MAX_GAP_S`]
+    /// The code moved by more than a gap of up to `crate::pipeline::timing::code_jump::MAX_GAP_S`
     /// explains (on at least three satellites): samples of an unknown, longer length were lost,
     /// and the receiver time must be re-established from the signal.
     pub length_unknown: bool,
@@ -121,17 +121,12 @@ impl ChannelManager {
             .position(|c| c.prn() == prn && c.state() != ChannelState::Lost)
     }
 
-    /// Moves the channels of a realignment search onto the code found, if one gap explains
-    /// the code shifts of at least three satellites ([`fit_code_gap`]); returns what moved.
-    /// The channels that collapsed restart their carrier loop at the Doppler they held before;
-    /// the others keep their loops.
-    ///
-    /// When at least three satellites are found again at a moved code that no gap up to
-    /// [`crate::pipeline::code_jump::MAX_GAP_S`] explains, samples of a longer, unknown length
-    /// were lost ([`Realigned::length_unknown`]): every satellite found is moved onto its code,
-    /// at the Doppler the search found (the Doppler held before may have drifted over the gap).
-    pub fn realign(&mut self, outcome: SearchOutcome) -> Option<Realigned> {
-        let r = outcome.realign?;
+    /// The code shifts a realignment search found (`SearchOutcome::is_realignment`): per
+    /// satellite with a live channel found again, how far its replica must move onto the
+    /// signal. Timing judges them (`crate::pipeline::timing::code_jump::plan_realignment`);
+    /// [`ChannelManager::realign`] carries out its plan. `None` for any other search.
+    pub fn realignment_found(&self, outcome: SearchOutcome) -> Option<RealignSearch> {
+        let realign = outcome.realign?;
         let first = outcome.first as f64;
         let found: Vec<(usize, f64, gpsrx_tracking::CodeShift, f64)> = outcome
             .results
@@ -148,44 +143,39 @@ impl ChannelManager {
                 ))
             })
             .collect();
-        let shifts: Vec<(u8, gpsrx_tracking::CodeShift)> = found
+        let shifts = found
             .iter()
             .map(|&(i, _, s, _)| (self.channels[i].prn().get(), s))
             .collect();
-        // Two samples, or a twentieth of a chip at high rates: the search's code resolution.
-        let tol = (0.05 * self.fs_hz / gpsrx_dsp::constants::CA_CHIP_RATE_HZ).max(2.0);
-        let fit = fit_code_gap(&shifts, self.fs_hz, tol);
-        let unexplained = unexplained_moves(&shifts, fit.as_ref(), tol);
-        let length_unknown = unexplained.len() >= crate::pipeline::code_jump::MIN_SATELLITES;
-        let (shortest_gap_s, prns) = match fit {
-            _ if length_unknown => {
-                tracing::debug!(
-                    "code realignment: the code of {unexplained:?} moved by more than a gap of up to {} s explains: {shifts:?}",
-                    crate::pipeline::code_jump::MAX_GAP_S
-                );
-                let moved = shifts.iter().filter(|(_, s)| code_moved(s, tol));
-                (
-                    crate::pipeline::code_jump::MAX_GAP_S,
-                    moved.map(|(p, _)| *p).collect(),
-                )
-            }
-            Some(gap) => (gap.shortest_s, gap.prns),
-            None => {
-                tracing::debug!("code realignment: no gap explains the shifts {shifts:?}");
-                return None;
-            }
-        };
+        Some(RealignSearch {
+            realign,
+            found,
+            shifts,
+        })
+    }
+
+    /// Moves the channels of `plan` onto the code their realignment search found; returns
+    /// what moved (at least `crate::pipeline::timing::code_jump::MIN_SATELLITES`, else
+    /// nothing). The channels that collapsed restart their carrier loop at the Doppler they
+    /// held before (when the gap's length is unknown, at the Doppler the search found: the one
+    /// held may have drifted over the gap); the others keep their loops.
+    pub fn realign(&mut self, search: RealignSearch, plan: &RealignPlan) -> Option<Realigned> {
+        let RealignSearch {
+            realign: r,
+            found,
+            shifts,
+        } = search;
         let mut moved = Vec::new();
         let mut at_sample = 0;
         for (i, start, _, found_hz) in found {
             let ch = &mut self.channels[i];
             let prn = ch.prn().get();
-            if !prns.contains(&prn) {
+            if !plan.prns.contains(&prn) {
                 continue;
             }
             let t_s = ch.next_span().0 as f64 / self.fs_hz;
             let carrier = r.satellites.iter().find(|s| s.prn == prn).map(|s| {
-                let doppler = if length_unknown {
+                let doppler = if plan.length_unknown {
                     found_hz
                 } else {
                     s.doppler_at(t_s)
@@ -197,40 +187,37 @@ impl ChannelManager {
                 at_sample = at_sample.max(ch.next_span().0);
             }
         }
-        (moved.len() >= crate::pipeline::code_jump::MIN_SATELLITES).then(|| {
+        (moved.len() >= crate::pipeline::timing::code_jump::MIN_SATELLITES).then(|| {
             let shift_samples = shifts
                 .iter()
                 .find(|(p, _)| *p == moved[0])
                 .map_or(0.0, |(_, s)| s.shift_samples / s.period_samples);
             Realigned {
                 jump_sample: r.jump,
-                shortest_gap_s,
+                shortest_gap_s: plan.shortest_gap_s,
                 fraction_of_period: shift_samples,
                 prns: moved,
                 at_sample,
-                length_unknown,
+                length_unknown: plan.length_unknown,
             }
         })
     }
 }
 
-/// Whether a code shift moved the code (by more than `tol_samples`, modulo its period).
-fn code_moved(s: &gpsrx_tracking::CodeShift, tol_samples: f64) -> bool {
-    crate::pipeline::gap_length::nearest_remainder(s.shift_samples, s.period_samples).abs()
-        > tol_samples
+/// What a code realignment search found: the realignment asked for, and per channel found
+/// again `(channel index, first sample of its code found, its code shift, Doppler found Hz)`.
+#[derive(Debug)]
+pub struct RealignSearch {
+    realign: Realign,
+    found: Vec<(usize, f64, gpsrx_tracking::CodeShift, f64)>,
+    shifts: Vec<(u8, gpsrx_tracking::CodeShift)>,
 }
 
-/// The satellites whose code moved but which the fitted gap (if any) does not explain.
-fn unexplained_moves(
-    shifts: &[(u8, gpsrx_tracking::CodeShift)],
-    fit: Option<&crate::pipeline::code_jump::CodeGap>,
-    tol_samples: f64,
-) -> Vec<u8> {
-    shifts
-        .iter()
-        .filter(|(p, s)| code_moved(s, tol_samples) && fit.is_none_or(|g| !g.prns.contains(p)))
-        .map(|(p, _)| *p)
-        .collect()
+impl RealignSearch {
+    /// The code shifts found, `(PRN, shift)` per satellite found again.
+    pub fn shifts(&self) -> &[(u8, gpsrx_tracking::CodeShift)] {
+        &self.shifts
+    }
 }
 
 /// The engine of code realignment searches at `fs_hz` with the settings `acq`.
@@ -247,36 +234,4 @@ pub(super) fn realign_engine(
             ..acq.clone()
         },
     )
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use gpsrx_tracking::CodeShift;
-
-    use crate::pipeline::code_jump::shifts_after;
-
-    #[test]
-    fn code_moves_of_a_gap_longer_than_the_fit_reaches_are_left_unexplained() {
-        let dopplers = [
-            -3186.0, 1963.0, -1888.0, 637.0, -565.0, 2480.0, -2710.0, 1210.0,
-        ];
-        let unexplained = |g: f64| {
-            let s = shifts_after(g, &dopplers);
-            unexplained_moves(&s, fit_code_gap(&s, 2.6e6, 2.0).as_ref(), 2.0)
-        };
-        // Up to the fit's reach, one length explains every move.
-        for g in [1.25e-3, 0.5, 0.7317] {
-            assert!(unexplained(g).is_empty(), "{g} s: {:?}", unexplained(g));
-        }
-        // Beyond, the moves g f_D / f_L1 (26 samples for 5 s at 3 kHz) differ between satellites by
-        // more than any one gap of up to a second explains (a few may agree by chance).
-        for g in [5.0, 5.37, 60.0] {
-            let u = unexplained(g);
-            assert!(u.len() >= 6, "{g} s: {u:?}");
-        }
-        // Nothing moved (a blockage that ended): no gap.
-        let still: Vec<(u8, CodeShift)> = shifts_after(0.0, &dopplers);
-        assert!(unexplained_moves(&still, None, 2.0).is_empty());
-    }
 }

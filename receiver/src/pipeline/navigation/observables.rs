@@ -13,8 +13,8 @@
 //! from the NCO state at its start advanced to `t`: SV time by `(t - t_rx) r / 1.023 MHz` for the
 //! code rate `r`, carrier phase by `(t - t_rx) f_D`.
 
-use crate::pipeline::navdata::NavDecoder;
-use crate::pipeline::smoothing::{Hatch, HatchEpoch};
+use crate::pipeline::navigation::navdata::NavDecoder;
+use crate::pipeline::navigation::smoothing::{Hatch, HatchEpoch};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
@@ -83,7 +83,7 @@ pub struct ObservableBuilder {
     lli: BTreeMap<u8, bool>,
     /// Highest epoch index any channel has reached.
     newest: i64,
-    /// Per PRN: the Hatch filter ([`crate::pipeline::smoothing`]), kept over losses of lock to
+    /// Per PRN: the Hatch filter ([`crate::pipeline::navigation::smoothing`]), kept over losses of lock to
     /// bridge them.
     smoothing: BTreeMap<u8, Hatch>,
     /// Samples lost: `(stream time s, length s if known)`; a filter is bridged over a gap only
@@ -243,7 +243,7 @@ impl ObservableBuilder {
             // range: negate. The receiver clock steps move it by f_L1 per second.
             let carrier_cycles = -carrier + self.total_step_ms as f64 * 1e-3 * F_L1_HZ;
             // Hatch filter (carrier smoothing, 10 s) and carrier Doppler; a loss of lock is
-            // bridged when it can be ([`crate::pipeline::smoothing`]), else the filter restarts.
+            // bridged when it can be ([`crate::pipeline::navigation::smoothing`]), else the filter restarts.
             let t_stream = t_epoch - t0.tow_s;
             let steps = self.total_step_ms;
             let max_m = self.hatch_epochs;

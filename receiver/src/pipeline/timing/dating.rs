@@ -10,7 +10,7 @@
 //! dates an output ([`WeekReference::known`] is false: `gps_week` is left empty, the NMEA date
 //! too, and `observables.rnx` waits for the decoded week).
 
-use crate::pipeline::navdata::current_gps_week;
+use crate::pipeline::navigation::navdata::current_gps_week;
 use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_nav::time::GpsTime;
 use gpsrx_samples::sigmf::RecordingStart;
@@ -87,16 +87,16 @@ impl WeekReference {
             WeekSource::Configured => {
                 if let Some(r) = recording.filter(|r| r.time.week != self.week) {
                     tracing::warn!(
-                        "--week {} overrides week {} of the recording ({})",
+                        "the GPS week given, {}, overrides week {} of the recording ({})",
                         self.week,
                         r.time.week,
                         r.origin
                     );
                 }
-                tracing::info!("GPS week {} (--week) until subframe 1 is decoded", self.week);
+                tracing::info!("GPS week {} (as given) until subframe 1 is decoded", self.week);
             }
             WeekSource::ApproximateTime => tracing::info!(
-                "GPS week {} (--time) until subframe 1 is decoded",
+                "GPS week {} (from the approximate time given) until subframe 1 is decoded",
                 self.week
             ),
             WeekSource::Recording(origin) => tracing::info!(
@@ -108,7 +108,7 @@ impl WeekReference {
                 self.week
             ),
             WeekSource::Unknown => tracing::warn!(
-                "the GPS week is unknown (no SigMF core:datetime, --week or --nav): the outputs carry no week or date until a subframe 1 gives it (up to 30 s after frame sync), and observables.rnx is written only once it does; give --week or --nav"
+                "the GPS week is unknown (no recording date, GPS week or navigation data was given): the outputs carry no week or date until a subframe 1 gives it (up to 30 s after frame sync), and observables.rnx is written only once it does; give the GPS week or navigation data to date them from the start"
             ),
         }
     }

@@ -2,8 +2,8 @@
 //! satellites in view), the observables as RINEX writes them, the integrity verdict, and the
 //! running statistics of the fixes.
 
-use crate::output::{Fix, FixQuality, ObsEpoch, SatObs, SatView};
-use crate::pipeline::observables::ObservableEpoch;
+use crate::pipeline::navigation::observables::ObservableEpoch;
+use crate::pipeline::sink::{Fix, FixQuality, ObsEpoch, SatObs, SatView};
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::frames::azimuth_elevation;
 use gpsrx_nav::pvt::{PvtSolution, RaimStatus};

@@ -5,17 +5,21 @@
 //! takes the predicted time rounded to the 20 ms bit, so fixes resume without waiting for
 //! frame sync. After lost samples ([`GapRecovery`]) the prediction is off by the gap: its
 //! length is resolved from the new bit edges and the carrier-phase steps
-//! ([`crate::pipeline::gap_length`]) and every time moved over it, or, when that cannot be
+//! ([`crate::pipeline::timing::gap_length`]) and every time moved over it, or, when that cannot be
 //! done, the times become rough hints for a fast frame sync ([`NavDecoder::hint_time`]).
 
-use crate::pipeline::gap_length::nearest_remainder;
-use crate::pipeline::navdata::NavDecoder;
+use crate::pipeline::navigation::navdata::NavDecoder;
+use crate::pipeline::timing::modulo::nearest_remainder;
 use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_tracking::ChannelEpoch;
 use std::collections::BTreeMap;
 
 /// How long the length of lost samples is sought after the code offsets may be used, s.
 pub const GAP_RESOLVE_S: f64 = 1.0;
+
+/// Refused carried SV times that agree: per satellite `(PRN, offset of the kept SV time from
+/// the new bit edge ms, SV time rate)`.
+pub type EdgeOffsets = Vec<(u8, f64, f64)>;
 
 /// What [`SvTimeKeeper::observe`] found that must be reported.
 #[derive(Debug, Clone, Copy)]
@@ -40,8 +44,8 @@ pub struct GapRecovery {
     pub before: Option<(f64, f64, f64)>,
     /// The carrier-phase steps at the gap: with them, the SV times
     /// are kept and carried over the gap once its length is resolved
-    /// ([`crate::pipeline::gap_length`]); without, the time comes from frame sync.
-    pub steps: Vec<crate::pipeline::carrier_step::PhaseStep>,
+    /// ([`crate::pipeline::timing::gap_length`]); without, the time comes from frame sync.
+    pub steps: Vec<crate::pipeline::timing::carrier_step::PhaseStep>,
     /// Per PRN: how far the SV time kept falls off the channel's new bit edge (ms), and the
     /// satellite's SV time rate.
     pub edge_offsets: BTreeMap<u8, (f64, f64)>,
@@ -65,11 +69,11 @@ impl GapRecovery {
     pub fn new(
         t_s: f64,
         before: Option<(f64, f64, f64)>,
-        steps: Vec<crate::pipeline::carrier_step::PhaseStep>,
+        steps: Vec<crate::pipeline::timing::carrier_step::PhaseStep>,
         code_from_s: Option<f64>,
     ) -> Self {
         let unresolved =
-            steps.len() < crate::pipeline::gap_length::MIN_STEPS && code_from_s.is_none();
+            steps.len() < crate::pipeline::timing::gap_length::MIN_STEPS && code_from_s.is_none();
         Self {
             t_s,
             before,
@@ -85,12 +89,12 @@ impl GapRecovery {
 
     /// Takes the offset `off_ms` of `prn`'s kept SV time from its new bit edge and the
     /// satellite's SV time rate at stream time `now_s`; once
-    /// [`crate::pipeline::discontinuity::MIN_SATELLITES`] offsets agree (0.1 ms), resolves the
+    /// [`crate::pipeline::timing::discontinuity::MIN_SATELLITES`] offsets agree (0.1 ms), resolves the
     /// length from the carrier-phase steps and, once settled, the code offsets
-    /// ([`crate::pipeline::gap_length::choose`]), or gives up after [`GAP_RESOLVE_S`].
+    /// ([`crate::pipeline::timing::gap_length::choose`]), or gives up after [`GAP_RESOLVE_S`].
     /// Returns whether the length was just resolved.
     pub fn add_edge_offset(&mut self, prn: u8, off_ms: f64, rate: f64, now_s: f64) -> bool {
-        use crate::pipeline::gap_length::{choose, estimate_from_code};
+        use crate::pipeline::timing::gap_length::{choose, estimate_from_code};
         self.edge_offsets.insert(prn, (off_ms, rate));
         let agreeing: Vec<(f64, f64)> = self
             .edge_offsets
@@ -98,7 +102,7 @@ impl GapRecovery {
             .filter(|o| (o.0 - off_ms).abs() < 0.1)
             .copied()
             .collect();
-        if agreeing.len() >= crate::pipeline::discontinuity::MIN_SATELLITES {
+        if agreeing.len() >= crate::pipeline::timing::discontinuity::MIN_SATELLITES {
             let mean = agreeing.iter().map(|o| o.0).sum::<f64>() / agreeing.len() as f64;
             // The kept time is g late: it falls -g (mod 20 ms) off the true bit edge.
             let offset = (-mean).rem_euclid(20.0);
@@ -206,15 +210,16 @@ const RATE_RATE_HORIZON_S: f64 = 5.0;
 const RATE_ALPHA: f64 = 0.02;
 const RATE_BETA: f64 = RATE_ALPHA * RATE_ALPHA / (2.0 - RATE_ALPHA);
 
-/// The satellites' SV times and the gap being recovered from.
+/// The satellites' SV times and the gap being recovered from: the one place that keeps them
+/// (navigation asks and tells it, never edits its state).
 #[derive(Debug, Default)]
 pub struct SvTimeKeeper {
     /// Per PRN: its SV time, kept over a loss of the signal.
-    pub clocks: BTreeMap<u8, SvClock>,
+    clocks: BTreeMap<u8, SvClock>,
     /// A gap being recovered from.
-    pub gap: Option<GapRecovery>,
+    gap: Option<GapRecovery>,
     /// Carried SV times refused at the new bit edge: `(stream time s, PRN, offset ms)`.
-    pub refused: Vec<(f64, u8, f64)>,
+    refused: Vec<(f64, u8, f64)>,
     /// Per PRN: the clock as it was, every [`SNAPSHOT_S`] over the last [`SNAPSHOTS`] of them
     /// (to go back to before lost samples found late, [`SvTimeKeeper::rewind`]).
     history: BTreeMap<u8, std::collections::VecDeque<SvClock>>,
@@ -226,6 +231,101 @@ const SNAPSHOT_S: f64 = 0.01;
 const SNAPSHOTS: usize = 30;
 
 impl SvTimeKeeper {
+    /// The gap being recovered from, if any.
+    pub fn gap(&self) -> Option<&GapRecovery> {
+        self.gap.as_ref()
+    }
+
+    /// Samples were lost at stream time `t_s` (samples at `fs_hz`): every clock goes back to
+    /// a little before it (its instant is known to a few milliseconds), and the gap is kept
+    /// to be measured ([`GapRecovery::new`] with the clock of the last fix `before`, the
+    /// carrier-phase `steps` and `code_from_s`); a gap whose length cannot be resolved makes
+    /// every SV time rough.
+    pub fn start_gap(
+        &mut self,
+        t_s: f64,
+        fs_hz: f64,
+        before: Option<(f64, f64, f64)>,
+        steps: Vec<crate::pipeline::timing::carrier_step::PhaseStep>,
+        code_from_s: Option<f64>,
+    ) {
+        self.rewind(((t_s - 0.003) * fs_hz).max(0.0) as u64);
+        let gap = GapRecovery::new(t_s, before, steps, code_from_s);
+        if gap.unresolved {
+            self.make_rough(None);
+        }
+        self.gap = Some(gap);
+    }
+
+    /// A gap at `t_s` (with the clock of the last fix `before`) unless one is being recovered
+    /// from already: its length will come from the clock bias of the next valid fix.
+    pub fn ensure_gap(&mut self, t_s: f64, before: Option<(f64, f64, f64)>) {
+        self.gap
+            .get_or_insert_with(|| GapRecovery::new(t_s, before, Vec::new(), None));
+    }
+
+    /// The carrier-phase steps over a code jump, measured once the phase loops hold again,
+    /// for the gap being recovered from.
+    pub fn set_gap_steps(&mut self, steps: Vec<crate::pipeline::timing::carrier_step::PhaseStep>) {
+        if let Some(gap) = self.gap.as_mut() {
+            gap.steps = steps;
+        }
+    }
+
+    /// A receiver clock step of `step_ms` made while a gap is recovered from (counted in
+    /// its length from the clock bias, [`GapRecovery::length_from_bias_ms`]).
+    pub fn note_clock_step(&mut self, step_ms: i64) {
+        if let Some(gap) = self.gap.as_mut() {
+            gap.stepped_ms += step_ms;
+        }
+    }
+
+    /// The gap being recovered from, taken once the receiver time is re-established (a valid
+    /// fix), if its length was not resolved on the way.
+    pub fn take_unmeasured_gap(&mut self) -> Option<GapRecovery> {
+        self.gap.take().filter(|g| g.length_ms.is_none())
+    }
+
+    /// A carried SV time of `prn` refused at `t_s`, `off_ms` off its new bit edge. When
+    /// [`crate::pipeline::timing::discontinuity::MIN_SATELLITES`] satellites were refused
+    /// within 2 s by the same offset (0.1 ms), samples were lost during the outage: returns how
+    /// many agree and their `(PRN, offset ms, SV time rate)` (and forgets the refusals).
+    pub fn note_refusal(&mut self, t_s: f64, prn: u8, off_ms: f64) -> Option<(usize, EdgeOffsets)> {
+        self.refused.retain(|r| t_s - r.0 < 2.0 && r.1 != prn);
+        self.refused.push((t_s, prn, off_ms));
+        let agreeing = self
+            .refused
+            .iter()
+            .filter(|r| (r.2 - off_ms).abs() < 0.1)
+            .count();
+        if agreeing < crate::pipeline::timing::discontinuity::MIN_SATELLITES {
+            return None;
+        }
+        let offsets: Vec<(u8, f64, f64)> = self
+            .refused
+            .iter()
+            .filter(|r| (r.2 - off_ms).abs() < 0.1)
+            .filter_map(|r| self.clocks.get(&r.1).map(|c| (r.1, r.2, c.rate)))
+            .collect();
+        self.refused.clear();
+        Some((agreeing, offsets))
+    }
+
+    /// The offsets `(PRN, offset ms, rate)` of refused carried times handed to the gap being
+    /// recovered from at `t_s` ([`GapRecovery::add_edge_offset`]): its length, if that
+    /// resolved it.
+    pub fn add_edge_offsets(&mut self, offsets: EdgeOffsets, t_s: f64) -> Option<f64> {
+        let mut resolved = None;
+        if let Some(gap) = self.gap.as_mut() {
+            for (p, o, r) in offsets {
+                if gap.add_edge_offset(p, o, r, t_s) {
+                    resolved = gap.length_ms;
+                }
+            }
+        }
+        resolved
+    }
+
     /// Moves every kept SV time over a gap of `length_ms` of receiver time (once its length is
     /// known): each satellite's SV time ran `length r` meanwhile; they are exact again.
     pub fn move_over_gap(&mut self, length_ms: f64) {
@@ -389,5 +489,55 @@ impl SvTimeKeeper {
             e.prn
         );
         note
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refusals_by_one_offset_on_three_satellites_within_two_seconds_are_a_gap() {
+        let mut k = SvTimeKeeper::default();
+        // Two satellites refused by about -9 ms, one by another offset: not yet.
+        assert!(k.note_refusal(10.0, 3, -9.00,).is_none());
+        assert!(k.note_refusal(10.5, 16, -9.05).is_none());
+        assert!(k.note_refusal(10.6, 22, -4.00).is_none());
+        // A third agreeing within 0.1 ms and 2 s: samples lost (no clocks kept: no offsets).
+        let (agreeing, offsets) = k.note_refusal(11.0, 25, -8.99).expect("a gap");
+        assert_eq!(agreeing, 3);
+        assert!(offsets.is_empty());
+        // The refusals are forgotten once reported.
+        assert!(k.note_refusal(11.1, 26, -9.0).is_none());
+        // Refusals older than 2 s do not count.
+        assert!(k.note_refusal(14.0, 29, -9.0).is_none());
+        assert!(k.note_refusal(14.5, 31, -9.0).is_none());
+        assert!(k.note_refusal(16.6, 32, -9.0).is_none());
+    }
+
+    #[test]
+    fn clock_steps_while_recovering_count_in_the_length_from_the_clock_bias() {
+        let mut k = SvTimeKeeper::default();
+        // Last fix at 5 s: bias 300 m, drift 3 m/s.
+        k.start_gap(10.0, 2.6e6, Some((5.0, 300.0, 3.0)), Vec::new(), None);
+        let gap = k.gap().expect("a gap");
+        assert!(
+            gap.unresolved,
+            "no steps, no code: the length comes from the clock bias"
+        );
+        // The receiver time is 31 ms late after the gap: the bias drops by c 31 ms from its
+        // prediction b0 + d (t - t0).
+        let c = SPEED_OF_LIGHT_MPS;
+        let bias = 300.0 + 3.0 * (12.0 - 5.0) - 0.031 * c;
+        let length = gap.length_from_bias_ms(12.0, bias).expect("a length");
+        assert!((length - 31.0).abs() < 1e-6, "{length}");
+        // A 31 ms clock step made meanwhile moves the bias back by as much: still 31 ms.
+        k.note_clock_step(31);
+        let gap = k.take_unmeasured_gap().expect("unmeasured");
+        let length = gap
+            .length_from_bias_ms(12.0, bias + 0.031 * c)
+            .expect("a length");
+        assert!((length - 31.0).abs() < 1e-6, "{length}");
+        assert!(k.gap().is_none());
     }
 }

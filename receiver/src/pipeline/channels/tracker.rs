@@ -3,12 +3,12 @@
 //!
 //! Samples are read in blocks into a [`SampleWindow`]; every channel then processes all the
 //! code periods the window holds (channels in parallel, see
-//! [`crate::pipeline::channel_manager::ChannelManager::work`]) while the next block is read
+//! [`crate::pipeline::channels::channel_manager::ChannelManager::work`]) while the next block is read
 //! behind them; samples no channel needs any more are dropped, so memory stays bounded for any
 //! file length. The whole receiver is [`crate::pipeline::Receiver`].
 
-use crate::pipeline::channel_manager::ChannelManager;
-use crate::pipeline::ring::{block_samples, SampleWindow};
+use crate::pipeline::channels::channel_manager::ChannelManager;
+use crate::pipeline::channels::ring::{block_samples, SampleWindow};
 use gpsrx_samples::{SampleError, SampleSource};
 use gpsrx_tracking::{AidingPort, Channel, ChannelEpoch};
 

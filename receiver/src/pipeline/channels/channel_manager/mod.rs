@@ -3,7 +3,7 @@
 //!
 //! - Cold start: the first samples of the stream are searched for every wanted PRN with the
 //!   configured search (or the assisted targets).
-//! - Background search ([`crate::pipeline::search_schedule`]): every PRN without a live channel
+//! - Background search ([`crate::pipeline::channels::search_schedule`]): every PRN without a live channel
 //!   is searched again and again within a CPU budget per second of signal, escalating the
 //!   integration while it is not found (to 10 ms x 40, about 28 dB-Hz), satellites just lost
 //!   (around their last Doppler, every 0.2 s) and predicted visible ones (around their
@@ -17,13 +17,13 @@
 
 pub mod realign;
 
-pub use realign::{Realigned, REALIGN_DOPPLER_HZ};
+pub use realign::{RealignSearch, Realigned};
 
-use crate::pipeline::profile::timed;
-use crate::pipeline::ring::SampleView;
-use crate::pipeline::search_schedule::{
+use crate::pipeline::channels::ring::SampleView;
+use crate::pipeline::channels::search_schedule::{
     level_config, search_pfa, Batch, Liveness, Scheduler, SearchBudget, Visibility, LEVELS,
 };
+use crate::pipeline::profile::timed;
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult, AcquisitionEngine, SearchTarget};
 use gpsrx_dsp::Prn;
 use gpsrx_tracking::{
@@ -75,7 +75,7 @@ pub struct SearchSettings {
     /// probability): the cold start's search and the first level of the background search.
     pub acq: AcqConfig,
     /// Escalate the background search to the weak-signal levels
-    /// ([`crate::pipeline::search_schedule::LEVELS`]) for PRNs not found.
+    /// ([`crate::pipeline::channels::search_schedule::LEVELS`]) for PRNs not found.
     pub weak_fallback: bool,
     /// The background search's CPU budget; `None`: no search after the cold start.
     pub background: Option<SearchBudget>,

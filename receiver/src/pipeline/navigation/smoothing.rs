@@ -20,7 +20,7 @@
 //! A bridge whose prediction misses the new code by more than [`MAX_INNOVATION_M`] (a carried
 //! time that was wrong) restarts the filter.
 
-use crate::pipeline::carrier_step::Quadratic;
+use crate::pipeline::timing::carrier_step::Quadratic;
 use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use std::collections::VecDeque;
 

@@ -279,6 +279,7 @@ impl SampleWindow {
     }
 
     /// Whether the source is exhausted.
+    #[cfg(test)]
     pub fn end_of_stream(&self) -> bool {
         self.end_of_stream
     }

@@ -207,7 +207,7 @@ impl WindowVerdict {
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct AidingStats {
     /// Seconds of the recording in which the feed-forward reached the loops (windows of
-    /// [`WINDOW_S`] with an aided channel).
+    /// `WINDOW_S` with an aided channel).
     pub aided_s: f64,
     /// Seconds of the recording the monitor went through.
     pub monitored_s: f64,
@@ -347,7 +347,7 @@ impl AidMonitor {
         }
     }
 
-    /// Evaluates every window that ends at least [`WINDOW_LAG_S`] before `t_processed_s` (the
+    /// Evaluates every window that ends at least `WINDOW_LAG_S` before `t_processed_s` (the
     /// receive time up to which the channels have processed the samples), in order, from the
     /// one holding `t_first_s` (the stream's first sample). `expected_common_hz`: the common
     /// residual a correct INS gives (`-f_L1 d_ref`), when the clock drift is known.

@@ -1,8 +1,8 @@
 //! Receiver time re-established after samples of unknown length were lost (a long gap).
 //!
 //! The monitors measure lost samples up to about a second: the carrier-phase steps, the new
-//! bit edges and the code ([`crate::pipeline::gap_length`], [`crate::pipeline::code_jump`],
-//! whose fit reaches [`crate::pipeline::code_jump::MAX_GAP_S`]). After a longer gap (a front
+//! bit edges and the code ([`crate::pipeline::timing::gap_length`], [`crate::pipeline::timing::code_jump`],
+//! whose fit reaches [`crate::pipeline::timing::code_jump::MAX_GAP_S`]). After a longer gap (a front
 //! end dropping seconds, a file joined from two captures) the receiver, which counts samples,
 //! runs late by the unknown length `g`: an SV time carried over it is off by `g` (whole data
 //! bits, which the bit edges cannot show: `g (1 + f_D / f_L1)` falls within a few
@@ -11,7 +11,7 @@
 //! SV time is forgotten, and the time comes back from the signal:
 //!
 //! - with ephemerides known (a navigation file, or decoded before the gap): from the
-//!   coarse-time solver ([`crate::pipeline::coarse_fix`], `gpsrx_nav::pvt::coarse_time`, van
+//!   coarse-time solver ([`crate::pipeline::timing::coarse_fix`], `gpsrx_nav::pvt::coarse_time`, van
 //!   Diggelen ch. 4) once five or six satellites are tracked again with their bit edges, about
 //!   a second after the signal returns. Its a-priori position is the last fix, its a-priori
 //!   time the receiver's own at the common sample `k`, `T_rx(k) = T_0 + k / f_s`, which lies
@@ -22,15 +22,15 @@
 //!   time is set; the first HOW of each confirms it, RAIM checks every fix.
 //! - else (or when the solver refuses): from the first time of week decoded after the gap
 //!   (frame sync, or a TLM and HOW confirmed across satellites,
-//!   [`crate::pipeline::quick_sync`]), which the navigation processor then uses to step the
+//!   [`crate::pipeline::timing::quick_sync`]), which the navigation processor then uses to step the
 //!   clock near GPS time.
 //!
 //! This module is part of the receiver's time keeping (with `sv_time`, `gap_length`,
 //! `discontinuity`, `code_jump`, `carrier_step`, `quick_sync`, `coarse_fix` and `dating`): a
 //! `timing/` wing behind one type that navigation asks would hold it.
 
-use crate::pipeline::coarse_fix::{CoarseFixer, CoarseOutcome};
-use crate::pipeline::sv_time::GapRecovery;
+use crate::pipeline::timing::coarse_fix::{CoarseFixer, CoarseOutcome};
+use crate::pipeline::timing::sv_time::GapRecovery;
 use gpsrx_nav::frames::Llh;
 use gpsrx_nav::time::GpsTime;
 
@@ -48,7 +48,7 @@ pub struct LongGapStart {
     /// and a fix before the gap are known.
     pub coarse: Option<CoarseFixer>,
     /// Frame sync from a TLM and HOW confirmed across satellites
-    /// ([`crate::pipeline::quick_sync`]): with ephemerides known a fix follows at once.
+    /// ([`crate::pipeline::timing::quick_sync`]): with ephemerides known a fix follows at once.
     pub quick_sync: bool,
 }
 

@@ -9,7 +9,7 @@
 //! [`CollapseMonitor`] watches every strong 1 ms channel's prompt power against its own level
 //! and reports a collapse of [`MIN_SATELLITES`] or more satellites within [`CLUSTER_S`]: the
 //! channel manager then searches every tracked satellite's code at its Doppler
-//! ([`crate::pipeline::channel_manager`]). A blockage collapses the power too; the search then
+//! ([`crate::pipeline::channels::channel_manager`]). A blockage collapses the power too; the search then
 //! finds nothing (or the code where it was) and nothing is moved.
 //!
 //! Per satellite, the mean prompt power of the last [`POWER_REPORTS`] reports is compared with
@@ -17,7 +17,7 @@
 //! floor is `S / (1 + C/N0 T)`; the threshold is their geometric mean `S / sqrt(1 + C/N0 T)`,
 //! so that both sides have a margin of `sqrt(1 + C/N0 T)` (2.2 at [`MIN_CN0_DBHZ`], 1 ms).
 
-use crate::pipeline::gap_length::nearest_remainder;
+use crate::pipeline::timing::modulo::nearest_remainder;
 use gpsrx_tracking::{ChannelEpoch, ChannelState, CodeShift};
 use std::collections::{BTreeMap, VecDeque};
 
@@ -273,8 +273,74 @@ pub fn fit_code_gap(shifts: &[(u8, CodeShift)], fs_hz: f64, tol_samples: f64) ->
     })
 }
 
+/// What to do with the channels after a code realignment search: the decision on the gap its
+/// code shifts show, made here and carried out by the channel manager
+/// ([`crate::pipeline::channels::ChannelManager::realign`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealignPlan {
+    /// The shortest gap the code shifts allow, s.
+    pub shortest_gap_s: f64,
+    /// The satellites whose channels move onto the code found.
+    pub prns: Vec<u8>,
+    /// The code moved by more than a gap of up to [`MAX_GAP_S`] explains (on at least
+    /// [`MIN_SATELLITES`] satellites): samples of an unknown, longer length were lost; the
+    /// channels take the Doppler the search found (the one held before may have drifted).
+    pub length_unknown: bool,
+}
+
+/// The plan for the code `shifts` `(PRN, shift)` a realignment search found at `fs_hz`: move
+/// the channels whose shift one gap explains ([`fit_code_gap`]), or, when at least
+/// [`MIN_SATELLITES`] moved by more than any gap up to [`MAX_GAP_S`] explains, every channel
+/// whose code moved (the length is then unknown). `None`: no gap explains the shifts, nothing
+/// moves.
+pub fn plan_realignment(shifts: &[(u8, CodeShift)], fs_hz: f64) -> Option<RealignPlan> {
+    // Two samples, or a twentieth of a chip at high rates: the search's code resolution.
+    let tol = (0.05 * fs_hz / gpsrx_dsp::constants::CA_CHIP_RATE_HZ).max(2.0);
+    let fit = fit_code_gap(shifts, fs_hz, tol);
+    let unexplained = unexplained_moves(shifts, fit.as_ref(), tol);
+    let length_unknown = unexplained.len() >= MIN_SATELLITES;
+    let (shortest_gap_s, prns) = match fit {
+        _ if length_unknown => {
+            tracing::debug!(
+                "code realignment: the code of {unexplained:?} moved by more than a gap of up to {} s explains: {shifts:?}",
+                MAX_GAP_S
+            );
+            let moved = shifts.iter().filter(|(_, s)| code_moved(s, tol));
+            (MAX_GAP_S, moved.map(|(p, _)| *p).collect())
+        }
+        Some(gap) => (gap.shortest_s, gap.prns),
+        None => {
+            tracing::debug!("code realignment: no gap explains the shifts {shifts:?}");
+            return None;
+        }
+    };
+    Some(RealignPlan {
+        shortest_gap_s,
+        prns,
+        length_unknown,
+    })
+}
+
+/// Whether a code shift moved the code (by more than `tol_samples`, modulo its period).
+fn code_moved(s: &CodeShift, tol_samples: f64) -> bool {
+    nearest_remainder(s.shift_samples, s.period_samples).abs() > tol_samples
+}
+
+/// The satellites whose code moved but which the fitted gap (if any) does not explain.
+fn unexplained_moves(
+    shifts: &[(u8, CodeShift)],
+    fit: Option<&CodeGap>,
+    tol_samples: f64,
+) -> Vec<u8> {
+    shifts
+        .iter()
+        .filter(|(p, s)| code_moved(s, tol_samples) && fit.is_none_or(|g| !g.prns.contains(p)))
+        .map(|(p, _)| *p)
+        .collect()
+}
+
 /// The code shifts after `g_s` of lost samples at 2.6 MHz for satellites at `dopplers` (Hz),
-/// PRNs 1, 2, ... (test support, also for `channel_manager::realign`).
+/// PRNs 1, 2, ... (test support).
 #[cfg(test)]
 pub(crate) fn shifts_after(g_s: f64, dopplers: &[f64]) -> Vec<(u8, gpsrx_tracking::CodeShift)> {
     dopplers
@@ -385,5 +451,29 @@ mod tests {
         four.push((9, s(90.0)));
         let gap = fit_code_gap(&four, 2.6e6, 2.0).expect("gap");
         assert_eq!(gap.prns, vec![1, 2, 3]);
+    }
+
+    #[test]
+    fn code_moves_of_a_gap_longer_than_the_fit_reaches_are_left_unexplained() {
+        let dopplers = [
+            -3186.0, 1963.0, -1888.0, 637.0, -565.0, 2480.0, -2710.0, 1210.0,
+        ];
+        let unexplained = |g: f64| {
+            let s = shifts_after(g, &dopplers);
+            unexplained_moves(&s, fit_code_gap(&s, 2.6e6, 2.0).as_ref(), 2.0)
+        };
+        // Up to the fit's reach, one length explains every move.
+        for g in [1.25e-3, 0.5, 0.7317] {
+            assert!(unexplained(g).is_empty(), "{g} s: {:?}", unexplained(g));
+        }
+        // Beyond, the moves g f_D / f_L1 (26 samples for 5 s at 3 kHz) differ between satellites by
+        // more than any one gap of up to a second explains (a few may agree by chance).
+        for g in [5.0, 5.37, 60.0] {
+            let u = unexplained(g);
+            assert!(u.len() >= 6, "{g} s: {u:?}");
+        }
+        // Nothing moved (a blockage that ended): no gap.
+        let still: Vec<(u8, CodeShift)> = shifts_after(0.0, &dopplers);
+        assert!(unexplained_moves(&still, None, 2.0).is_empty());
     }
 }

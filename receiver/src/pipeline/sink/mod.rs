@@ -7,7 +7,10 @@
 //! implements what it wants. [`crate::output::FileSink`] writes the standard files;
 //! [`MemorySink`] keeps everything in memory (tests, bindings, notebooks).
 
-use crate::output::{ChannelRow, Fix, ObsEpoch};
+mod products;
+
+pub use products::{ChannelRow, Fix, FixQuality, ObsEpoch, SatObs, SatView};
+
 use gpsrx_nav::atmosphere::{KlobucharParams, UtcParams};
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::pvt::PvtSolution;
@@ -39,7 +42,7 @@ pub struct ObservablesReport {
     /// which may be 1024 weeks off).
     pub week_decoded: bool,
     /// Whether `epoch.time.week` is known: decoded, or a reference week that does not come
-    /// from the system clock ([`crate::pipeline::dating`]).
+    /// from the system clock ([`crate::pipeline::WeekReference`]).
     pub week_known: bool,
 }
 
@@ -99,7 +102,7 @@ pub enum ReceiverEvent {
         length_ms: f64,
     },
     /// The satellites' SV times came from their code phases, the approximate time and
-    /// position ([`crate::pipeline::coarse_fix`]), before any time of week was decoded.
+    /// position (`crate::pipeline::timing::coarse_fix`), before any time of week was decoded.
     CoarseTime {
         /// Stream time of the solution, s.
         t_s: f64,

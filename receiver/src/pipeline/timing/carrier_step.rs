@@ -17,7 +17,7 @@
 //! Under dynamics the quadratic stops describing the phase over long windows: the window is
 //! shortened until the fit's residuals are those of the noise.
 
-use crate::pipeline::gap_length::nearest_remainder;
+use crate::pipeline::timing::modulo::nearest_remainder;
 use gpsrx_tracking::ChannelEpoch;
 use std::f64::consts::{PI, TAU};
 

@@ -57,7 +57,7 @@ pub enum NavEvent {
     /// While unsynchronised, with [`NavDecoder::report_tow_candidates`]: a telemetry word
     /// with the preamble and a hand-over word ending at the newest bit passed parity. Not yet
     /// trusted: [`NavDecoder::sync_at`] takes it once another satellite confirms it
-    /// ([`crate::pipeline::quick_sync`]).
+    /// (`crate::pipeline::timing::quick_sync`).
     TowCandidate {
         /// `ms_count` of the TLM's first bit.
         first_ms: u64,
@@ -276,7 +276,7 @@ impl NavDecoder {
             return;
         };
         let sv_ms = sv * 1e3;
-        let off = crate::pipeline::gap_length::nearest_remainder(sv_ms, 20.0);
+        let off = crate::pipeline::timing::modulo::nearest_remainder(sv_ms, 20.0);
         if off.abs() > 0.5 {
             events.push(NavEvent::BitEdgeMismatch { offset_ms: off });
             self.reset_sync();

@@ -45,7 +45,7 @@
 //! ([`InsFeedForward::note_samples_lost`]) every stream time is taken as `t_s + lost` here
 //! (fixes, aids, predictions), and a time origin given after it is moved back by `lost`.
 
-use crate::pipeline::fix_output::passes_integrity;
+use crate::pipeline::navigation::fix_output::passes_integrity;
 use gpsrx_core::{los_doppler_hz, PosVel};
 use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_ins_aiding::{BandLimiter, InsTrack, InsVelocityCalibration};
@@ -298,7 +298,7 @@ impl InsFeedForward {
 
     /// The unfiltered feed-forward Doppler (Hz) of `prn` at receive time `t_s`, without
     /// logging and without the band limiter: what the integrity monitor compares with the
-    /// Doppler of a channel that runs unaided ([`crate::pipeline::aid_monitor`]). None when
+    /// Doppler of a channel that runs unaided ([`crate::pipeline::aiding::AidMonitor`]). None when
     /// the aid cannot be computed (no GPS time, no ephemeris, outside the INS file).
     pub fn predicted_doppler_hz(&self, prn: u8, t_s: f64) -> Option<f64> {
         let (t0, know) = {
@@ -392,7 +392,7 @@ impl InsFeedForward {
         };
         let Some(eph) = self.ephemeris(prn, t0.add_seconds(t_s)) else {
             self.log_once(prn, "eph", || {
-                format!("G{prn:02}: no ephemeris yet (decoded or --nav), no INS feed-forward")
+                format!("G{prn:02}: no ephemeris yet (none decoded, none in the navigation data given), no INS feed-forward")
             });
             return None;
         };

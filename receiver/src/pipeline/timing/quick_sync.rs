@@ -1,6 +1,6 @@
 //! Frame sync 1.2 s into a subframe, confirmed across satellites.
 //!
-//! The normal frame sync ([`crate::pipeline::navdata`]) waits for a whole parity-checked
+//! The normal frame sync ([`crate::pipeline::navigation::navdata`]) waits for a whole parity-checked
 //! subframe and the next preamble: 6-12 s. A telemetry word (preamble) and a hand-over word
 //! that both pass parity give the time of week 1.2 s after a subframe starts, but alone they
 //! could be a chance match (20 preamble and parity bits). Two satellites whose candidate

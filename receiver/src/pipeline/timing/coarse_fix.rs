@@ -17,7 +17,7 @@
 //! [`gpsrx_nav::pvt::solve_coarse_time`] turns the phi_i, the ephemerides, the a-priori time
 //! `t_a = T_start + k / fs` and the a-priori position into each satellite's full transmit time
 //! `T_i = N_i ms + phi_i`. The SV time at the start of period `m_i(k)` is `N_i ms`: the
-//! decoder's time tag ([`crate::pipeline::navdata::NavDecoder::carry_time`]), whose
+//! decoder's time tag ([`crate::pipeline::navigation::navdata::NavDecoder::carry_time`]), whose
 //! `sv_tow_s(m, c) = N_i ms + (m - m_i(k)) ms + c / 1.023e6` inverts the equations above.
 //!
 //! # Checks
@@ -35,11 +35,11 @@
 //! passed the chi-square test of its integers (6 or more satellites), or, with exactly 5 (no
 //! redundancy), if all 5 have bit edges that agree; otherwise the receiver waits (for another
 //! satellite, or for frame sync). Later, each satellite's first bit is checked against the
-//! time again ([`crate::pipeline::navdata::NavEvent::BitEdgeMismatch`]) and its first HOW
-//! against it ([`crate::pipeline::navdata::NavEvent::TowMismatch`]); the normal PVT's RAIM
+//! time again ([`crate::pipeline::navigation::navdata::NavEvent::BitEdgeMismatch`]) and its first HOW
+//! against it ([`crate::pipeline::navigation::navdata::NavEvent::TowMismatch`]); the normal PVT's RAIM
 //! checks every fix; a failure drops the times (the processor's part).
 
-use crate::pipeline::observables::CODE_SETTLE_MS;
+use crate::pipeline::navigation::observables::CODE_SETTLE_MS;
 use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::frames::Llh;

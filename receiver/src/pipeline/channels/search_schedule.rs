@@ -108,13 +108,13 @@ pub const BURST_S: f64 = 1.25;
 
 /// The default refill, CPU s per second of signal: half a percent of a core. Once the first
 /// round is done it pays for the cheap search of about 20 absent PRNs every
-/// [`UNKNOWN_WAIT_S`] and their deep round every [`DEEP_WAIT_S`] (about 0.003 + 0.007 at
+/// `UNKNOWN_WAIT_S` and their deep round every `DEEP_WAIT_S` (about 0.003 + 0.007 at
 /// 4 MHz; the rounds come later than that when it runs short). It was 0.02, which spent 1.2 s
 /// of CPU in a 60 s run on 10 ms x 50 searches of absent PRNs (half the searches' cost, a
 /// third of the run's).
 pub const DEFAULT_PER_SIGNAL_S: f64 = 0.005;
 
-/// The CPU time searches may spend. Searches of a satellite lost in the last [`HOT_FOR_S`] at
+/// The CPU time searches may spend. Searches of a satellite lost in the last `HOT_FOR_S` at
 /// the configured level (narrow and cheap: re-acquisition) are not charged.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SearchBudget {
@@ -245,6 +245,7 @@ impl Scheduler {
     }
 
     /// The modelled CPU time left, s.
+    #[cfg(test)]
     pub fn tokens_s(&self) -> f64 {
         self.tokens_s
     }
