@@ -78,7 +78,7 @@ pub enum FoundBy {
     /// The carrier phases jumped together at `sample` (this monitor).
     CarrierPhase,
     /// The data-bit edges moved together by `offset_ms` somewhere between `sample` and
-    /// `after_sample` ([`crate::pipeline::timing::bit_edge`]).
+    /// `after_sample` (the timing wing's `bit_edge` monitor).
     BitEdges {
         /// The move, ms in 1..20.
         offset_ms: u64,
@@ -303,7 +303,7 @@ impl DiscontinuityMonitor {
 
     /// Per satellite with a carrier history: the carrier-phase step over a jump known only
     /// to lie between samples `before` and `after` (the bit edges' move,
-    /// [`crate::pipeline::bit_edge`]): measured from the reports before the one and after
+    /// `bit_edge`): measured from the reports before the one and after
     /// the other, so that neither side holds the jump.
     pub fn steps_between(&self, before: u64, after: u64) -> Vec<PhaseStep> {
         let prns: Vec<u8> = self.watches.keys().copied().collect();
