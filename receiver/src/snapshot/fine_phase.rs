@@ -39,8 +39,21 @@
 use gpsrx_dsp::constants::{CA_CODE_LENGTH, F_L1_HZ};
 use gpsrx_dsp::{CaCode, Prn};
 use num_complex::{Complex, Complex32, Complex64};
-use rustfft::FftPlanner;
+use rustfft::{Fft, FftPlanner};
+use std::cell::RefCell;
 use std::f64::consts::PI;
+use std::sync::Arc;
+
+thread_local! {
+    /// One planner per thread: it keeps the plans of the lengths it made (1023 and N), which
+    /// cost more to make than to run once.
+    static PLANNER: RefCell<FftPlanner<f64>> = RefCell::new(FftPlanner::new());
+}
+
+/// The forward FFT of `len` points, from this thread's planner.
+fn forward_fft(len: usize) -> Arc<dyn Fft<f64>> {
+    PLANNER.with(|p| p.borrow_mut().plan_fft_forward(len))
+}
 
 /// Half-width of the delay searched around the start, samples.
 pub const SPAN_SAMPLES: f64 = 1.0;
@@ -135,7 +148,7 @@ fn code_harmonics(prn: Prn, k_max: usize) -> Vec<Complex64> {
         .iter()
         .map(|&c| Complex64::new(f64::from(c), 0.0))
         .collect();
-    FftPlanner::new().plan_fft_forward(len).process(&mut a);
+    forward_fft(len).process(&mut a);
     (0..=2 * k_max)
         .map(|i| {
             let k = i as i64 - k_max as i64;
@@ -159,7 +172,7 @@ fn period_spectra(
     fs_hz: f64,
     doppler_hz: f64,
 ) -> Vec<Vec<Complex64>> {
-    let fft = FftPlanner::new().plan_fft_forward(n);
+    let fft = forward_fft(n);
     let w = -2.0 * PI * doppler_hz / fs_hz;
     (0..periods)
         .map(|m| {

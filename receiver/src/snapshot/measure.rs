@@ -31,6 +31,7 @@ use gpsrx_dsp::acquisition::{AcqConfig, AcqResult, AcquisitionEngine, SearchTarg
 use gpsrx_dsp::Prn;
 use gpsrx_nav::{GpsTime, HealthPolicy, NavData, Vector3};
 use num_complex::Complex32;
+use rayon::prelude::*;
 
 use super::fine_phase::band_limited_code_phase;
 use crate::pipeline::channels::predict_satellite;
@@ -268,7 +269,8 @@ pub fn acquire_snapshot(
     }
     let mut acq = assemble(&results, pred, offset, folded, tol);
     let fit = CodeFitOptions::default();
-    for s in &mut acq.sats {
+    // Each satellite's fit on its own core (the band-limited fit is most of a snapshot's time).
+    acq.sats.par_iter_mut().for_each(|s| {
         if let Some(tau) = fit_code_phase(
             samples,
             wide.fs_hz(),
@@ -280,7 +282,7 @@ pub fn acquire_snapshot(
             s.code_phase_samples = tau;
         }
         s.code_phase_samples = refine(samples, wide.fs_hz(), s, opts.code_band_hz);
-    }
+    });
     Ok(acq)
 }
 
@@ -317,7 +319,7 @@ pub fn look_at_predicted(
     let period = fs_hz * 1e-3;
     let fit = CodeFitOptions::default();
     missed
-        .iter()
+        .par_iter()
         .filter_map(|m| {
             let seen = m.doppler_hz + offset_hz;
             let dopplers = (seen, m.doppler_hz);
