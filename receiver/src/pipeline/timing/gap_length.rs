@@ -130,7 +130,10 @@ pub fn estimate_from_code(offsets: &[(f64, f64)]) -> Option<(f64, f64)> {
 ///   must agree, and a phase candidate must be within 4 sigma of the code's estimate;
 /// - otherwise, when the code leaves exactly one candidate within 3 sigma and the phase steps
 ///   explain it (score at least [`MIN_SCORE`]), that one: two independent measurements agree
-///   on it although neither alone excludes every other.
+///   on it although neither alone excludes every other;
+/// - otherwise the candidates are weighed by both together ([`joint_choice`]): under a
+///   Doppler ramp few phase steps pass their check and the code's estimate leaves two or
+///   three candidates, which together they may still tell apart.
 pub fn choose(offset_ms: f64, steps: &[PhaseStep], by_code: Option<(f64, f64)>) -> Option<f64> {
     let by_phase = resolve_gap_ms(offset_ms, steps, 1000.0);
     let near_code = |sigmas: f64| -> Vec<f64> {
@@ -154,9 +157,56 @@ pub fn choose(offset_ms: f64, steps: &[PhaseStep], by_code: Option<(f64, f64)>) 
         (None, Some(c)) => Some(c),
         (None, None) => match near_code(3.0).as_slice() {
             [c] if steps.len() >= MIN_STEPS && phase_score(*c, steps) >= MIN_SCORE => Some(*c),
-            _ => None,
+            _ => by_code.and_then(|code| joint_choice(offset_ms, steps, code)),
         },
     }
+}
+
+/// Probability that a measured phase step is an outlier (a slip after the jump), in
+/// [`joint_choice`]'s likelihood.
+pub const STEP_OUTLIER_PROB: f64 = 0.05;
+/// Fewest phase steps [`joint_choice`] weighs.
+pub const MIN_JOINT_STEPS: usize = 2;
+/// Least log-likelihood ratio of the best candidate over the next in [`joint_choice`]
+/// (`ln 1000`).
+pub const MIN_JOINT_LOG_RATIO: f64 = 6.9;
+
+/// The candidate `o + 20 k` within 5 sigma of the code's estimate `(g, sigma)` that the code
+/// and the phase steps together make at least 1000 times likelier than any other:
+/// `L(c) = -(c - g)^2 / (2 sigma^2) + sum_i ln((1 - rho) exp(-e_i^2 / (2 s^2)) + rho)`, with
+/// `e_i` step `i`'s error for `c` (modulo pi), `s` = [`STEP_SIGMA_RAD`] and `rho` =
+/// [`STEP_OUTLIER_PROB`] (each step moves `L` by at most `ln rho` = -3.0, so two steps and the
+/// code are needed to reach the ratio). The best must also explain the steps (score at least
+/// [`MIN_SCORE`]).
+pub fn joint_choice(offset_ms: f64, steps: &[PhaseStep], code: (f64, f64)) -> Option<f64> {
+    let (g, sigma) = code;
+    if steps.len() < MIN_JOINT_STEPS || !(g.is_finite() && sigma > 0.0 && sigma.is_finite()) {
+        return None;
+    }
+    let k_lo = ((g - 5.0 * sigma - offset_ms) / 20.0).ceil().max(0.0) as i64;
+    let k_hi = ((g + 5.0 * sigma - offset_ms) / 20.0).floor() as i64;
+    let s2 = 2.0 * STEP_SIGMA_RAD * STEP_SIGMA_RAD;
+    let mut scored: Vec<(f64, f64)> = (k_lo..=k_hi)
+        .map(|k| offset_ms + 20.0 * k as f64)
+        .filter(|&c| c > 0.25)
+        .map(|c| {
+            let phase: f64 = steps
+                .iter()
+                .map(|st| {
+                    let e = nearest_remainder(
+                        st.predicted_rad(c * 1e-3) - st.step_rad,
+                        std::f64::consts::PI,
+                    );
+                    ((1.0 - STEP_OUTLIER_PROB) * (-e * e / s2).exp() + STEP_OUTLIER_PROB).ln()
+                })
+                .sum();
+            (phase - (c - g).powi(2) / (2.0 * sigma * sigma), c)
+        })
+        .collect();
+    scored.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let (best, c) = *scored.first()?;
+    let next = scored.get(1).map_or(f64::NEG_INFINITY, |x| x.0);
+    (best - next >= MIN_JOINT_LOG_RATIO && phase_score(c, steps) >= MIN_SCORE).then_some(c)
 }
 
 #[cfg(test)]
@@ -242,5 +292,27 @@ mod tests {
             })
             .collect();
         assert_eq!(resolve_gap_ms(11.0, &random, 1000.0), None);
+    }
+
+    #[test]
+    fn two_phase_steps_and_the_code_together_resolve_what_neither_does_alone() {
+        // A 31 ms gap under a 4.3 g climb (the dyn-gaps rocket): two steps passed their check,
+        // at 488 and 2164 Hz with Doppler rates of 19 and 13 Hz/s, and the code said
+        // 24.5 +- 6 ms (11, 31 and 51 ms all within 3 sigma).
+        let mut steps = steps_for(31.0, &[487.7, 2164.1], &[0.08, -0.05]);
+        steps[0].rate_hz_s = 19.2;
+        steps[1].rate_hz_s = 13.2;
+        for s in &mut steps {
+            let phi = s.predicted_rad(0.031) + 0.05;
+            s.step_rad = nearest_remainder(phi, std::f64::consts::PI);
+        }
+        assert_eq!(resolve_gap_ms(11.0, &steps, 1000.0), None);
+        assert_eq!(choose(11.0, &steps, Some((24.5, 6.0))), Some(31.0));
+        // Steps that 11 and 31 ms explain alike (whole cycles in 20 ms at 1000 and 1500 Hz):
+        // the code alone prefers 31 by too little.
+        let alike = steps_for(31.0, &[1000.0, 1500.0], &[0.0]);
+        assert_eq!(joint_choice(11.0, &alike, (24.5, 6.0)), None);
+        // One step is not enough, however well it fits.
+        assert_eq!(joint_choice(11.0, &steps[..1], (24.5, 6.0)), None);
     }
 }
