@@ -40,3 +40,41 @@ fn the_transmission_time_is_the_start_of_subframe_1() {
     // The D19.12 form of the field.
     assert!(text.contains("    0.538200000000D+06"), "{text}");
 }
+
+#[test]
+fn observables_whose_time_goes_back_are_left_out_of_rinex_and_the_run_goes_on() {
+    // Two captures joined out of order: the receiver's time goes back by 40 s. RINEX holds
+    // increasing time only, so those epochs are left out; before, the run stopped with an error.
+    use gpsrx_nav::time::GpsTime;
+    use gpsrx_receiver::output::{ObsEpoch, SatObs};
+    use gpsrx_receiver::pipeline::{NavigationEnd, ObservablesReport, Sink};
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let mut files = FileSink::create(dir.path(), 10.0).unwrap_or_else(|e| panic!("{e}"));
+    let report = |tow_s: f64| ObservablesReport {
+        epoch: ObsEpoch {
+            time: GpsTime::new(2190, tow_s),
+            clock_offset_s: None,
+            sats: vec![SatObs {
+                prn: 5,
+                pseudorange_m: Some(2.2e7),
+                ..SatObs::default()
+            }],
+        },
+        fix_position_m: Some([-3.05e6, 4.04e6, 3.87e6]),
+        week_decoded: true,
+        week_known: true,
+    };
+    for tow in [538_240.0, 538_240.1, 538_200.0, 538_200.1, 538_240.2] {
+        files
+            .observables(&report(tow))
+            .unwrap_or_else(|e| panic!("TOW {tow}: {e}"));
+    }
+    files
+        .finish(&NavigationEnd::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let text = std::fs::read_to_string(dir.path().join("observables.rnx"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let epochs: Vec<&str> = text.lines().filter(|l| l.starts_with("> ")).collect();
+    assert_eq!(epochs.len(), 3, "{text}");
+    assert!(epochs[2].contains(" 30 40.2000000"), "{:?}", epochs[2]);
+}

@@ -39,6 +39,8 @@ pub struct FileSink {
     obs_week_known: bool,
     /// Epochs dropped from the backlog while the week was unknown (memory bound).
     obs_dropped: usize,
+    /// Observable epochs left out because their time was not after the last one written.
+    obs_not_after: usize,
     fixes: Vec<Fix>,
     /// What the plots need, when they are drawn.
     plots: Option<RunPlotData>,
@@ -68,6 +70,7 @@ impl FileSink {
             obs_backlog: Vec::new(),
             obs_week_known: false,
             obs_dropped: 0,
+            obs_not_after: 0,
             fixes: Vec::new(),
             plots: None,
         })
@@ -156,7 +159,25 @@ impl Sink for FileSink {
             return Ok(());
         }
         match (&mut self.obs_writer, report.fix_position_m) {
-            (Some(w), _) => w.write_epoch(&report.epoch)?,
+            (Some(w), _) => {
+                let back = w
+                    .last_epoch_time()
+                    .filter(|last| report.epoch.time.diff_s(*last) <= 0.0);
+                if let Some(last) = back {
+                    // RINEX holds increasing time only: a recording whose time went back (two
+                    // captures joined in the wrong order) keeps its fixes, not these epochs.
+                    if self.obs_not_after == 0 {
+                        tracing::warn!(
+                            "observables.rnx: the epoch at TOW {:.3} s is not after the last one written (TOW {:.3} s): the recording's time went back (captures joined out of order?); such epochs are left out of observables.rnx, the fixes go on",
+                            report.epoch.time.tow_s,
+                            last.tow_s
+                        );
+                    }
+                    self.obs_not_after += 1;
+                } else {
+                    w.write_epoch(&report.epoch)?;
+                }
+            }
             (None, Some(position)) => {
                 self.open_observables(Some(position), week)?;
                 if let Some(w) = &mut self.obs_writer {
@@ -191,6 +212,12 @@ impl Sink for FileSink {
         self.pvt_csv.flush()?;
         self.nmea.flush()?;
         self.channels_csv.flush()?;
+        if self.obs_not_after > 0 {
+            tracing::warn!(
+                "observables.rnx: {} epochs left out because the recording's time went back",
+                self.obs_not_after
+            );
+        }
         match self.obs_writer.take() {
             Some(w) => {
                 let last = w.last_epoch_time();
