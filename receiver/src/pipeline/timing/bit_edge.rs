@@ -135,9 +135,13 @@ impl BitEdgeMonitor {
             && (e.t_coh_s - 1e-3).abs() < 1e-4
             && e.cn0_dbhz >= MIN_CN0_DBHZ
             && e.prompt.norm_sqr() > 0.0;
-        if !watched {
+        // A new channel of the same satellite counts its milliseconds from 0 again.
+        let restarted = w.last.is_some_and(|(ms, _)| e.ms_count <= ms);
+        if !watched || restarted {
             *w = EdgeWatch::default();
-            return;
+            if !watched {
+                return;
+            }
         }
         if e.bit_edge {
             w.edge_ms = Some(e.ms_count);
@@ -173,13 +177,14 @@ impl BitEdgeMonitor {
         if !consecutive {
             w.pending = None;
         }
-        if let (true, Some((_, prev)), Some(edge)) = (consecutive, w.last, w.edge_ms) {
+        let since_edge = w.edge_ms.and_then(|edge| e.ms_count.checked_sub(edge));
+        if let (true, Some((_, prev)), Some(since_edge)) = (consecutive, w.last, since_edge) {
             if (e.prompt * prev.conj()).re < 0.0 {
                 let p = noise_flip_prob(e.cn0_dbhz, e.t_coh_s);
                 let flip = Flip {
                     ms: e.ms_count,
                     sample: e.sample_index,
-                    offset_ms: (e.ms_count - edge) % BIT_MS,
+                    offset_ms: since_edge % BIT_MS,
                     weight: ((1.0 - p) / p).ln(),
                 };
                 match w.pending.take() {
