@@ -13,9 +13,10 @@ worst 3D error of the valid fixes from the fault to 10 s after the return, how m
 are over 5 m, and how many are over 5 m and beyond their 3-sigma (the integrity failures).
 """
 import argparse
-import bisect
 import csv
 import math
+
+from truth_track import TruthTrack
 
 
 def main():
@@ -26,18 +27,8 @@ def main():
     ap.add_argument("--len", type=float, required=True)
     ap.add_argument("--label", default="")
     a = ap.parse_args()
-    rows = [(float(r["tow_s"]), float(r["x_m"]), float(r["y_m"]), float(r["z_m"]))
-            for r in csv.DictReader(open(a.truth))]
-    tows = [r[0] for r in rows]
-    t0 = tows[0]
-
-    def truth_at(tow):
-        i = bisect.bisect_left(tows, tow)
-        if i <= 0 or i >= len(tows):
-            return None
-        p, q = rows[i - 1], rows[i]
-        f = (tow - p[0]) / (q[0] - p[0])
-        return [p[k] + f * (q[k] - p[k]) for k in (1, 2, 3)]
+    track = TruthTrack(a.truth)
+    truth_at = track.at
 
     back, worst, over5, beyond = None, 0.0, 0, 0
     ret = a.at + a.len
@@ -45,7 +36,7 @@ def main():
     for r in csv.DictReader(open(f"{a.out}/pvt.csv")):
         if r["quality"] not in ("gnss", "fused"):
             continue
-        t = float(r["tow_s"]) - t0
+        t = float(r["tow_s"]) - track.start_tow
         if t < a.at:
             continue
         if prev <= ret + 10.0 and t - prev > 0.3 and t > ret:

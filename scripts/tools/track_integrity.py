@@ -9,9 +9,10 @@ truth (interpolated at the fix's GPS time of week) exceeds 5 m and their stated 
 from the truth's first row. For a static antenna see fault_recovery.py.
 """
 import argparse
-import bisect
 import csv
 import math
+
+from truth_track import TruthTrack
 
 
 def main():
@@ -21,23 +22,14 @@ def main():
     ap.add_argument("--from", dest="t_from", type=float, default=-1e18)
     ap.add_argument("--to", dest="t_to", type=float, default=1e18)
     a = ap.parse_args()
-    rows = [(float(r["tow_s"]), float(r["x_m"]), float(r["y_m"]), float(r["z_m"]))
-            for r in csv.DictReader(open(a.truth))]
-    tows = [r[0] for r in rows]
-
-    def truth_at(tow):
-        i = bisect.bisect_left(tows, tow)
-        if i <= 0 or i >= len(tows):
-            return None
-        p, q = rows[i - 1], rows[i]
-        f = (tow - p[0]) / (q[0] - p[0])
-        return [p[k] + f * (q[k] - p[k]) for k in (1, 2, 3)]
+    track = TruthTrack(a.truth)
+    truth_at = track.at
 
     n, bad, worst = 0, [], 0.0
     for r in csv.DictReader(open(f"{a.out}/pvt.csv")):
         if r["quality"] not in ("gnss", "fused"):
             continue
-        t = float(r["tow_s"]) - tows[0]
+        t = float(r["tow_s"]) - track.start_tow
         p = truth_at(float(r["tow_s"]))
         if p is None or not (a.t_from <= t <= a.t_to):
             continue

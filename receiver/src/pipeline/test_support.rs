@@ -42,3 +42,22 @@ pub fn report(
         bit_start_ms: None,
     }
 }
+
+/// Deterministic uniform numbers (xorshift) and standard normals (Box-Muller), for tests that
+/// need noise without a dependency on the random-number crates' streams.
+pub struct Noise(pub u64);
+
+impl Noise {
+    /// Uniform in (0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    /// Standard normal.
+    pub fn normal(&mut self) -> f64 {
+        (-2.0 * self.uniform().ln()).sqrt() * (std::f64::consts::TAU * self.uniform()).cos()
+    }
+}

@@ -291,19 +291,7 @@ impl BitEdgeMonitor {
 mod tests {
     use super::*;
 
-    /// Deterministic uniform numbers (xorshift) and standard normals (Box-Muller).
-    struct Noise(u64);
-    impl Noise {
-        fn uniform(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-        }
-        fn normal(&mut self) -> f64 {
-            (-2.0 * self.uniform().ln()).sqrt() * (std::f64::consts::TAU * self.uniform()).cos()
-        }
-    }
+    use crate::pipeline::test_support::Noise;
 
     /// Channels at `cn0` dB-Hz (one per entry), 1 ms reports at 2.048 MHz whose bits (random,
     /// per satellite) have edges at `ms % 20 == phase` of each; from `cut_ms` on, `lost_ms`

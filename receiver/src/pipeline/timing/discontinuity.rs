@@ -321,19 +321,7 @@ mod tests {
         -3120.4, -1877.9, -640.2, 199.1, 874.6, 1502.3, 2280.8, 3411.7,
     ];
 
-    /// Deterministic standard normal numbers (xorshift and Box-Muller).
-    struct Noise(u64);
-    impl Noise {
-        fn uniform(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-        }
-        fn normal(&mut self) -> f64 {
-            (-2.0 * self.uniform().ln()).sqrt() * (TAU * self.uniform()).cos()
-        }
-    }
+    use crate::pipeline::test_support::Noise;
 
     /// A 1 ms report of satellite `i` at 45 dB-Hz whose signal phase is `2 pi f t + jump`
     /// against an NCO at `2 pi f t` (the loop has not reacted yet), with unit noise per arm
