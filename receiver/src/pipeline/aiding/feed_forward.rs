@@ -296,6 +296,34 @@ impl InsFeedForward {
         Some(-F_L1_HZ * d_ref)
     }
 
+    /// The change of the carrier phase the loops track for `prn` over the `span_s` seconds of
+    /// signal that end at receive time `t_s` (cycles, in the sense of the Doppler: its
+    /// integral), from the INS: the feed-forward Doppler plus the part of the receiver clock
+    /// drift it leaves to the loops ([`Self::expected_common_residual_hz`]), integrated by
+    /// Simpson's rule over 8 intervals; with the signal lost so far (s) by which receive times
+    /// are moved to signal times. `None` when a Doppler cannot be computed or the clock drift
+    /// is not known yet.
+    pub fn carrier_change_cycles(&self, prn: u8, t_s: f64, span_s: f64) -> Option<(f64, f64)> {
+        const INTERVALS: usize = 8;
+        if !(span_s.is_finite() && span_s > 0.0 && t_s.is_finite()) {
+            return None;
+        }
+        let common = self.expected_common_residual_hz()?;
+        let lost_s = self.know.read().ok()?.lost_s;
+        let h = span_s / INTERVALS as f64;
+        let mut sum = 0.0;
+        for i in 0..=INTERVALS {
+            let f = self.predicted_doppler_hz(prn, t_s - span_s + i as f64 * h)? + common;
+            let w = match i {
+                0 | INTERVALS => 1.0,
+                i if i % 2 == 1 => 4.0,
+                _ => 2.0,
+            };
+            sum += w * f;
+        }
+        Some((sum * h / 3.0, lost_s))
+    }
+
     /// The unfiltered feed-forward Doppler (Hz) of `prn` at receive time `t_s`, without
     /// logging and without the band limiter: what the integrity monitor compares with the
     /// Doppler of a channel that runs unaided ([`crate::pipeline::aiding::AidMonitor`]). None when

@@ -13,6 +13,7 @@
 //! from the NCO state at its start advanced to `t`: SV time by `(t - t_rx) r / 1.023 MHz` for the
 //! code rate `r`, carrier phase by `(t - t_rx) f_D`.
 
+use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::navigation::navdata::NavDecoder;
 use crate::pipeline::navigation::smoothing::{Hatch, HatchEpoch};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ, SPEED_OF_LIGHT_MPS};
@@ -191,7 +192,12 @@ impl ObservableBuilder {
 
     /// Takes one channel report (with the decoder of its satellite); returns the epochs that
     /// are complete (no channel can add to them any more).
-    pub fn push(&mut self, e: &ChannelEpoch, dec: &NavDecoder) -> Vec<ObservableEpoch> {
+    pub fn push(
+        &mut self,
+        e: &ChannelEpoch,
+        dec: &NavDecoder,
+        aid: Option<&InsFeedForward>,
+    ) -> Vec<ObservableEpoch> {
         // Only phase-locked channels with signal give observables (a channel that has just
         // lost its signal still reports until its C/N0 test releases it), once their code loop
         // has settled.
@@ -271,7 +277,18 @@ impl ObservableBuilder {
                     (h.smoothed_m, rate)
                 }
                 Some(h) => {
-                    let bridged = lost_s.is_some_and(|g| h.bridge(&he, g, max_m));
+                    // With an INS the range change over the break follows the motion (a
+                    // manoeuvre's jerk defeats the quadratic); only when the INS has been told
+                    // of every gap (its times are then signal times).
+                    let total_lost: Option<f64> = self.gaps.iter().map(|g| g.1).sum();
+                    let by_ins = match (aid, lost_s, total_lost) {
+                        (Some(a), Some(g), Some(total)) => a
+                            .carrier_change_cycles(e.prn, t_stream, t_stream - h.t_stream_s + g)
+                            .filter(|&(_, told)| (told - total).abs() < 1e-4)
+                            .map(|(cycles, _)| -cycles * SPEED_OF_LIGHT_MPS / F_L1_HZ),
+                        _ => None,
+                    };
+                    let bridged = lost_s.is_some_and(|g| h.bridge(&he, g, max_m, by_ins));
                     if !bridged {
                         *h = Hatch::start(&he);
                     }

@@ -344,7 +344,7 @@ impl NavigationProcessor {
         self.channel_row(channel, e, sink)?;
         self.realign_clock(e, sink)?;
         let ready = match self.decoders.get(&e.prn) {
-            Some(d) => self.builder.push(e, d),
+            Some(d) => self.builder.push(e, d, aiding),
             None => Vec::new(),
         };
         if let (Some(ff), Some(t0)) = (aiding, self.builder.rx_time_origin()) {

@@ -161,8 +161,30 @@ impl Hatch {
     /// The range change (m, carrier sign, with the clock terms) from the last epoch to one
     /// `elapsed_s` of signal later, across `lost_s` of lost samples and `dsteps_ms` of clock
     /// steps; `None` without enough history or beyond [`MAX_BRIDGE_S`].
-    fn bridge_change_m(&self, elapsed_s: f64, lost_s: f64, dsteps_ms: i64) -> Option<f64> {
-        if !(0.0..=MAX_BRIDGE_S).contains(&elapsed_s) || self.history.len() < 5 {
+    fn bridge_change_m(
+        &self,
+        elapsed_s: f64,
+        lost_s: f64,
+        dsteps_ms: i64,
+        signal_change_m: Option<f64>,
+    ) -> Option<f64> {
+        if !(0.0..=MAX_BRIDGE_S).contains(&elapsed_s) {
+            return None;
+        }
+        let clock_m = -SPEED_OF_LIGHT_MPS * lost_s + SPEED_OF_LIGHT_MPS * dsteps_ms as f64 * 1e-3;
+        // The carrier's own quadratic when it follows the phase (it holds a steady
+        // acceleration to millimetres), else the change given from outside (an INS).
+        let given = signal_change_m.filter(|c| c.is_finite());
+        self.quadratic_change_m(elapsed_s)
+            .or(given)
+            .map(|change| change + clock_m)
+    }
+
+    /// The range change (m, carrier sign, without the clock terms) over `elapsed_s` of signal
+    /// after the last epoch, by the quadratic through the carrier history; `None` when the
+    /// history is short or no quadratic follows it.
+    fn quadratic_change_m(&self, elapsed_s: f64) -> Option<f64> {
+        if self.history.len() < 5 {
             return None;
         }
         let (t_last, l_last) = *self.history.back()?;
@@ -184,19 +206,26 @@ impl Hatch {
             return None;
         }
         let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
-        Some(
-            lambda * (q.at(elapsed_s) - q.at(0.0)) - SPEED_OF_LIGHT_MPS * lost_s
-                + SPEED_OF_LIGHT_MPS * dsteps_ms as f64 * 1e-3,
-        )
+        Some(lambda * (q.at(elapsed_s) - q.at(0.0)))
     }
 
     /// Continues the filter over a break in lock (the pseudorange being continuous) to epoch
-    /// `e`, `lost_s` of samples lost since the last epoch. Returns false (the caller restarts
-    /// the filter) when the break cannot be bridged or the bridged prediction misses the new
-    /// code.
-    pub fn bridge(&mut self, e: &HatchEpoch, lost_s: f64, max_m: u32) -> bool {
+    /// `e`, `lost_s` of samples lost since the last epoch. The range change over the break
+    /// (m, carrier sign, without the clock terms) is the extrapolated quadratic when it follows
+    /// the phase, else `signal_change_m` when given (from an INS,
+    /// [`crate::pipeline::aiding::InsFeedForward::carrier_change_cycles`]: it follows a
+    /// manoeuvre's jerk). Returns false (the caller restarts the
+    /// filter) when the break cannot be bridged or the bridged prediction misses the new code.
+    pub fn bridge(
+        &mut self,
+        e: &HatchEpoch,
+        lost_s: f64,
+        max_m: u32,
+        signal_change_m: Option<f64>,
+    ) -> bool {
         let elapsed = e.t_stream_s - self.t_stream_s + lost_s;
-        let Some(change) = self.bridge_change_m(elapsed, lost_s, e.steps_ms - self.steps_ms) else {
+        let dsteps = e.steps_ms - self.steps_ms;
+        let Some(change) = self.bridge_change_m(elapsed, lost_s, dsteps, signal_change_m) else {
             return false;
         };
         if (self.smoothed_m + change - e.pseudorange_m).abs() > MAX_INNOVATION_M {
@@ -282,7 +311,7 @@ mod tests {
             match h.as_mut() {
                 None => h = Some(Hatch::start(&e)),
                 Some(f) if (t_stream - t_gap).abs() < 1e-9 => {
-                    assert!(f.bridge(&e, lost, 100), "bridged");
+                    assert!(f.bridge(&e, lost, 100, None), "bridged");
                 }
                 Some(f) => f.update(&e, 100),
             }
@@ -313,8 +342,56 @@ mod tests {
         }
         // A carried time 1 ms wrong: 300 km off the prediction.
         let mut wrong = h.clone();
-        assert!(!wrong.bridge(&at(20, 0.0, 20e6 - 300_000.0, 2.0), 0.0, 100));
+        assert!(!wrong.bridge(&at(20, 0.0, 20e6 - 300_000.0, 2.0), 0.0, 100, None));
         // Too long a break.
-        assert!(!h.bridge(&at(60, 0.0, 20e6 - 1000.0, 6.0), 0.0, 100));
+        assert!(!h.bridge(&at(60, 0.0, 20e6 - 1000.0, 6.0), 0.0, 100, None));
+    }
+
+    #[test]
+    fn under_a_jerk_only_a_range_change_from_an_ins_bridges_the_break() {
+        // A 10 g turn seen along a line of sight: 98 m/s^2 of range acceleration changing at
+        // 40 m/s^3. No quadratic follows the phase over the history, so the quadratic bridge is
+        // refused; the range change over the break given from outside (an INS) bridges it.
+        let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+        let range = |t: f64| 21e6 - 300.0 * t + 0.5 * 98.0 * t * t + 40.0 * t * t * t / 6.0;
+        let (t_gap, lost) = (2.5, 0.031);
+        let noise = |k: i64| 3.0 * ((k as f64 * 12.9898).sin() * 43_758.545).fract();
+        let epoch = |k: i64| {
+            let t_stream = k as f64 * 0.1;
+            let t_true = t_stream + if t_stream >= t_gap { lost } else { 0.0 };
+            // The receiver clock falls behind by the lost time: the pseudorange by c g.
+            let clock_m = if t_stream >= t_gap {
+                -SPEED_OF_LIGHT_MPS * lost
+            } else {
+                0.0
+            };
+            let e = HatchEpoch {
+                epoch: k,
+                carrier_cycles: (range(t_true) + clock_m) / lambda,
+                pseudorange_m: range(t_true) + clock_m + noise(k),
+                steps_ms: 0,
+                t_stream_s: t_stream,
+            };
+            (e, range(t_true) + clock_m)
+        };
+        let mut h = Hatch::start(&epoch(0).0);
+        for k in 1..25 {
+            h.update(&epoch(k).0, 100);
+        }
+        let (e, truth) = epoch(25);
+        assert!(
+            !h.clone().bridge(&e, lost, 100, None),
+            "a quadratic bridged a jerk"
+        );
+        let signal_change = range(2.5 + lost) - range(2.4);
+        assert!(
+            h.bridge(&e, lost, 100, Some(signal_change)),
+            "the INS bridge was refused"
+        );
+        assert!(
+            (h.smoothed_m - truth).abs() < 1.0,
+            "{}",
+            h.smoothed_m - truth
+        );
     }
 }
