@@ -190,6 +190,60 @@ impl ObservableBuilder {
             .sum()
     }
 
+    /// The Hatch filter's epoch `he` of `e`'s satellite (carrier smoothing, 10 s) and its
+    /// carrier Doppler: a loss of lock (`lost_flag`) is bridged when it can be
+    /// ([`crate::pipeline::navigation::smoothing`]; with an INS over a manoeuvre), else the
+    /// filter restarts. Returns the smoothed pseudorange (m) and the Doppler (Hz).
+    fn smooth(
+        &mut self,
+        e: &ChannelEpoch,
+        he: &HatchEpoch,
+        lost_flag: bool,
+        aid: Option<&InsFeedForward>,
+    ) -> (f64, f64) {
+        let (n, t_stream, steps) = (he.epoch, he.t_stream_s, he.steps_ms);
+        let max_m = self.hatch_epochs;
+        let lost_s = self
+            .smoothing
+            .get(&e.prn)
+            .and_then(|h| self.lost_between(h.t_stream_s, t_stream));
+        // With an INS the range change over a break follows the motion (a manoeuvre's jerk
+        // defeats the quadratic); only when the INS has been told of every gap (its times are
+        // then signal times).
+        let total_lost: Option<f64> = self.gaps.iter().map(|g| g.1).sum();
+        match self.smoothing.get_mut(&e.prn) {
+            Some(h) if h.epoch == n - 1 && !lost_flag => {
+                // A clock step is not a Doppler; over the elapsed sample time (an epoch after a
+                // clock step is not 1/rate after the previous one).
+                let dl_signal = he.carrier_cycles
+                    - h.carrier_cycles
+                    - (steps - h.steps_ms) as f64 * 1e-3 * F_L1_HZ;
+                let rate = -dl_signal / (t_stream - h.t_stream_s);
+                h.update(he, max_m);
+                self.phase_rate.insert((n, e.prn), rate);
+                (h.smoothed_m, rate)
+            }
+            Some(h) => {
+                let by_ins = match (aid, lost_s, total_lost) {
+                    (Some(a), Some(g), Some(total)) => a
+                        .carrier_change_cycles(e.prn, t_stream, t_stream - h.t_stream_s + g)
+                        .filter(|&(_, told)| (told - total).abs() < 1e-4)
+                        .map(|(cycles, _)| -cycles * SPEED_OF_LIGHT_MPS / F_L1_HZ),
+                    _ => None,
+                };
+                let bridged = lost_s.is_some_and(|g| h.bridge(he, g, max_m, by_ins));
+                if !bridged {
+                    *h = Hatch::start(he);
+                }
+                (h.smoothed_m, e.doppler_hz)
+            }
+            None => {
+                self.smoothing.insert(e.prn, Hatch::start(he));
+                (he.pseudorange_m, e.doppler_hz)
+            }
+        }
+    }
+
     /// Takes one channel report (with the decoder of its satellite); returns the epochs that
     /// are complete (no channel can add to them any more).
     pub fn push(
@@ -251,54 +305,14 @@ impl ObservableBuilder {
             // Hatch filter (carrier smoothing, 10 s) and carrier Doppler; a loss of lock is
             // bridged when it can be ([`crate::pipeline::navigation::smoothing`]), else the filter restarts.
             let t_stream = t_epoch - t0.tow_s;
-            let steps = self.total_step_ms;
-            let max_m = self.hatch_epochs;
-            let lost_s = self
-                .smoothing
-                .get(&e.prn)
-                .and_then(|h| self.lost_between(h.t_stream_s, t_stream));
             let he = HatchEpoch {
                 epoch: n,
                 carrier_cycles,
                 pseudorange_m,
-                steps_ms: steps,
+                steps_ms: self.total_step_ms,
                 t_stream_s: t_stream,
             };
-            let (smoothed, doppler_hz) = match self.smoothing.get_mut(&e.prn) {
-                Some(h) if h.epoch == n - 1 && !lost_flag => {
-                    // A clock step is not a Doppler; over the elapsed sample time (an epoch
-                    // after a clock step is not 1/rate after the previous one).
-                    let dl_signal = carrier_cycles
-                        - h.carrier_cycles
-                        - (steps - h.steps_ms) as f64 * 1e-3 * F_L1_HZ;
-                    let rate = -dl_signal / (t_stream - h.t_stream_s);
-                    h.update(&he, max_m);
-                    self.phase_rate.insert((n, e.prn), rate);
-                    (h.smoothed_m, rate)
-                }
-                Some(h) => {
-                    // With an INS the range change over the break follows the motion (a
-                    // manoeuvre's jerk defeats the quadratic); only when the INS has been told
-                    // of every gap (its times are then signal times).
-                    let total_lost: Option<f64> = self.gaps.iter().map(|g| g.1).sum();
-                    let by_ins = match (aid, lost_s, total_lost) {
-                        (Some(a), Some(g), Some(total)) => a
-                            .carrier_change_cycles(e.prn, t_stream, t_stream - h.t_stream_s + g)
-                            .filter(|&(_, told)| (told - total).abs() < 1e-4)
-                            .map(|(cycles, _)| -cycles * SPEED_OF_LIGHT_MPS / F_L1_HZ),
-                        _ => None,
-                    };
-                    let bridged = lost_s.is_some_and(|g| h.bridge(&he, g, max_m, by_ins));
-                    if !bridged {
-                        *h = Hatch::start(&he);
-                    }
-                    (h.smoothed_m, e.doppler_hz)
-                }
-                None => {
-                    self.smoothing.insert(e.prn, Hatch::start(&he));
-                    (pseudorange_m, e.doppler_hz)
-                }
-            };
+            let (smoothed, doppler_hz) = self.smooth(e, &he, lost_flag, aid);
             self.pending.entry(n).or_default().push(SatObservable {
                 prn: e.prn,
                 sv_tow_s: sv_tow,
