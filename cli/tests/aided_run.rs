@@ -76,7 +76,7 @@ fn feedforward_doppler_matches_truth_for_a_perfect_ins() {
     write_ins_for(&sim, &InsErrorConfig::default(), &ins_path).unwrap_or_else(|e| panic!("{e}"));
     let ins = read_ins_csv(&ins_path, 0.5).unwrap_or_else(|e| panic!("{e}"));
     let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
-    let ff = InsFeedForward::new(ins, Some(nav), 2190, None).allow_unhealthy(true);
+    let ff = InsFeedForward::new(ins, Some(nav), Some(2190), None).allow_unhealthy(true);
     // The clock drift, as a fix's velocity solution would give it (m/s).
     let drift_mps = 4.0e-8 * 299_792_458.0;
     let (_, rx0) = sim.receiver_truth(0.5);
@@ -160,6 +160,47 @@ fn feedforward_doppler_matches_truth_for_a_perfect_ins() {
     );
 }
 
+/// An INS file with its own time of week and a recording whose GPS week is not known at the
+/// start (no SigMF date, no `--week`): no feed-forward until the navigation message gives the
+/// week, then the same feed-forward as with the week known from the start (the INS file's
+/// time of week kept, not the decoded one, which is off by the receiver clock bias). Before,
+/// the INS time was put in the system clock's week and the aid never came.
+#[test]
+fn an_ins_time_of_week_waits_for_the_decoded_week() {
+    let dir = tmp();
+    let sc = turn_scenario(4.0, 1.0, 2.0);
+    let sim = Simulator::new(&sc, Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+    let ins_path = dir.path().join("ins.csv");
+    write_ins_for(&sim, &InsErrorConfig::default(), &ins_path).unwrap_or_else(|e| panic!("{e}"));
+    let ins = read_ins_csv(&ins_path, 0.5).unwrap_or_else(|e| panic!("{e}"));
+    let nav = parse_rinex_nav(BUILTIN_NAV_TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let known =
+        InsFeedForward::new(ins.clone(), Some(nav.clone()), Some(2190), None).allow_unhealthy(true);
+    let waiting = InsFeedForward::new(ins, Some(nav), None, None).allow_unhealthy(true);
+    let prn = sim.satellites[0].prn.get();
+    assert!(waiting.aid(prn, 1.0).is_none(), "no week yet, no aid");
+    // The decoded origin: the same time of week 0.2 ms off (a receiver clock bias of 2e-4 s).
+    waiting.set_time_origin(gpsrx_nav::time::GpsTime::new(2190, 538194.0002));
+    let (_, rx) = sim.receiver_truth(0.5);
+    for ff in [&known, &waiting] {
+        ff.set_fix(0.5, rx.pos_m, Some(4.0e-8 * 299_792_458.0), None);
+    }
+    for sat in &sim.satellites {
+        let p = sat.prn.get();
+        let (a, b) = (known.aid(p, 2.0), waiting.aid(p, 2.0));
+        let (a, b) = (
+            a.unwrap_or_else(|| panic!("no aid for {p} with the week known")),
+            b.unwrap_or_else(|| panic!("no aid for {p} once the week is decoded")),
+        );
+        assert!(
+            (a.doppler_hz - b.doppler_hz).abs() < 1e-6,
+            "G{p:02}: {} vs {} Hz",
+            a.doppler_hz,
+            b.doppler_hz
+        );
+    }
+}
+
 /// Without the GPS time or the ephemeris there is no feed-forward (never a made-up one).
 #[test]
 fn no_feedforward_without_time_or_ephemeris() {
@@ -168,7 +209,7 @@ fn no_feedforward_without_time_or_ephemeris() {
     let p = dir.path().join("ins.csv");
     std::fs::write(&p, text).unwrap_or_else(|e| panic!("{e}"));
     let ins = read_ins_csv(&p, 0.5).unwrap_or_else(|e| panic!("{e}"));
-    let ff = InsFeedForward::new(ins, None, 2190, None);
+    let ff = InsFeedForward::new(ins, None, Some(2190), None);
     assert!(ff.aid(5, 0.05).is_none(), "no GPS time yet");
     ff.set_time_origin(gpsrx_nav::time::GpsTime::new(2190, 538194.0));
     assert!(ff.aid(5, 0.05).is_none(), "no ephemeris for G05");

@@ -597,15 +597,19 @@ impl Channel {
     /// Forgets the data-bit edges (after samples were lost, the bits no longer fall where they
     /// did): the bit synchroniser starts again on the coming prompts; the loops keep running.
     /// A channel integrating longer than 1 ms (aligned to the old edges, so now straddling
-    /// the new ones) goes back to its 1 ms loops at the frequency it held; a weak pull-in goes
+    /// the new ones) goes back to its 1 ms loops at the frequency and Doppler rate it held; a
+    /// weak pull-in goes
     /// back to its frequency stage, whose sums need no edges.
     pub fn restart_bit_sync(&mut self) {
         if self.weak_stage.is_none() && (self.carrier.t_coh_s() * 1e3).round() as usize != 1 {
             // Integrations aligned to the old bit edges straddle the new ones: back to the
             // 1 ms loops (at the frequency held), where the edges can be found again.
+            // With the Doppler rate held (a 10 g turn is 500 Hz/s: a loop restarted at rate 0
+            // falls behind by tens of hertz in its first tenth of a second and slips).
             let ff = self.ff_applied_hz.unwrap_or(0.0);
             let f = self.carrier.frequency_memory_hz() + ff;
-            if self.restart_carrier(f, 0.0).is_none() {
+            let rate = self.carrier.filter().rate_memory().unwrap_or(0.0);
+            if self.restart_carrier(f, rate).is_none() {
                 return;
             }
             self.acc = [Complex64::new(0.0, 0.0); 3];

@@ -324,7 +324,7 @@ impl Receiver {
             Some(ins) => Some(Self::feedforward(
                 ins,
                 &assistance.nav,
-                reference_week,
+                reference.known().then_some(reference_week),
                 run,
                 config
                     .tracking
@@ -368,7 +368,7 @@ impl Receiver {
     fn feedforward(
         ins: InsAiding,
         nav: &Option<NavData>,
-        reference_week: u32,
+        reference_week: Option<u32>,
         run: &crate::config::RunSettings,
         aided_order: u8,
     ) -> Result<InsFeedForward, ReceiverError> {

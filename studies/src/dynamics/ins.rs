@@ -38,7 +38,7 @@ pub(super) fn feedforward(
     };
     let samples = simulate_ins(&truth, duration_s + 0.5, &cfg)?;
     let track = InsTrack::from_samples(samples)?;
-    let ff = InsFeedForward::new(track, Some(nav.clone()), env.start.week, None);
+    let ff = InsFeedForward::new(track, Some(nav.clone()), Some(env.start.week), None);
     ff.set_time_origin(env.start);
     ff.set_fix(
         0.0,

@@ -73,7 +73,8 @@ impl Channel {
             }
             None if (self.carrier.t_coh_s() * 1e3).round() as usize != 1 => {
                 let f = self.carrier.frequency_memory_hz() + ff;
-                self.restart_carrier(f, 0.0)?;
+                let rate = self.carrier.filter().rate_memory().unwrap_or(0.0);
+                self.restart_carrier(f, rate)?;
             }
             None => {}
         }

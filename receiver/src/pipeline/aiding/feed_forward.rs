@@ -98,32 +98,38 @@ pub struct InsFeedForward {
     limiters: Mutex<BTreeMap<u8, (BandLimiter, f64)>>,
     logged: Mutex<BTreeSet<(u8, &'static str)>>,
     calibrate: bool,
+    /// The INS file's time of week at its stream time (s, s), waiting for the GPS week when it
+    /// was not known at the start: the first decoded time of week gives it.
+    ins_first_tow_s: Option<(f64, f64)>,
 }
 
 impl InsFeedForward {
     /// A feed-forward from an INS track, optional `--nav` ephemerides (used until a satellite's
-    /// own are decoded), the GPS week to place the INS file's `gps_tow_s` in, and an optional
-    /// band limiter corner (rad/s).
+    /// own are decoded), the GPS week to place the INS file's `gps_tow_s` in (`None`: not known
+    /// yet; the week of the first decoded time of week is taken, see
+    /// [`InsFeedForward::set_time_origin`]), and an optional band limiter corner (rad/s).
     pub fn new(
         ins: InsTrack,
         nav: Option<NavData>,
-        reference_week: u32,
+        reference_week: Option<u32>,
         band_limit_alpha_rad_s: Option<f64>,
     ) -> Self {
-        // A file with `t_s` and `gps_tow_s` tells the GPS time of the first IF sample; a file in
-        // the GPS time base (no `t_s`) needs the receiver's own time first.
-        let t0 = ins
+        // A file with `t_s` and `gps_tow_s` tells the GPS time of the first IF sample (once the
+        // week is known); a file in the GPS time base (no `t_s`) needs the receiver's own time.
+        let first_tow_s = ins
             .gps_time_base_tow_s()
             .is_none()
             .then(|| ins.gps_tow_at(ins.span_s().0))
             .flatten()
-            .map(|tow| GpsTime::new(reference_week, tow).add_seconds(-ins.span_s().0));
-        if let Some(t) = t0 {
+            .map(|tow| (tow, ins.span_s().0));
+        let t0 = first_tow_s.zip(reference_week).map(|((tow, at_s), week)| {
+            let t = GpsTime::new(week, tow).add_seconds(-at_s);
             tracing::info!(
                 "INS aiding: GPS time from the INS file (first sample at TOW {:.3} s)",
                 t.tow_s
             );
-        }
+            t
+        });
         let mut by_prn: BTreeMap<u8, Vec<Ephemeris>> = BTreeMap::new();
         for e in nav.into_iter().flat_map(|n| n.ephemerides) {
             by_prn.entry(e.prn).or_default().push(e);
@@ -137,6 +143,7 @@ impl InsFeedForward {
                 t0,
                 ..Knowledge::default()
             }),
+            ins_first_tow_s: first_tow_s.filter(|_| t0.is_none()),
             limiters: Mutex::new(BTreeMap::new()),
             logged: Mutex::new(BTreeSet::new()),
             calibrate: false,
@@ -163,7 +170,9 @@ impl InsFeedForward {
     }
 
     /// Sets the GPS time of the first sample (from the first decoded time of week), unless it is
-    /// already known.
+    /// already known. An INS file with its own time of week waiting for the week
+    /// ([`InsFeedForward::new`] without one) takes the week from `t0` (the one putting the
+    /// file's time of week nearest to it) and keeps its own time of week.
     pub fn set_time_origin(&self, t0: GpsTime) {
         if self.know.read().is_ok_and(|k| k.t0.is_some()) {
             return;
@@ -171,11 +180,25 @@ impl InsFeedForward {
         if let Ok(mut k) = self.know.write() {
             if k.t0.is_none() {
                 // `t0` maps stream time to GPS time; the aid works in elapsed time.
-                let t0 = t0.add_seconds(-k.lost_s);
-                tracing::info!(
-                    "INS aiding: GPS time known (TOW {:.3} s at the first sample)",
-                    t0.tow_s
-                );
+                let decoded = t0.add_seconds(-k.lost_s);
+                let t0 = match self.ins_first_tow_s {
+                    Some((tow, at_s)) => {
+                        let t = nearest_week(decoded, tow).add_seconds(-at_s);
+                        tracing::info!(
+                            "INS aiding: GPS time from the INS file (first sample at TOW {:.3} s), \
+                             the week from the navigation message",
+                            t.tow_s
+                        );
+                        t
+                    }
+                    None => {
+                        tracing::info!(
+                            "INS aiding: GPS time known (TOW {:.3} s at the first sample)",
+                            decoded.tow_s
+                        );
+                        decoded
+                    }
+                };
                 k.t0 = Some(t0);
             }
         }
@@ -481,5 +504,39 @@ impl Knowledge {
 impl gpsrx_tracking::AidingPort for InsFeedForward {
     fn doppler_aid(&self, prn: gpsrx_dsp::Prn, t_s: f64) -> Option<DopplerAid> {
         self.aid(prn.get(), t_s)
+    }
+}
+
+/// The GPS time at time of week `tow_s` in the week that puts it nearest to `near`.
+fn nearest_week(near: GpsTime, tow_s: f64) -> GpsTime {
+    let same = GpsTime::new(near.week, tow_s);
+    let half_week_s = 302_400.0;
+    match same.diff_s(near) {
+        d if d > half_week_s && near.week > 0 => GpsTime::new(near.week - 1, tow_s),
+        d if d < -half_week_s => GpsTime::new(near.week + 1, tow_s),
+        _ => same,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_time_of_week_takes_the_week_nearest_to_the_decoded_time() {
+        let near = GpsTime::new(2191, 5.0);
+        assert_eq!(
+            nearest_week(near, 604_795.0).week,
+            2190,
+            "just before the rollover"
+        );
+        assert_eq!(nearest_week(near, 20.0).week, 2191);
+        let late = GpsTime::new(2190, 604_790.0);
+        assert_eq!(
+            nearest_week(late, 3.0).week,
+            2191,
+            "just after the rollover"
+        );
+        assert_eq!(nearest_week(late, 604_789.0).week, 2190);
     }
 }

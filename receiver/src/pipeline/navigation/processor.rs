@@ -46,6 +46,8 @@ pub struct NavigationProcessor {
     almanac: AlmanacCollector,
     builder: ObservableBuilder,
     prior: Option<PvtSolution>,
+    /// The last valid fix for the acquisition scheduler's predictions (kept across gaps).
+    anchor: Option<predict::PredictionAnchor>,
     iono_fallback_said: bool,
     /// The RAIM outcome last logged (transitions are logged).
     last_raim: Option<RaimStatus>,
@@ -141,6 +143,7 @@ impl NavigationProcessor {
             almanac: AlmanacCollector::new(reference_week),
             builder,
             prior: None,
+            anchor: None,
             iono_fallback_said: false,
             last_raim: None,
             poor_geometry_logged: false,

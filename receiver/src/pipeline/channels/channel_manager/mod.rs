@@ -523,6 +523,17 @@ impl ChannelManager {
         }
         let end = outcome.first + outcome.batch.as_ref().map_or(0, |b| b.len as u64);
         if let (Some(s), Some(b)) = (self.schedule.as_mut(), outcome.batch.as_ref()) {
+            for (t, r) in b.targets.iter().zip(&outcome.results) {
+                tracing::trace!(
+                    "search at sample {end}, level {}: {} in {:?} Hz: detected {} (metric {:.2}, threshold {:.2})",
+                    b.level,
+                    t.prn,
+                    t.doppler_window_hz,
+                    r.detected,
+                    r.metric,
+                    r.threshold
+                );
+            }
             s.record(b, &outcome.results, end, visibility);
         }
         let mut started = Vec::new();

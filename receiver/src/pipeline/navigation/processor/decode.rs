@@ -276,6 +276,8 @@ impl NavigationProcessor {
         }
         self.builder.restart();
         self.prior = None;
+        // The coarse time was wrong, and so were the fixes from it.
+        self.anchor = None;
         sink.event(&ReceiverEvent::CoarseTimeDropped { t_s })
     }
 }

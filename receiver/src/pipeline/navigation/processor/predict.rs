@@ -6,14 +6,16 @@ use super::{
     PREDICTED_DOPPLER_RATE_HZ_S,
 };
 use crate::pipeline::channels::search_schedule::Visibility;
-use gpsrx_nav::constants::SPEED_OF_LIGHT_MPS;
+use gpsrx_core::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::ephemeris::HealthPolicy;
+use gpsrx_nav::pvt::PvtSolution;
+use gpsrx_nav::Vector3;
 
 impl NavigationProcessor {
     /// What is predicted of `prn` at stream time `t_stream_s` for the acquisition scheduler:
-    /// with a fix (position, velocity, clock bias and drift) and the satellite's ephemeris
-    /// (decoded or from `--nav`), whether it is above the horizon and its Doppler within
-    /// [`PREDICTED_DOPPLER_HZ`] plus [`PREDICTED_DOPPLER_RATE_HZ_S`] per second since the fix
+    /// with a valid fix (position, velocity, acceleration, clock drift; kept across gaps) and
+    /// the satellite's ephemeris (decoded or from `--nav`), whether it is above the horizon and
+    /// its Doppler within the uncertainty of [`PredictionAnchor::at`]
     /// (`crate::pipeline::channels::visibility`); else nothing.
     pub fn visibility(&self, prn: u8, t_stream_s: f64) -> Visibility {
         let Some((rx, t, drift, half_width_hz)) = self.prediction_origin(t_stream_s) else {
@@ -50,25 +52,15 @@ impl NavigationProcessor {
     }
 
     /// Where, when and with which clock drift (s/s) the receiver is at stream time
-    /// `t_stream_s`, and the Doppler uncertainty of a prediction from that: the last fix
-    /// (position, velocity, clock bias and drift; [`PREDICTED_DOPPLER_HZ`] growing by
-    /// [`PREDICTED_DOPPLER_RATE_HZ_S`] with its age), else `--approx-llh` and `--time` (the
-    /// receiver clock drift unknown: [`APPROX_DOPPLER_HZ`]).
+    /// `t_stream_s`, and the Doppler uncertainty of a prediction from that: the last valid fix
+    /// ([`PredictionAnchor::at`]), else `--approx-llh` and `--time` (the receiver clock drift
+    /// unknown: [`APPROX_DOPPLER_HZ`]).
     pub(super) fn prediction_origin(
         &self,
         t_stream_s: f64,
     ) -> Option<(gpsrx_core::PosVel, gpsrx_nav::time::GpsTime, f64, f64)> {
-        if let (Some(fix), Some(t0)) = (self.prior.as_ref(), self.builder.rx_time_origin()) {
-            // GPS time: receiver time less the clock bias of the fix.
-            let t = t0.add_seconds(t_stream_s - fix.clock_bias_m / SPEED_OF_LIGHT_MPS);
-            let rx = gpsrx_core::PosVel {
-                pos_m: fix.pos_ecef_m,
-                vel_mps: fix.vel_ecef_mps.unwrap_or_default(),
-            };
-            let drift = fix.clock_drift_mps.unwrap_or(0.0) / SPEED_OF_LIGHT_MPS;
-            let age_s = (t.tow_s - fix.time.tow_s).abs();
-            let width = PREDICTED_DOPPLER_HZ + PREDICTED_DOPPLER_RATE_HZ_S * age_s;
-            return Some((rx, t, drift, width));
+        if let Some(anchor) = &self.anchor {
+            return Some(anchor.at(t_stream_s));
         }
         let ([lat, lon, h], t0) = (self.settings.approx_llh?, self.settings.approx_time?);
         let rx = gpsrx_core::PosVel {
@@ -76,5 +68,136 @@ impl NavigationProcessor {
             vel_mps: gpsrx_nav::Vector3::zeros(),
         };
         Some((rx, t0.add_seconds(t_stream_s), 0.0, APPROX_DOPPLER_HZ))
+    }
+}
+
+/// The last valid fix, kept for the acquisition scheduler's predictions across gaps and
+/// outages (a Doppler prediction needs the time to a second, not to the millisecond the
+/// receiver time is re-established to), with the receiver's acceleration from the two last
+/// fixes' velocities.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct PredictionAnchor {
+    /// GPS time of the fix.
+    time: gpsrx_nav::time::GpsTime,
+    /// Its stream time, s.
+    t_stream_s: f64,
+    /// ECEF position, m, and velocity, m/s (zero when the fix had none).
+    pos_m: Vector3<f64>,
+    vel_mps: Option<Vector3<f64>>,
+    /// Receiver clock drift, s/s.
+    drift_s_s: f64,
+    /// ECEF acceleration, m/s^2 (zero until two fixes with velocities within
+    /// [`ACCEL_FROM_FIXES_WITHIN_S`]).
+    accel_mps2: Vector3<f64>,
+}
+
+/// Two fixes further apart than this give no acceleration, s.
+const ACCEL_FROM_FIXES_WITHIN_S: f64 = 2.0;
+
+impl PredictionAnchor {
+    /// The anchor after the valid fix `sol` at stream time `t_stream_s`, following `prev`.
+    pub(super) fn new(sol: &PvtSolution, t_stream_s: f64, prev: Option<&Self>) -> Self {
+        let drift_s_s = sol.clock_drift_mps.unwrap_or(0.0) / SPEED_OF_LIGHT_MPS;
+        Self::from_fix(
+            sol.time,
+            t_stream_s,
+            sol.pos_ecef_m,
+            sol.vel_ecef_mps,
+            drift_s_s,
+        )
+        .after(prev)
+    }
+
+    fn from_fix(
+        time: gpsrx_nav::time::GpsTime,
+        t_stream_s: f64,
+        pos_m: Vector3<f64>,
+        vel_mps: Option<Vector3<f64>>,
+        drift_s_s: f64,
+    ) -> Self {
+        Self {
+            time,
+            t_stream_s,
+            pos_m,
+            vel_mps,
+            drift_s_s,
+            accel_mps2: Vector3::zeros(),
+        }
+    }
+
+    /// With the acceleration from the previous anchor's velocity.
+    fn after(mut self, prev: Option<&Self>) -> Self {
+        self.accel_mps2 = prev
+            .and_then(|p| {
+                let dt = self.t_stream_s - p.t_stream_s;
+                let (v1, v0) = (self.vel_mps?, p.vel_mps?);
+                (dt > 0.0 && dt <= ACCEL_FROM_FIXES_WITHIN_S).then(|| (v1 - v0) / dt)
+            })
+            .filter(|a| a.iter().all(|x| x.is_finite()))
+            .unwrap_or_else(Vector3::zeros);
+        self
+    }
+
+    /// The receiver `age` s after the fix (position and velocity carried with the fix's
+    /// acceleration: `p + v age + a age^2 / 2`, `v + a age`), the GPS time, the clock drift
+    /// (s/s), and the Doppler uncertainty: [`PREDICTED_DOPPLER_HZ`] plus, per second of age,
+    /// [`PREDICTED_DOPPLER_RATE_HZ_S`] and the Doppler rate of the acceleration, `|a| /
+    /// lambda_L1` (the acceleration may stop or double: a 10 g turn is 515 Hz/s).
+    pub(super) fn at(
+        &self,
+        t_stream_s: f64,
+    ) -> (gpsrx_core::PosVel, gpsrx_nav::time::GpsTime, f64, f64) {
+        let age_s = t_stream_s - self.t_stream_s;
+        let v = self.vel_mps.unwrap_or_default();
+        let a = self.accel_mps2;
+        let rx = gpsrx_core::PosVel {
+            pos_m: self.pos_m + v * age_s + a * (0.5 * age_s * age_s),
+            vel_mps: v + a * age_s,
+        };
+        let accel_rate_hz_s = a.norm() / (SPEED_OF_LIGHT_MPS / F_L1_HZ);
+        let width =
+            PREDICTED_DOPPLER_HZ + (PREDICTED_DOPPLER_RATE_HZ_S + accel_rate_hz_s) * age_s.abs();
+        (rx, self.time.add_seconds(age_s), self.drift_s_s, width)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gpsrx_nav::time::GpsTime;
+
+    /// Two fixes 0.1 s apart in a 10 g turn (the velocity turned by 9.8 m/s): 1 s after the
+    /// second the receiver is where constant acceleration takes it, and the Doppler window
+    /// has grown by the acceleration's 515 Hz/s besides the base rate.
+    #[test]
+    fn a_prediction_carries_the_fixes_acceleration_and_widens_with_it() {
+        let t = GpsTime::new(2190, 538_240.0);
+        let p0 = Vector3::new(-3.0e6, 4.0e6, 3.9e6);
+        let v0 = Vector3::new(250.0, 0.0, 0.0);
+        let a = Vector3::new(0.0, 98.0665, 0.0);
+        let first = PredictionAnchor::from_fix(t, 40.0, p0, Some(v0), 1e-8);
+        let second = PredictionAnchor::from_fix(
+            t.add_seconds(0.1),
+            40.1,
+            p0 + v0 * 0.1 + a * 0.005,
+            Some(v0 + a * 0.1),
+            1e-8,
+        )
+        .after(Some(&first));
+        let (rx, time, drift, width) = second.at(41.1);
+        let want_v = v0 + a * 1.1;
+        let want_p = p0 + v0 * 1.1 + a * (0.5 * 1.1 * 1.1);
+        assert!((rx.vel_mps - want_v).norm() < 1e-6, "{}", rx.vel_mps);
+        assert!((rx.pos_m - want_p).norm() < 1e-6, "{}", rx.pos_m);
+        assert!((time.diff_s(t) - 1.1).abs() < 1e-9);
+        assert_eq!(drift, 1e-8);
+        let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+        let want_w = PREDICTED_DOPPLER_HZ + PREDICTED_DOPPLER_RATE_HZ_S + 98.0665 / lambda;
+        assert!((width - want_w).abs() < 1e-6, "{width} vs {want_w}");
+        // Fixes too far apart tell no acceleration: the window grows at the base rate only.
+        let late = PredictionAnchor::from_fix(t.add_seconds(5.0), 45.0, p0, Some(v0), 0.0)
+            .after(Some(&second));
+        let (_, _, _, w) = late.at(46.0);
+        assert!((w - PREDICTED_DOPPLER_HZ - PREDICTED_DOPPLER_RATE_HZ_S).abs() < 1e-9);
     }
 }

@@ -2,6 +2,7 @@
 //! (`gpsrx_nav::pvt::solve`), its integrity verdict, the fix and observables to the sink, and
 //! the receiver clock kept within 0.5 ms of GPS time by whole-millisecond steps.
 
+use super::predict::PredictionAnchor;
 use super::{NavigationProcessor, FAILURES_TO_DISTRUST_TIME};
 use crate::config::{IonoModel, TropoModel};
 use crate::pipeline::aiding::InsFeedForward;
@@ -287,6 +288,10 @@ impl NavigationProcessor {
             solution: sol.clone(),
             t_stream_s,
         })?;
+        if passes_integrity(&sol) {
+            let anchor = PredictionAnchor::new(&sol, t_stream_s, self.anchor.as_ref());
+            self.anchor = Some(anchor);
+        }
         self.prior = Some(sol);
         Ok(())
     }
