@@ -113,8 +113,9 @@ impl GapRecovery {
             self.length_ms =
                 choose(offset, &self.steps, by_code).map(|l| refine_length_ms(l, &agreeing));
             tracing::debug!(
-                "gap length: {offset:.3} ms modulo 20 ms from {} bit edges; by the code {by_code:?}; with the carrier-phase steps: {:?}",
+                "{now_s:.2} s: gap length: {offset:.3} ms modulo 20 ms from {} bit edges; by the code {by_code:?} (from {:?} s); with the carrier-phase steps: {:?}",
                 agreeing.len(),
+                self.code_from_s,
                 self.length_ms
             );
         }
