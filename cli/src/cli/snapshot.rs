@@ -6,7 +6,9 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, clap::Args)]
 pub struct SnapshotArgs {
     /// The snapshots: a SnapperGPS JSON file (`.json`: many snapshots with their timestamps),
-    /// or a raw/WAV/SigMF recording holding one snapshot (needs --time unless SigMF).
+    /// a SigMF recording with one capture per snapshot (each capture's `core:datetime` its
+    /// approximate time), or a raw/WAV/SigMF recording holding one snapshot (needs --time
+    /// unless SigMF gives `core:datetime`).
     pub input: PathBuf,
     /// RINEX navigation file (broadcast ephemerides of the day; RINEX 2 or 3). Needed: without
     /// it the command says so.

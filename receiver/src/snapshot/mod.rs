@@ -11,7 +11,9 @@
 //! - [`smooth`]: optional smoothing of the track across consecutive snapshots;
 //! - [`driver`]: a sequence of snapshots, each good fix seeding the next;
 //! - [`clock`]: the device clock's error from the sequence's fixes (a second pass);
-//! - [`output`]: `snapshots.csv`, the GeoJSON track, errors against a truth.
+//! - [`output`]: `snapshots.csv`, the GeoJSON track, errors against a truth;
+//! - [`set`]: a whole set as one job (input, navigation data, options, outputs), as
+//!   `gpsrx snapshot`, `gpsrx batch` and the Python package run it.
 //!
 //! # A-priori limits
 //!
@@ -26,12 +28,14 @@ pub mod fine_phase;
 pub mod input;
 pub mod measure;
 pub mod output;
+pub mod set;
 pub mod smooth;
 pub mod snappergps;
 pub mod solve;
 
 pub use driver::{SnapshotOptions, SnapshotOutcome, SnapshotProcessor};
-pub use input::{read_raw_snapshot, SampleSpec, Snapshot};
+pub use input::{read_raw_snapshot, read_sigmf_set, SampleSpec, Snapshot};
+pub use set::{run_set, write_set, SetResult, SnapshotSetSpec};
 pub use solve::SnapshotQuality;
 
 use std::path::PathBuf;
@@ -42,6 +46,14 @@ pub enum SnapshotError {
     /// The input cannot be read.
     #[error("cannot read {path}: {reason}")]
     Input {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+    /// The navigation file cannot be read.
+    #[error("cannot read the navigation file {path}: {reason}")]
+    Nav {
         /// The file.
         path: PathBuf,
         /// What went wrong.
@@ -59,4 +71,7 @@ pub enum SnapshotError {
     /// An output file cannot be written.
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
+    /// The error plot cannot be drawn.
+    #[error(transparent)]
+    Plot(#[from] crate::output::plots::PlotError),
 }
