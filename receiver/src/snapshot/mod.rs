@@ -7,6 +7,7 @@
 //! - [`measure`]: assisted acquisition of one snapshot (sub-sample code phase, common
 //!   front-end offset, narrow second search, false-peak rejection);
 //! - [`fine_phase`]: the sub-sample code phase from a band-limited matched replica;
+//! - [`crlb`]: the Cramer-Rao bound of that code phase (what any estimator can reach);
 //! - [`solve`]: the coarse-time fix ([`gpsrx_nav::pvt::coarse_time`]) and its checks;
 //! - [`smooth`]: optional smoothing of the track across consecutive snapshots;
 //! - [`driver`]: a sequence of snapshots, each good fix seeding the next;
@@ -23,6 +24,7 @@
 //! (a row with quality `none`), not a wrong fix.
 
 pub mod clock;
+pub mod crlb;
 pub mod driver;
 pub mod fine_phase;
 pub mod input;
