@@ -102,7 +102,8 @@ def snapshot(
     ``h_error_m``, ...) and ``summary`` (dict: ``fixes``, ``h_error_median_m``, ...).
 
     Options: ``time="WEEK:TOW"``, ``format``, ``map``, ``fs_hz``, ``if_hz``,
-    ``height_sigma_m`` (30), ``max_speed_mps`` (50), ``coherent_ms``, ``smooth_accel_mps2``,
+    ``height_sigma_m`` (30), ``max_speed_mps`` (50), ``coherent_ms``, ``coherent_look``
+    (False), ``smooth_accel_mps2``,
     ``truth`` (SnapperGPS truth JSON), ``truth_h_m``, ``truth_ecef_m``."""
 
 def process_snapshots(spec: Dict[str, Any], out_root: PathLike) -> Dict[str, Any]:

@@ -26,7 +26,7 @@ fn spec_from(d: &Bound<'_, PyAny>) -> PyResult<SnapshotSetSpec> {
 /// recording with one capture per snapshot, or a raw recording of one snapshot (`format`,
 /// `fs_hz`, `if_hz`, `time="WEEK:TOW"`); `nav` a RINEX navigation file; `approx_llh`
 /// `[lat_deg, lon_deg, h_m]`. Other keywords: `time`, `format`, `map`, `fs_hz`, `if_hz`,
-/// `height_sigma_m`, `max_speed_mps`, `coherent_ms`, `smooth_accel_mps2`, `truth`,
+/// `height_sigma_m`, `max_speed_mps`, `coherent_ms`, `coherent_look`, `smooth_accel_mps2`, `truth`,
 /// `truth_h_m`, `truth_ecef_m`. Returns `{"snapshots": columns (one row per input snapshot),
 /// "summary": dict}`; with `out`, `snapshots.csv` and the tracks are written there too.
 #[pyfunction]

@@ -59,6 +59,7 @@ fn spec(args: &SnapshotArgs) -> anyhow::Result<SnapshotSetSpec> {
     spec.height_sigma_m = args.height_sigma;
     spec.max_speed_mps = args.max_speed;
     spec.coherent_ms = args.coherent_ms;
+    spec.coherent_look = args.coherent_look;
     spec.smooth_accel_mps2 = args.smooth_accel;
     spec.truth.clone_from(&args.truth);
     spec.truth_h_m = args.truth_h;

@@ -6,6 +6,8 @@
 //!   (many snapshots, device timestamps) and their truth files;
 //! - [`measure`]: assisted acquisition of one snapshot (sub-sample code phase, common
 //!   front-end offset, narrow second search, false-peak rejection);
+//! - [`coherent`]: detection at a predicted code phase, coherent over the snapshot with the
+//!   data-bit edge hypothesised;
 //! - [`fine_phase`]: the sub-sample code phase from a band-limited matched replica;
 //! - [`crlb`]: the Cramer-Rao bound of that code phase (what any estimator can reach);
 //! - [`solve`]: the coarse-time fix ([`gpsrx_nav::pvt::coarse_time`]) and its checks;
@@ -24,6 +26,7 @@
 //! (a row with quality `none`), not a wrong fix.
 
 pub mod clock;
+pub mod coherent;
 pub mod crlb;
 pub mod driver;
 pub mod fine_phase;

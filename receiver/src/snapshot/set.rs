@@ -79,6 +79,10 @@ pub struct SnapshotSetSpec {
     /// Coherent integration of the search, ms (default: automatic).
     #[serde(default)]
     pub coherent_ms: Option<u32>,
+    /// Look for the satellites the searches missed with the coherent test too
+    /// ([`super::coherent`]).
+    #[serde(default)]
+    pub coherent_look: bool,
     /// Acceleration sigma of the track smoother, m/s^2 (`None`: each snapshot alone).
     #[serde(default)]
     pub smooth_accel_mps2: Option<f64>,
@@ -111,6 +115,7 @@ impl SnapshotSetSpec {
             height_sigma_m: DEFAULT_HEIGHT_SIGMA_M,
             max_speed_mps: DEFAULT_MAX_SPEED_MPS,
             coherent_ms: None,
+            coherent_look: false,
             smooth_accel_mps2: None,
             truth: None,
             truth_h_m: 0.0,
@@ -156,6 +161,7 @@ impl SnapshotSetSpec {
         let mut opts = SnapshotOptions::default();
         opts.measure.coherent_ms = self.coherent_ms;
         opts.measure.max_speed_mps = self.max_speed_mps;
+        opts.measure.coherent_predicted = self.coherent_look;
         opts.solve.height = (self.height_sigma_m > 0.0).then_some(HeightConstraint {
             h_m: apriori.h_m,
             sigma_m: self.height_sigma_m,
