@@ -125,3 +125,61 @@ fn run_json_prints_the_summary_for_scripts() {
         "{v}"
     );
 }
+
+/// A `[[snapshots]]` set in a TOML manifest: one simulated 12 ms snapshot (1-bit real at
+/// 4.092 MHz, dated by its SigMF `core:datetime`) positioned against the simulator's antenna,
+/// and a missing set reported without stopping the batch.
+#[test]
+fn a_snapshot_set_in_a_manifest_is_positioned_and_a_missing_one_is_a_row() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let toml = "duration_s = 0.012\nseed = 21\nnav = \"builtin:brdc0010.22n\"\n\
+                [start]\nweek = 2190\ntow_s = 538194.0\n\
+                [output]\nformat = \"ri1_lsb\"\nfs_hz = 4.092e6\nif_hz = 1.3e6\n\
+                [receiver]\nkind = \"static\"\nllh_deg = [36.3721, 127.3604, 80.0]\n\
+                [satellites]\ncn0_all_dbhz = 45.0\n";
+    let scenario = Scenario::from_toml(toml).expect("scenario");
+    Simulator::new(&scenario, Path::new("."))
+        .and_then(|s| s.run(&dir.path().join("snap"), &|_| {}))
+        .expect("simulation");
+    let manifest = dir.path().join("m.toml");
+    // The a-priori 30 km north-east of the antenna.
+    std::fs::write(
+        &manifest,
+        "[[snapshots]]\nname = \"sim\"\npath = \"snap/signal.ri1_lsb\"\n\
+         nav = \"builtin:brdc0010.22n\"\napprox_llh = [36.5621, 127.6004, 80.0]\n\
+         [[snapshots]]\npath = \"nowhere.json\"\nnav = \"builtin:brdc0010.22n\"\n\
+         approx_llh = [36.5621, 127.6004, 80.0]\n",
+    )
+    .expect("write");
+    let out = dir.path().join("out");
+    let o = batch(&manifest, &out);
+    let (stdout, stderr) = (text(&o.stdout), text(&o.stderr));
+    assert_eq!(o.status.code(), Some(0), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("2 snapshot sets: 1 with fixes, 0 without a fix, 1 failed"),
+        "{stdout}"
+    );
+    let mut reader = csv::Reader::from_path(out.join("summary.csv")).expect("summary.csv");
+    let header = reader.headers().expect("header").clone();
+    let col = |name: &str| header.iter().position(|h| h == name).expect(name);
+    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.expect("row")).collect();
+    assert_eq!(rows.len(), 2);
+    let (sim, missing) = (&rows[0], &rows[1]);
+    assert_eq!(&sim[col("kind")], "snapshots");
+    assert_eq!(&sim[col("status")], "ok", "{sim:?}");
+    assert_eq!(&sim[col("fixes")], "1");
+    // Within 0.0005 deg (about 55 m north, 45 m east) of the simulated antenna.
+    let lat: f64 = sim[col("mean_lat_deg")].parse().expect("lat");
+    let lon: f64 = sim[col("mean_lon_deg")].parse().expect("lon");
+    assert!(
+        (lat - 36.3721).abs() < 5e-4 && (lon - 127.3604).abs() < 5e-4,
+        "{lat} {lon}"
+    );
+    assert_eq!(&missing[col("name")], "nowhere");
+    assert_eq!(&missing[col("status")], "error");
+    assert!(
+        missing[col("message")].contains("nowhere.json"),
+        "{missing:?}"
+    );
+    assert!(out.join("sim").join("snapshots.csv").is_file());
+}

@@ -4,8 +4,10 @@
 - :func:`run` -- a whole recording, as ``gpsrx run`` does, into pandas-ready columns;
 - :func:`acquire` -- the FFT acquisition search on a block of samples;
 - :func:`simulate` -- the simulator, as ``gpsrx simulate`` does (recording and truth files);
+- :func:`snapshot` -- a snapshot set positioned as ``gpsrx snapshot`` does (one row per
+  snapshot), :func:`process_snapshots` -- the same as a batch task;
 - :func:`study_cases`, :func:`run_study_case` -- a study grid case by case;
-- :mod:`gpsrx.batch` -- many recordings and study grids on a Dask cluster.
+- :mod:`gpsrx.batch` -- many recordings, snapshot sets and study grids on a Dask cluster.
 
 Every table is a dict of equal-length columns: ``pandas.DataFrame(result["fixes"])``.
 Errors are Python exceptions with the messages of the ``gpsrx`` command: ``FileNotFoundError``
@@ -18,10 +20,12 @@ from ._gpsrx import (
     __version__,
     acquire,
     process_recording,
+    process_snapshots,
     read_manifest,
     run,
     run_study_case,
     simulate,
+    snapshot,
     study_cases,
 )
 from . import batch  # noqa: E402 (after the extension it uses)
@@ -33,10 +37,12 @@ __all__ = [
     "__version__",
     "acquire",
     "process_recording",
+    "process_snapshots",
     "read_manifest",
     "run",
     "run_study_case",
     "simulate",
+    "snapshot",
     "study_cases",
     "read_truth",
     "fix_errors_m",

@@ -10,10 +10,12 @@ from ._gpsrx import (
     __version__ as __version__,
     acquire as acquire,
     process_recording as process_recording,
+    process_snapshots as process_snapshots,
     read_manifest as read_manifest,
     run as run,
     run_study_case as run_study_case,
     simulate as simulate,
+    snapshot as snapshot,
     study_cases as study_cases,
 )
 

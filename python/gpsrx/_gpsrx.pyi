@@ -77,7 +77,8 @@ def simulate(
     (``data_path``, ``meta_path``, ``truth_path``, ``satellites``, ``fs_hz``, ...)."""
 
 def read_manifest(path: PathLike) -> Dict[str, List[Dict[str, Any]]]:
-    """A batch manifest (TOML or CSV): ``{"recordings": [spec], "studies": [study]}``."""
+    """A batch manifest (TOML or CSV): ``{"recordings": [spec], "snapshots": [set spec],
+    "studies": [study]}``."""
 
 def process_recording(spec: Dict[str, Any], out_root: PathLike) -> Dict[str, Any]:
     """One recording into ``out_root/NAME/``: its summary row (``status`` ok, no_fix or error)."""
@@ -87,3 +88,23 @@ def study_cases(study: str = "steady-state", quick: bool = True) -> List[Dict[st
 
 def run_study_case(index: int, study: str = "steady-state", quick: bool = True) -> Dict[str, Any]:
     """One case of a study grid: its parameters and results."""
+
+def snapshot(
+    path: PathLike,
+    nav: Optional[PathLike],
+    approx_llh: Sequence[float],
+    out: Optional[PathLike] = None,
+    **options: Any,
+) -> Dict[str, Any]:
+    """A snapshot set (SnapperGPS JSON, SigMF with one capture per snapshot, or one raw
+    snapshot) positioned as ``gpsrx snapshot`` does: ``snapshots`` (Columns, one row per input
+    snapshot: ``index``, ``quality``, ``reason``, ``lat_deg``, ``x_m``, ``time_correction_s``,
+    ``h_error_m``, ...) and ``summary`` (dict: ``fixes``, ``h_error_median_m``, ...).
+
+    Options: ``time="WEEK:TOW"``, ``format``, ``map``, ``fs_hz``, ``if_hz``,
+    ``height_sigma_m`` (30), ``max_speed_mps`` (50), ``coherent_ms``, ``coherent_look``
+    (False), ``smooth_accel_mps2``,
+    ``truth`` (SnapperGPS truth JSON), ``truth_h_m``, ``truth_ecef_m``."""
+
+def process_snapshots(spec: Dict[str, Any], out_root: PathLike) -> Dict[str, Any]:
+    """One snapshot set into ``out_root/NAME/``: its summary row (``status`` ok, no_fix or error)."""

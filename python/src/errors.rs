@@ -4,6 +4,7 @@
 
 use gpsrx_receiver::batch::RecordingError;
 use gpsrx_receiver::error_message;
+use gpsrx_receiver::snapshot::SnapshotError;
 use gpsrx_receiver::ReceiverError;
 use gpsrx_samples::SampleError;
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
@@ -50,5 +51,23 @@ pub fn recording_error(e: &RecordingError) -> PyErr {
         RecordingError::Receiver(r) => receiver_error(r),
         RecordingError::Assistance(_) | RecordingError::Output(_) => PyOSError::new_err(message),
         RecordingError::BuiltinNav(_) => Error::new_err(message),
+    }
+}
+
+/// The Python exception of a snapshot set that cannot be run: a missing input, navigation or
+/// truth file is `FileNotFoundError`, another unreadable one `OSError`, a bad option or missing
+/// navigation data `ValueError`.
+pub fn snapshot_error(e: &SnapshotError) -> PyErr {
+    let message = error_message(e);
+    match e {
+        SnapshotError::Input { path, .. } | SnapshotError::Nav { path, .. } => {
+            if path.exists() {
+                PyOSError::new_err(message)
+            } else {
+                PyFileNotFoundError::new_err(message)
+            }
+        }
+        SnapshotError::NoEphemerides | SnapshotError::Option(_) => PyValueError::new_err(message),
+        SnapshotError::Output(_) | SnapshotError::Plot(_) => PyOSError::new_err(message),
     }
 }

@@ -1,6 +1,6 @@
 //! The Python package `gpsrx` (module `gpsrx._gpsrx`, built by maturin from `pyproject.toml`):
 //! the receiver fed with numpy arrays ([`receiver`]), whole runs, acquisition, the simulator,
-//! batch tasks and study grids ([`functions`]), with library errors as Python exceptions
+//! batch tasks and study grids ([`functions`]), snapshot sets ([`snapshot`]), with library errors as Python exceptions
 //! ([`errors`]) and products as pandas-ready columns ([`records`]). The GIL is released while
 //! the receiver works.
 //!
@@ -12,6 +12,7 @@ pub mod errors;
 pub mod functions;
 pub mod receiver;
 pub mod records;
+pub mod snapshot;
 
 use pyo3::prelude::*;
 
@@ -28,5 +29,7 @@ fn _gpsrx(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(functions::process_recording, m)?)?;
     m.add_function(wrap_pyfunction!(functions::study_cases, m)?)?;
     m.add_function(wrap_pyfunction!(functions::run_study_case, m)?)?;
+    m.add_function(wrap_pyfunction!(snapshot::snapshot, m)?)?;
+    m.add_function(wrap_pyfunction!(snapshot::process_snapshots, m)?)?;
     Ok(())
 }

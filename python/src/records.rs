@@ -3,6 +3,8 @@
 
 use gpsrx_receiver::output::ChannelRow;
 use gpsrx_receiver::pipeline::{FixReport, ObservablesReport, ReceiverEvent};
+use gpsrx_receiver::snapshot::output::utc_text;
+use gpsrx_receiver::snapshot::SnapshotOutcome;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -272,4 +274,76 @@ pub fn events<'py>(py: Python<'py>, events: &[ReceiverEvent]) -> PyResult<Vec<Bo
 
 fn prn_list(prns: &[u8]) -> String {
     prns.iter().map(u8::to_string).collect::<Vec<_>>().join(" ")
+}
+
+/// Columns of a snapshot table (one row per input snapshot, as `snapshots.csv`).
+pub const SNAPSHOT_COLUMNS: [&str; 26] = [
+    "index",
+    "label",
+    "time_utc",
+    "week",
+    "tow_s",
+    "lat_deg",
+    "lon_deg",
+    "h_m",
+    "x_m",
+    "y_m",
+    "z_m",
+    "n_sv",
+    "hdop",
+    "pdop",
+    "quality",
+    "reason",
+    "residual_rms_m",
+    "time_correction_s",
+    "clock_bias_m",
+    "fe_offset_hz",
+    "searched",
+    "detected",
+    "used_prns",
+    "excluded_prns",
+    "rejected_prns",
+    "h_error_m",
+];
+
+/// Snapshot rows as columns (NaN where a row has no value; `week` -1 without a time);
+/// `errors` parallel to `rows` or empty.
+pub fn snapshots<'py>(
+    py: Python<'py>,
+    rows: &[SnapshotOutcome],
+    errors: &[Option<f64>],
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut c = Columns::default();
+    for (k, o) in rows.iter().enumerate() {
+        let time = o.time.or(o.apriori_time);
+        let llh = o.llh;
+        let x = o.ecef_m;
+        c.int("index", o.index as i64);
+        c.text("label", o.label.clone());
+        c.text("time_utc", time.map_or_else(String::new, utc_text));
+        c.int("week", time.map_or(-1, |t| i64::from(t.week)));
+        c.opt("tow_s", time.map(|t| t.tow_s));
+        c.opt("lat_deg", llh.map(|l| l.lat_rad.to_degrees()));
+        c.opt("lon_deg", llh.map(|l| l.lon_rad.to_degrees()));
+        c.opt("h_m", llh.map(|l| l.h_m));
+        c.opt("x_m", x.map(|x| x.x));
+        c.opt("y_m", x.map(|x| x.y));
+        c.opt("z_m", x.map(|x| x.z));
+        c.int("n_sv", o.used_prns.len() as i64);
+        c.opt("hdop", o.hdop);
+        c.opt("pdop", o.pdop);
+        c.text("quality", o.quality.name().to_string());
+        c.text("reason", o.reason.clone());
+        c.opt("residual_rms_m", o.residual_rms_m);
+        c.opt("time_correction_s", o.time_correction_s);
+        c.opt("clock_bias_m", o.clock_bias_m);
+        c.opt("fe_offset_hz", o.fe_offset_hz);
+        c.int("searched", o.searched as i64);
+        c.int("detected", o.detected as i64);
+        c.text("used_prns", prn_list(&o.used_prns));
+        c.text("excluded_prns", prn_list(&o.excluded_prns));
+        c.text("rejected_prns", prn_list(&o.rejected_prns));
+        c.opt("h_error_m", errors.get(k).copied().flatten());
+    }
+    c.into_dict(py, &SNAPSHOT_COLUMNS)
 }

@@ -51,12 +51,13 @@ pub enum Command {
     /// Process a recording into position fixes and standard files (RINEX, NMEA, GeoJSON, KML, CSV).
     #[command(after_help = RUN_EXIT_STATUS)]
     Run(Box<RunArgs>),
-    /// Process the recordings (and study grids) of a manifest one after another: one summary
-    /// table.
+    /// Process the recordings, snapshot sets (and study grids) of a manifest one after
+    /// another: one summary table.
     #[command(after_help = BATCH_EXIT_STATUS)]
     Batch(BatchArgs),
     /// Position snapshots of a few milliseconds each (coarse-time navigation): SnapperGPS
-    /// JSON files or one raw snapshot; writes snapshots.csv and GeoJSON/KML/GPX tracks.
+    /// JSON files, SigMF recordings with one capture per snapshot, or one raw snapshot; writes
+    /// snapshots.csv and GeoJSON/KML/GPX tracks.
     Snapshot(SnapshotArgs),
     /// Print the default configuration file (`gpsrx config --default > gpsrx.toml`).
     Config(ConfigArgs),
@@ -76,11 +77,12 @@ pub const BATCH_EXIT_STATUS: &str = "Exit status:
 #[derive(Debug, Args)]
 pub struct BatchArgs {
     /// The manifest: TOML (`[[recording]]` tables with `path`, `format`, `fs_hz`, `nav`,
-    /// `options`; `[[study]]` grids) or CSV (a header with a `path` column; other columns are
+    /// `options`; `[[snapshots]]` sets with `path`, `nav`, `approx_llh` and the options of
+    /// `gpsrx snapshot`; `[[study]]` grids) or CSV (a header with a `path` column; other columns are
     /// receiver options such as `tropo` or `rate_hz`). Relative paths are relative to it.
     pub manifest: PathBuf,
-    /// Output directory: `summary.csv`, one directory of `gpsrx run` files per recording, and
-    /// `study-NAME.csv` per study grid.
+    /// Output directory: `summary.csv`, one directory of `gpsrx run` files per recording (of
+    /// `gpsrx snapshot` files per snapshot set), and `study-NAME.csv` per study grid.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 }

@@ -6,7 +6,9 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, clap::Args)]
 pub struct SnapshotArgs {
     /// The snapshots: a SnapperGPS JSON file (`.json`: many snapshots with their timestamps),
-    /// or a raw/WAV/SigMF recording holding one snapshot (needs --time unless SigMF).
+    /// a SigMF recording with one capture per snapshot (each capture's `core:datetime` its
+    /// approximate time), or a raw/WAV/SigMF recording holding one snapshot (needs --time
+    /// unless SigMF gives `core:datetime`).
     pub input: PathBuf,
     /// RINEX navigation file (broadcast ephemerides of the day; RINEX 2 or 3). Needed: without
     /// it the command says so.
@@ -49,6 +51,11 @@ pub struct SnapshotArgs {
     /// Coherent integration, ms (default: 1 ms below 40 ms of samples, else 10 ms).
     #[arg(long, value_name = "MS")]
     pub coherent_ms: Option<u32>,
+    /// Look for the satellites the searches missed (at the code phases a first fix predicts)
+    /// with a coherent test over the whole snapshot too, the data-bit edge hypothesised: about
+    /// 1.5 dB more sensitive than the non-coherent one (off by default: see the README).
+    #[arg(long)]
+    pub coherent_look: bool,
     /// Output directory: snapshots.csv and track.geojson, track.kml, track.gpx.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,

@@ -156,6 +156,38 @@ pub fn peak_to_noise(
     (noise > 0.0 && noise.is_finite()).then(|| (power(&out[0]) / noise, k))
 }
 
+/// The complex correlation of each whole code period (at most `max_periods`) with the code
+/// starting at `code_phase_samples` plus each of `offsets_samples`, Dopplers as in
+/// [`fit_code_phase`]: `out[i][m]` for offset `i` and period `m` (the same correlator as
+/// [`peak_to_noise`]). At most [`MAX_TAPS`] offsets: the vectors of any further ones stay
+/// empty.
+pub fn period_correlations(
+    samples: &[Complex32],
+    fs_hz: f64,
+    prn: Prn,
+    code_phase_samples: f64,
+    dopplers_hz: (f64, f64),
+    max_periods: usize,
+    offsets_samples: &[f64],
+) -> Vec<Vec<Complex64>> {
+    let correlator = Correlator::best();
+    let code = PackedCode::new(CaCode::new(prn).chips());
+    let mut out: Vec<Vec<Complex64>> = vec![Vec::new(); offsets_samples.len()];
+    correlate_periods(
+        SampleSlice::Cf32(samples),
+        &mut Vec::new(),
+        &correlator,
+        &code,
+        fs_hz,
+        code_phase_samples,
+        dopplers_hz,
+        max_periods,
+        offsets_samples,
+        &mut out,
+    );
+    out
+}
+
 /// Vertex of the least-squares parabola through `(x, y)`, if it is a maximum.
 fn parabola_vertex(x: &[f64], y: &[f64]) -> Option<f64> {
     // Normal equations of y = a + b x + c x^2.

@@ -18,6 +18,13 @@
 //! name = "day2"              # default: the file name without its extension
 //! path = "day2.sigmf-meta"
 //!
+//! [[snapshots]]              # a snapshot set (crate::snapshot::SnapshotSetSpec's keys)
+//! path = "walk.json"         # SnapperGPS JSON, SigMF with one capture per snapshot, or raw
+//! nav = "walk.nav"
+//! approx_llh = [52.03, -1.2574, 112.0]
+//! truth = "walk_truth.json"  # optional: scored against it
+//! truth_h_m = 112.4
+//!
 //! [[study]]                  # a study grid, one case (or chunk of cases) per task
 //! name = "steady-state"
 //! cases = [0, 20]            # case indices start..end (default: all)
@@ -31,6 +38,7 @@
 //! [`RecordingSpec`]; every other column is an option ([`super::options`]), its cell a TOML value
 //! (`1`, `true`, `[1, 2]`) or else a string (`none`). An empty cell leaves the key unset.
 
+use crate::snapshot::SnapshotSetSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -114,11 +122,14 @@ fn one() -> usize {
     1
 }
 
-/// A batch: recordings and study grids.
+/// A batch: recordings, snapshot sets and study grids.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Manifest {
     /// The recordings, in order.
     pub recordings: Vec<RecordingSpec>,
+    /// The snapshot sets, in order (TOML `[[snapshots]]` tables).
+    #[serde(default)]
+    pub snapshots: Vec<SnapshotSetSpec>,
     /// The study grids.
     pub studies: Vec<StudySpec>,
 }
@@ -178,10 +189,12 @@ impl Manifest {
             None => toml::Table::new(),
         };
         let recordings = take_array(&mut doc, "recording")?;
+        let snapshots = take_array(&mut doc, "snapshots")?;
         let studies = take_array(&mut doc, "study")?;
         if let Some(key) = doc.keys().next() {
             return Err(format!(
-                "unknown key `{key}`: a manifest has [defaults], [[recording]] and [[study]] tables"
+                "unknown key `{key}`: a manifest has [defaults], [[recording]], [[snapshots]] \
+                 and [[study]] tables"
             ));
         }
         let recordings = recordings
@@ -201,7 +214,20 @@ impl Manifest {
                     .map_err(|e| format!("[[study]] number {}: {}", i + 1, e.message().trim()))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Self::checked(recordings, studies)
+        let snapshots = snapshots
+            .into_iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let mut spec: SnapshotSetSpec = toml::Value::Table(t).try_into().map_err(|e| {
+                    format!("[[snapshots]] number {}: {}", i + 1, e.message().trim())
+                })?;
+                if spec.name.is_empty() {
+                    spec.name = default_name(&spec.path);
+                }
+                Ok(spec)
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        Self::checked(recordings, snapshots, studies)
     }
 
     /// Parses a CSV manifest (paths as written).
@@ -241,35 +267,52 @@ impl Manifest {
             table.insert("options".into(), toml::Value::Table(options));
             recordings.push(spec_from_table(table).map_err(|e| format!("line {line}: {e}"))?);
         }
-        Self::checked(recordings, Vec::new())
+        Self::checked(recordings, Vec::new(), Vec::new())
     }
 
-    /// Checks the entries: at least one, unique names, chunks of at least one case.
-    fn checked(recordings: Vec<RecordingSpec>, studies: Vec<StudySpec>) -> Result<Self, String> {
-        if recordings.is_empty() && studies.is_empty() {
-            return Err(
-                "no recording and no study: add [[recording]] tables with a `path` (TOML) or lines under a header with a `path` column (CSV)".into(),
-            );
-        }
-        let mut names = BTreeSet::new();
-        for r in &recordings {
-            if !names.insert(r.name.as_str()) {
-                return Err(format!(
-                    "two recordings are named `{}`: give each a `name` of its own (it names its output directory)",
-                    r.name
-                ));
-            }
-        }
+    /// Checks the entries: chunks of at least one case (the rest in [`Self::check_names`]).
+    fn checked(
+        recordings: Vec<RecordingSpec>,
+        snapshots: Vec<SnapshotSetSpec>,
+        studies: Vec<StudySpec>,
+    ) -> Result<Self, String> {
         if let Some(s) = studies.iter().find(|s| s.chunk == 0) {
             return Err(format!(
                 "[[study]] {}: chunk = 0: use 1 or more cases per task",
                 s.name
             ));
         }
-        Ok(Self {
+        let m = Self {
             recordings,
+            snapshots,
             studies,
-        })
+        };
+        m.check_names()?;
+        Ok(m)
+    }
+
+    /// At least one entry; recordings and snapshot sets with names of their own (each names
+    /// its output directory).
+    fn check_names(&self) -> Result<(), String> {
+        if self.recordings.is_empty() && self.snapshots.is_empty() && self.studies.is_empty() {
+            return Err(
+                "no recording, snapshot set or study: add [[recording]] tables with a `path` (TOML) or lines under a header with a `path` column (CSV)".into(),
+            );
+        }
+        let mut names = BTreeSet::new();
+        let all = self
+            .recordings
+            .iter()
+            .map(|r| r.name.as_str())
+            .chain(self.snapshots.iter().map(|s| s.name.as_str()));
+        for name in all {
+            if !names.insert(name) {
+                return Err(format!(
+                    "two entries are named `{name}`: give each a `name` of its own (it names its output directory)"
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Takes relative paths relative to `base`.
@@ -281,6 +324,15 @@ impl Manifest {
                 p.to_path_buf()
             }
         };
+        for s in &mut self.snapshots {
+            s.path = resolve(&s.path);
+            s.truth = s.truth.as_deref().map(resolve);
+            if let Some(nav) = &s.nav {
+                if !nav.starts_with("builtin:") {
+                    s.nav = Some(resolve(Path::new(nav)).display().to_string());
+                }
+            }
+        }
         for r in &mut self.recordings {
             r.path = resolve(&r.path);
             r.config = r.config.as_deref().map(resolve);
@@ -451,5 +503,47 @@ mod tests {
         assert_eq!(m.recordings[0].nav.as_deref(), Some(nav.as_str()));
         assert_eq!(m.recordings[1].path, PathBuf::from("/abs/b.bin"));
         assert_eq!(m.recordings[1].nav.as_deref(), Some("builtin:brdc0010.22n"));
+    }
+
+    #[test]
+    fn snapshot_sets_are_read_with_their_paths_resolved_and_names_checked() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("m.toml");
+        std::fs::write(
+            &path,
+            "[[snapshots]]\npath = \"walk/w00.json\"\nnav = \"w00.nav\"\n\
+             approx_llh = [52.03, -1.2574, 112.0]\ntruth = \"walk/truth.json\"\n\
+             smooth_accel_mps2 = 0.5\n\
+             [[snapshots]]\nname = \"air\"\npath = \"/abs/air.stream\"\n\
+             nav = \"builtin:brdc0010.22n\"\napprox_llh = [52.6, 10.9, 0.0]\n\
+             format = \"ri2_lsb\"\nmap = [0.5, 1.5, -1.5, -0.5]\nheight_sigma_m = 0.0\n",
+        )
+        .expect("write");
+        let m = Manifest::read(&path).expect("valid");
+        assert!(m.recordings.is_empty());
+        let [walk, air] = &m.snapshots[..] else {
+            panic!("two sets: {m:?}")
+        };
+        assert_eq!(walk.name, "w00");
+        assert_eq!(walk.path, dir.path().join("walk/w00.json"));
+        assert_eq!(walk.truth, Some(dir.path().join("walk/truth.json")));
+        let nav = dir.path().join("w00.nav").display().to_string();
+        assert_eq!(walk.nav.as_deref(), Some(nav.as_str()));
+        assert_eq!(walk.smooth_accel_mps2, Some(0.5));
+        assert_eq!((air.name.as_str(), air.height_sigma_m), ("air", 0.0));
+        assert_eq!(air.path, PathBuf::from("/abs/air.stream"));
+        assert_eq!(air.nav.as_deref(), Some("builtin:brdc0010.22n"));
+        // A set named as a recording; a set without its a-priori.
+        let e = Manifest::from_toml(
+            "[[recording]]\npath = \"x/a.bin\"\n[[snapshots]]\npath = \"y/a.json\"\n\
+             approx_llh = [0.0, 0.0, 0.0]",
+        )
+        .expect_err("same name");
+        assert!(e.contains("named `a`"), "{e}");
+        let e = Manifest::from_toml("[[snapshots]]\npath = \"a.json\"").expect_err("no a-priori");
+        assert!(
+            e.contains("[[snapshots]] number 1") && e.contains("approx_llh"),
+            "{e}"
+        );
     }
 }

@@ -1,11 +1,14 @@
-//! Batches of recordings processed one after another on this machine: `gpsrx batch` and the
-//! Python package's tasks (`gpsrx.batch`, one per recording on a Dask cluster) share this code.
+//! Batches of recordings and snapshot sets processed one after another on this machine:
+//! `gpsrx batch` and the Python package's tasks (`gpsrx.batch`, one per recording or set on a
+//! Dask cluster) share this code.
 //!
 //! A [`Manifest`] (TOML or CSV, [`manifest`]) lists the recordings with their format, rate,
-//! navigation file and receiver options ([`options`]); [`process`] runs one into its own
-//! output directory and turns any failure into a row of the summary ([`summary`]), so a bad
-//! recording does not stop the batch; [`run_batch`] runs them in turn. Memory stays bounded by
-//! one receiver: a recording's outputs are streamed to its files and dropped before the next.
+//! navigation file and receiver options ([`options`]), and the snapshot sets
+//! ([`crate::snapshot::SnapshotSetSpec`]); [`process`] runs a recording into its own output
+//! directory, [`process_snapshots`] a set, and either turns any failure into a row of the
+//! summary ([`summary`]), so a bad entry does not stop the batch; [`run_batch`] runs them in
+//! turn. Memory stays bounded by one receiver: a recording's outputs are streamed to its files
+//! and dropped before the next.
 
 pub mod manifest;
 pub mod options;
@@ -16,6 +19,7 @@ pub use manifest::{Manifest, ManifestError, RecordingSpec, StudySpec};
 pub use recording::{run_recording, run_recording_to, RecordingError};
 pub use summary::{BatchRow, Status};
 
+use crate::snapshot::{run_set, write_set, SnapshotSetSpec};
 use std::path::Path;
 
 /// Runs one recording with its files in `out_root/NAME/`; every failure becomes a row with
@@ -33,19 +37,39 @@ pub fn process(spec: &RecordingSpec, out_root: &Path) -> BatchRow {
     }
 }
 
-/// Runs every recording of `manifest` in turn (`progress` is told each row as it is done).
+/// Positions one snapshot set with its files (`snapshots.csv`, the tracks, `errors.png` when
+/// scored) in `out_root/NAME/`; every failure becomes a row with status [`Status::Error`].
+pub fn process_snapshots(spec: &SnapshotSetSpec, out_root: &Path) -> BatchRow {
+    let path = spec.path.display().to_string();
+    let out = out_root.join(&spec.name);
+    let result = run_set(spec, |_| {}).and_then(|r| write_set(&out, &r).map(|()| r));
+    match result {
+        Ok(r) => BatchRow::snapshot_set(&spec.name, &path, &r),
+        Err(e) => {
+            let message = crate::error_message(&e);
+            tracing::warn!("{}: {message}", spec.name);
+            BatchRow::failed_set(&spec.name, &path, message)
+        }
+    }
+}
+
+/// Runs every recording, then every snapshot set of `manifest` in turn (`progress` is told
+/// each row as it is done).
 pub fn run_batch(
     manifest: &Manifest,
     out_root: &Path,
     progress: &mut dyn FnMut(&BatchRow),
 ) -> Vec<BatchRow> {
-    manifest
+    let recordings = manifest
         .recordings
         .iter()
-        .map(|spec| {
-            let row = process(spec, out_root);
-            progress(&row);
-            row
-        })
+        .map(|spec| process(spec, out_root));
+    let sets = manifest
+        .snapshots
+        .iter()
+        .map(|spec| process_snapshots(spec, out_root));
+    recordings
+        .chain(sets)
+        .inspect(|row| progress(row))
         .collect()
 }

@@ -1,6 +1,7 @@
-//! The summary table of a batch: one row per recording, with its outcome.
+//! The summary table of a batch: one row per recording or snapshot set, with its outcome.
 
 use crate::pipeline::RunSummary;
+use crate::snapshot::{SetResult, SnapshotQuality};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::Path;
@@ -9,7 +10,7 @@ use std::path::Path;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
-    /// Processed, with at least one valid fix.
+    /// Processed, with at least one valid fix (a snapshot set: one row of quality `fix`).
     Ok,
     /// Processed to the end without a valid fix.
     NoFix,
@@ -59,6 +60,14 @@ pub struct BatchRow {
     pub mean_h_m: f64,
     /// Mean PDOP (NaN: none).
     pub mean_pdop: f64,
+    /// What the entry is: `recording` or `snapshots`.
+    pub kind: String,
+    /// Snapshots in a set (0 for a recording).
+    pub snapshots: usize,
+    /// Median horizontal error of a set's fixes against its truth, m (NaN: not scored).
+    pub h_error_median_m: f64,
+    /// 95th percentile of the same, m (NaN: not scored).
+    pub h_error_p95_m: f64,
 }
 
 impl BatchRow {
@@ -89,6 +98,67 @@ impl BatchRow {
             mean_lon_deg: lon,
             mean_h_m: h,
             mean_pdop: s.mean_pdop.unwrap_or(f64::NAN),
+            kind: KIND_RECORDING.into(),
+            snapshots: 0,
+            h_error_median_m: f64::NAN,
+            h_error_p95_m: f64::NAN,
+        }
+    }
+
+    /// The row of a positioned snapshot set: `fixes` counts the rows of quality `fix`,
+    /// `invalid_fixes` those `unverified`; the means are over the `fix` rows; the duration is
+    /// the seconds of samples.
+    pub fn snapshot_set(name: &str, path: &str, r: &SetResult) -> Self {
+        let fixes: Vec<_> = r
+            .outcomes
+            .iter()
+            .filter(|o| o.quality == SnapshotQuality::Fix)
+            .collect();
+        let mean = |f: &dyn Fn(&crate::snapshot::SnapshotOutcome) -> Option<f64>| {
+            let v: Vec<f64> = fixes.iter().filter_map(|o| f(o)).collect();
+            if v.is_empty() {
+                f64::NAN
+            } else {
+                v.iter().sum::<f64>() / v.len() as f64
+            }
+        };
+        let mut prns: Vec<u8> = fixes.iter().flat_map(|o| o.used_prns.clone()).collect();
+        prns.sort_unstable();
+        prns.dedup();
+        let without = r.score.snapshots - r.score.fixes - r.score.unverified;
+        let mut message = format!(
+            "{without} of {} snapshots without a position",
+            r.score.snapshots
+        );
+        if r.scored {
+            message = format!(
+                "horizontal error median {:.1} m, 95th percentile {:.1} m; {message}",
+                r.score.median_m, r.score.p95_m
+            );
+        }
+        Self {
+            name: name.to_string(),
+            path: path.to_string(),
+            status: if fixes.is_empty() {
+                Status::NoFix
+            } else {
+                Status::Ok
+            },
+            message,
+            duration_s: r.signal_s,
+            wall_s: r.elapsed_s,
+            fixes: fixes.len(),
+            invalid_fixes: r.score.unverified,
+            tracked_prns: prns.iter().map(u8::to_string).collect::<Vec<_>>().join(" "),
+            first_fix_s: f64::NAN,
+            mean_lat_deg: mean(&|o| o.llh.map(|l| l.lat_rad.to_degrees())),
+            mean_lon_deg: mean(&|o| o.llh.map(|l| l.lon_rad.to_degrees())),
+            mean_h_m: mean(&|o| o.llh.map(|l| l.h_m)),
+            mean_pdop: mean(&|o| o.pdop),
+            kind: KIND_SNAPSHOTS.into(),
+            snapshots: r.score.snapshots,
+            h_error_median_m: if r.scored { r.score.median_m } else { f64::NAN },
+            h_error_p95_m: if r.scored { r.score.p95_m } else { f64::NAN },
         }
     }
 
@@ -100,10 +170,23 @@ impl BatchRow {
             ..Self::done(name, path, &RunSummary::default(), &[])
         }
     }
+
+    /// The row of a snapshot set that failed with `message`.
+    pub fn failed_set(name: &str, path: &str, message: String) -> Self {
+        Self {
+            kind: KIND_SNAPSHOTS.into(),
+            ..Self::failed(name, path, message)
+        }
+    }
 }
 
-/// The CSV columns, in order.
-pub const COLUMNS: [&str; 14] = [
+/// [`BatchRow::kind`] of a recording.
+pub const KIND_RECORDING: &str = "recording";
+/// [`BatchRow::kind`] of a snapshot set.
+pub const KIND_SNAPSHOTS: &str = "snapshots";
+
+/// The CSV columns, in order (later ones are added at the end: read by name).
+pub const COLUMNS: [&str; 18] = [
     "name",
     "path",
     "status",
@@ -118,6 +201,10 @@ pub const COLUMNS: [&str; 14] = [
     "mean_lon_deg",
     "mean_h_m",
     "mean_pdop",
+    "kind",
+    "snapshots",
+    "h_error_median_m",
+    "h_error_p95_m",
 ];
 
 /// Writes the summary as CSV (NaN as an empty cell).
@@ -147,6 +234,10 @@ pub fn write_summary_csv(path: &Path, rows: &[BatchRow]) -> std::io::Result<()> 
             num(r.mean_lon_deg, 8),
             num(r.mean_h_m, 3),
             num(r.mean_pdop, 3),
+            r.kind.clone(),
+            r.snapshots.to_string(),
+            num(r.h_error_median_m, 2),
+            num(r.h_error_p95_m, 2),
         ])?;
     }
     w.flush()
@@ -160,9 +251,10 @@ pub fn print_summary(out: &mut dyn Write, rows: &[BatchRow]) -> std::io::Result<
         "recording", "status", "signal_s", "wall_s", "fixes", "1st_fix_s", "mean_pdop"
     )?;
     for r in rows {
-        let text = match r.status {
-            Status::Error => r.message.clone(),
-            _ => r.tracked_prns.clone(),
+        let text = if r.status == Status::Error || r.kind == KIND_SNAPSHOTS {
+            r.message.clone()
+        } else {
+            r.tracked_prns.clone()
         };
         writeln!(
             out,
@@ -176,12 +268,22 @@ pub fn print_summary(out: &mut dyn Write, rows: &[BatchRow]) -> std::io::Result<
             r.mean_pdop
         )?;
     }
-    let ok = rows.iter().filter(|r| r.status == Status::Ok).count();
-    let failed = rows.iter().filter(|r| r.status == Status::Error).count();
-    writeln!(
-        out,
-        "{} recordings: {ok} with fixes, {} without a fix, {failed} failed",
-        rows.len(),
-        rows.len() - ok - failed
-    )
+    for (kind, what) in [
+        (KIND_RECORDING, "recordings"),
+        (KIND_SNAPSHOTS, "snapshot sets"),
+    ] {
+        let of_kind: Vec<_> = rows.iter().filter(|r| r.kind == kind).collect();
+        if of_kind.is_empty() {
+            continue;
+        }
+        let ok = of_kind.iter().filter(|r| r.status == Status::Ok).count();
+        let failed = of_kind.iter().filter(|r| r.status == Status::Error).count();
+        writeln!(
+            out,
+            "{} {what}: {ok} with fixes, {} without a fix, {failed} failed",
+            of_kind.len(),
+            of_kind.len() - ok - failed
+        )?;
+    }
+    Ok(())
 }

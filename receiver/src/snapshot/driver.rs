@@ -357,6 +357,7 @@ impl<'a> SnapshotProcessor<'a> {
             offset,
             &missed,
             self.opts.measure.code_band_hz,
+            self.opts.measure.coherent_predicted,
         );
         if extra.is_empty() {
             return o;

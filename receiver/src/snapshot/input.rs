@@ -83,6 +83,114 @@ pub fn read_raw_snapshot(
     })
 }
 
+/// The metadata file of a SigMF recording named by its data file or its `.sigmf-meta`.
+fn sigmf_meta_of(path: &Path) -> Option<std::path::PathBuf> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("sigmf-meta"))
+    {
+        return Some(path.to_path_buf());
+    }
+    let meta = gpsrx_samples::sigmf::meta_path_for(path);
+    meta.is_file().then_some(meta)
+}
+
+/// One capture of a SigMF recording: its first sample and its `core:datetime`.
+#[derive(Debug, Clone, PartialEq)]
+struct Capture {
+    sample_start: u64,
+    datetime: Option<String>,
+}
+
+/// The captures of a SigMF metadata file, in sample order.
+fn captures(meta: &Path) -> Result<Vec<Capture>, SnapshotError> {
+    let bad = |reason: String| SnapshotError::Input {
+        path: meta.to_path_buf(),
+        reason,
+    };
+    let text = std::fs::read_to_string(meta).map_err(|e| bad(e.to_string()))?;
+    let doc: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| bad(format!("not valid JSON ({e})")))?;
+    let list = doc
+        .get("captures")
+        .and_then(serde_json::Value::as_array)
+        .map_or(&[][..], Vec::as_slice);
+    let mut out: Vec<Capture> = list
+        .iter()
+        .map(|c| Capture {
+            sample_start: c
+                .get("core:sample_start")
+                .and_then(serde_json::Value::as_u64)
+                .unwrap_or(0),
+            datetime: c
+                .get("core:datetime")
+                .and_then(serde_json::Value::as_str)
+                .map(str::to_string),
+        })
+        .collect();
+    out.sort_by_key(|c| c.sample_start);
+    Ok(out)
+}
+
+/// The snapshots of a SigMF recording with more than one capture: capture `k` holds the
+/// samples from its `core:sample_start` to the next capture's (at most [`MAX_SNAPSHOT_S`]),
+/// its `core:datetime` (UTC) is the snapshot's approximate time (a capture without one, or
+/// with one that cannot be read, has none: its row says so). `Ok(None)` when `path` is no
+/// SigMF recording or has a single capture (one snapshot: [`read_raw_snapshot`]).
+pub fn read_sigmf_set(path: &Path) -> Result<Option<Vec<Snapshot>>, SnapshotError> {
+    let Some(meta) = sigmf_meta_of(path) else {
+        return Ok(None);
+    };
+    let caps = captures(&meta)?;
+    if caps.len() < 2 {
+        return Ok(None);
+    }
+    let input_error = |e: gpsrx_samples::SampleError| SnapshotError::Input {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    };
+    let if_hz = gpsrx_samples::sigmf::read_sigmf_meta(&meta)
+        .map_err(input_error)?
+        .described_if_hz()
+        .0;
+    let mut out = Vec::with_capacity(caps.len());
+    for (index, c) in caps.iter().enumerate() {
+        let first = SourceConfig {
+            path: meta.clone(),
+            format: None,
+            fs_hz: None,
+            if_hz: 0.0,
+            invert_q: false,
+            skip_s: 0.0,
+            duration_s: Some(1e-3),
+        };
+        let fs_hz = open_source(&first).map_err(input_error)?.fs_hz();
+        let end = caps.get(index + 1).map(|n| n.sample_start);
+        let len = end.map_or(u64::MAX, |e| e.saturating_sub(c.sample_start));
+        let wanted = (len as f64).min(MAX_SNAPSHOT_S * fs_hz) as usize;
+        let cfg = SourceConfig {
+            skip_s: c.sample_start as f64 / fs_hz,
+            duration_s: Some(wanted as f64 / fs_hz),
+            ..first
+        };
+        let mut source = open_source(&cfg).map_err(input_error)?;
+        let samples = read_all(source.as_mut(), wanted).map_err(input_error)?;
+        out.push(Snapshot {
+            index,
+            samples,
+            fs_hz,
+            folded: !source.format().is_complex()
+                && gpsrx_samples::resolve::is_folded_if(if_hz, fs_hz),
+            approx_time: c
+                .datetime
+                .as_deref()
+                .and_then(|t| gpsrx_samples::sigmf::parse_datetime_utc(t).ok()),
+            label: c.datetime.clone().unwrap_or_default(),
+        });
+    }
+    Ok(Some(out))
+}
+
 /// Reads up to `wanted` samples from the start of `source`.
 pub(crate) fn read_all(
     source: &mut dyn SampleSource,

@@ -33,6 +33,7 @@ use gpsrx_nav::{GpsTime, HealthPolicy, NavData, Vector3};
 use num_complex::Complex32;
 use rayon::prelude::*;
 
+use super::coherent::coherent_detect;
 use super::fine_phase::band_limited_code_phase;
 use crate::pipeline::channels::predict_satellite;
 
@@ -115,10 +116,13 @@ pub struct MeasureOptions {
     /// ([`super::fine_phase`]); `None`: the parabola fit of
     /// [`gpsrx_dsp::acquisition::code_fit`] alone.
     pub code_band_hz: Option<f64>,
+    /// Look for missed satellites with the coherent test too ([`look_at_predicted`]).
+    pub coherent_predicted: bool,
 }
 
 impl Default for MeasureOptions {
-    /// Automatic coherent time, +-7 kHz, 5 deg, pfa 1e-4, 50 m/s.
+    /// Automatic coherent time, +-7 kHz, 5 deg, pfa 1e-4, 50 m/s, the band-limited fit at
+    /// +-1.75 MHz, no coherent test at predicted code phases.
     fn default() -> Self {
         Self {
             coherent_ms: None,
@@ -127,6 +131,7 @@ impl Default for MeasureOptions {
             pfa: 1e-4,
             max_speed_mps: 50.0,
             code_band_hz: Some(DEFAULT_CODE_BAND_HZ),
+            coherent_predicted: false,
         }
     }
 }
@@ -307,41 +312,99 @@ pub const PREDICTED_MAX_SHIFT_CHIPS: f64 = 0.3;
 /// Looks for each missed satellite at its predicted code phase and Doppler (plus the
 /// front-end offset): accepted when the non-coherent power there over the noise passes the
 /// Gamma(K) threshold for [`PREDICTED_PFA`] (one cell: the position is known) and the fitted
-/// peak stays within [`PREDICTED_MAX_SHIFT_CHIPS`]. A wrong one is left to the residual test.
+/// peak stays within [`PREDICTED_MAX_SHIFT_CHIPS`]; else, with `coherent`, when the coherent
+/// statistic over the whole snapshot with the bit edge hypothesised passes its threshold for
+/// the same probability ([`super::coherent`]) and the band-limited fit stays as close. A wrong
+/// one is left to the residual test.
 pub fn look_at_predicted(
     samples: &[Complex32],
     fs_hz: f64,
     offset_hz: f64,
     missed: &[PredictedPhase],
     code_band_hz: Option<f64>,
+    coherent: bool,
 ) -> Vec<SatCodePhase> {
-    let per_chip = fs_hz / gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
-    let period = fs_hz * 1e-3;
-    let fit = CodeFitOptions::default();
     missed
         .par_iter()
         .filter_map(|m| {
-            let seen = m.doppler_hz + offset_hz;
-            let dopplers = (seen, m.doppler_hz);
-            let tau = fit_code_phase(samples, fs_hz, m.prn, m.code_phase_samples, dopplers, &fit)?;
-            let d = (tau - m.code_phase_samples + 0.5 * period).rem_euclid(period) - 0.5 * period;
-            if d.abs() > PREDICTED_MAX_SHIFT_CHIPS * per_chip {
-                return None;
-            }
-            let (ratio, k) = peak_to_noise(samples, fs_hz, m.prn, tau, dopplers, 1000)?;
-            let threshold = detection_threshold(k as u32, PREDICTED_PFA, 1) / k as f64;
-            let mut s = SatCodePhase {
-                prn: m.prn,
-                code_phase_samples: tau,
-                doppler_seen_hz: seen,
-                doppler_hz: m.doppler_hz,
-                cn0_dbhz: 10.0 * ((ratio - 1.0).max(1e-3) / 1e-3).log10(),
-                elevation_deg: m.elevation_deg,
-            };
-            s.code_phase_samples = refine(samples, fs_hz, &s, code_band_hz);
-            (ratio >= threshold).then_some(s)
+            look_non_coherent(samples, fs_hz, offset_hz, m, code_band_hz).or_else(|| {
+                coherent
+                    .then(|| look_coherent(samples, fs_hz, offset_hz, m, code_band_hz))
+                    .flatten()
+            })
         })
         .collect()
+}
+
+/// Whether `tau` lies within [`PREDICTED_MAX_SHIFT_CHIPS`] of the prediction (modulo 1 ms).
+fn near_prediction(tau: f64, m: &PredictedPhase, fs_hz: f64) -> bool {
+    let period = fs_hz * 1e-3;
+    let per_chip = fs_hz / gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
+    let d = (tau - m.code_phase_samples + 0.5 * period).rem_euclid(period) - 0.5 * period;
+    d.abs() <= PREDICTED_MAX_SHIFT_CHIPS * per_chip
+}
+
+/// The non-coherent test of [`look_at_predicted`].
+fn look_non_coherent(
+    samples: &[Complex32],
+    fs_hz: f64,
+    offset_hz: f64,
+    m: &PredictedPhase,
+    code_band_hz: Option<f64>,
+) -> Option<SatCodePhase> {
+    let fit = CodeFitOptions::default();
+    let seen = m.doppler_hz + offset_hz;
+    let dopplers = (seen, m.doppler_hz);
+    let tau = fit_code_phase(samples, fs_hz, m.prn, m.code_phase_samples, dopplers, &fit)?;
+    if !near_prediction(tau, m, fs_hz) {
+        return None;
+    }
+    let (ratio, k) = peak_to_noise(samples, fs_hz, m.prn, tau, dopplers, 1000)?;
+    let threshold = detection_threshold(k as u32, PREDICTED_PFA, 1) / k as f64;
+    let mut s = SatCodePhase {
+        prn: m.prn,
+        code_phase_samples: tau,
+        doppler_seen_hz: seen,
+        doppler_hz: m.doppler_hz,
+        cn0_dbhz: 10.0 * ((ratio - 1.0).max(1e-3) / 1e-3).log10(),
+        elevation_deg: m.elevation_deg,
+    };
+    s.code_phase_samples = refine(samples, fs_hz, &s, code_band_hz);
+    (ratio >= threshold).then_some(s)
+}
+
+/// The coherent test of [`look_at_predicted`] at the predicted code phase; the C/N0 from the
+/// statistic's mean `1 + M T C/N0`.
+fn look_coherent(
+    samples: &[Complex32],
+    fs_hz: f64,
+    offset_hz: f64,
+    m: &PredictedPhase,
+    code_band_hz: Option<f64>,
+) -> Option<SatCodePhase> {
+    let seen = m.doppler_hz + offset_hz;
+    let d = coherent_detect(
+        samples,
+        fs_hz,
+        m.prn,
+        m.code_phase_samples,
+        (seen, m.doppler_hz),
+        PREDICTED_PFA,
+    )?;
+    if !d.detected() {
+        return None;
+    }
+    let cn0 = (d.z - 1.0).max(1e-3) / (d.periods as f64 * 1e-3);
+    let mut s = SatCodePhase {
+        prn: m.prn,
+        code_phase_samples: m.code_phase_samples,
+        doppler_seen_hz: seen + d.doppler_offset_hz,
+        doppler_hz: m.doppler_hz,
+        cn0_dbhz: 10.0 * cn0.log10(),
+        elevation_deg: m.elevation_deg,
+    };
+    s.code_phase_samples = refine(samples, fs_hz, &s, code_band_hz);
+    near_prediction(s.code_phase_samples, m, fs_hz).then_some(s)
 }
 
 /// The code phase of `s` from the band-limited matched replica when `band_hz` is set and the

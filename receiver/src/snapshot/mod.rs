@@ -6,12 +6,17 @@
 //!   (many snapshots, device timestamps) and their truth files;
 //! - [`measure`]: assisted acquisition of one snapshot (sub-sample code phase, common
 //!   front-end offset, narrow second search, false-peak rejection);
+//! - [`coherent`]: detection at a predicted code phase, coherent over the snapshot with the
+//!   data-bit edge hypothesised;
 //! - [`fine_phase`]: the sub-sample code phase from a band-limited matched replica;
+//! - [`crlb`]: the Cramer-Rao bound of that code phase (what any estimator can reach);
 //! - [`solve`]: the coarse-time fix ([`gpsrx_nav::pvt::coarse_time`]) and its checks;
 //! - [`smooth`]: optional smoothing of the track across consecutive snapshots;
 //! - [`driver`]: a sequence of snapshots, each good fix seeding the next;
 //! - [`clock`]: the device clock's error from the sequence's fixes (a second pass);
-//! - [`output`]: `snapshots.csv`, the GeoJSON track, errors against a truth.
+//! - [`output`]: `snapshots.csv`, the GeoJSON track, errors against a truth;
+//! - [`set`]: a whole set as one job (input, navigation data, options, outputs), as
+//!   `gpsrx snapshot`, `gpsrx batch` and the Python package run it.
 //!
 //! # A-priori limits
 //!
@@ -21,17 +26,21 @@
 //! (a row with quality `none`), not a wrong fix.
 
 pub mod clock;
+pub mod coherent;
+pub mod crlb;
 pub mod driver;
 pub mod fine_phase;
 pub mod input;
 pub mod measure;
 pub mod output;
+pub mod set;
 pub mod smooth;
 pub mod snappergps;
 pub mod solve;
 
 pub use driver::{SnapshotOptions, SnapshotOutcome, SnapshotProcessor};
-pub use input::{read_raw_snapshot, SampleSpec, Snapshot};
+pub use input::{read_raw_snapshot, read_sigmf_set, SampleSpec, Snapshot};
+pub use set::{run_set, write_set, SetResult, SnapshotSetSpec};
 pub use solve::SnapshotQuality;
 
 use std::path::PathBuf;
@@ -42,6 +51,14 @@ pub enum SnapshotError {
     /// The input cannot be read.
     #[error("cannot read {path}: {reason}")]
     Input {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+    /// The navigation file cannot be read.
+    #[error("cannot read the navigation file {path}: {reason}")]
+    Nav {
         /// The file.
         path: PathBuf,
         /// What went wrong.
@@ -59,4 +76,7 @@ pub enum SnapshotError {
     /// An output file cannot be written.
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
+    /// The error plot cannot be drawn.
+    #[error(transparent)]
+    Plot(#[from] crate::output::plots::PlotError),
 }
