@@ -322,8 +322,8 @@ impl SampleWindow {
     /// values: the integers divided by the gain).
     pub fn push(&mut self, samples: &[Complex32]) {
         if !matches!(self.store, Store::Cf32(_)) {
-            let held = self.get_cf32(self.start, (self.end() - self.start) as usize);
             let gain = std::mem::replace(&mut self.gain, 1.0);
+            let held = self.get_cf32(self.start, (self.end() - self.start) as usize);
             let held: Vec<Complex32> = held
                 .map(Cow::into_owned)
                 .unwrap_or_default()
