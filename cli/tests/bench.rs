@@ -176,7 +176,7 @@ fn correlator_ceiling_limits_the_kernels_and_bad_names_are_refused() {
         .iter()
         .filter(|k| k.isa() != gpsrx_dsp::correlator::Isa::Avx512)
         .count();
-    assert_eq!(rows.len(), expected * 3 * 3);
+    assert_eq!(rows.len(), expected * 6 * 3);
     assert!(rows.iter().all(|r| r["isa"] != "avx512"));
     // Under the avx2 ceiling auto takes AVX2 kernels (or scalar on a CPU without them).
     let auto = v["auto"]
