@@ -185,7 +185,7 @@ impl SampleSource for FileSource {
     /// ci8 and ci16 at IF 0 with Q as stored: handed over as stored; every other integer
     /// format (cu8, ri8, ri16, and ci8/ci16 mixed from an IF or with Q inverted): ci16, the
     /// values [`SampleSource::read`] gives times [`held_gain`], rounded
-    /// ([`FileSource::read_converted`]).
+    /// (converted per 32 Ki samples as they are read).
     fn integer_format(&self) -> Option<IntegerFormat> {
         match self.resolved.format {
             SampleFormat::Ci8 if self.as_stored() => Some(IntegerFormat::Ci8),
