@@ -124,6 +124,20 @@ impl FileSource {
             && matches!(r.format, SampleFormat::Ci8 | SampleFormat::Ci16Le)
     }
 
+    /// `2 zero` for cu8 at IF 0 with Q as stored, `gain` 2 and a zero that is a multiple of
+    /// 1/2 within 0..=255 (127.5: 255): the held value `2 code - 2 zero` is then exact integer
+    /// arithmetic.
+    fn cu8_offset(&self, gain: f32) -> Option<i16> {
+        let r = &self.resolved;
+        match r.format {
+            SampleFormat::Cu8 { zero } if r.if_hz == 0.0 && !r.invert_q && gain == 2.0 => {
+                let twice = 2.0 * zero;
+                (twice.fract() == 0.0 && (0.0..=510.0).contains(&twice)).then_some(twice as i16)
+            }
+            _ => None,
+        }
+    }
+
     /// Samples left to deliver.
     pub fn remaining(&self) -> u64 {
         self.span.end_sample() - self.pos
@@ -135,6 +149,15 @@ impl FileSource {
     /// stays small.
     fn read_converted(&mut self, out: &mut [[i16; 2]]) -> Result<(u64, usize), SampleError> {
         let gain = self.integer_gain();
+        if let Some(offset) = self.cu8_offset(gain) {
+            // cu8 at IF 0, Q as stored, its zero a multiple of 1/2: gain x code - gain x zero,
+            // exact, straight from the bytes.
+            return self.for_each_chunk(out.len(), |_, bytes, _, range| {
+                for (o, b) in out[range].iter_mut().zip(bytes.chunks_exact(2)) {
+                    *o = [2 * i16::from(b[0]) - offset, 2 * i16::from(b[1]) - offset];
+                }
+            });
+        }
         let mut buf = std::mem::take(&mut self.converted);
         let first = self.pos;
         let mut done = 0;

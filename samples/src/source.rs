@@ -138,12 +138,16 @@ pub fn held_gain(format: &SampleFormat) -> Option<f32> {
 
 /// Rounds complex baseband values `x` times `gain` into `out` (same length) as the ci16 the
 /// int16 correlators read: `[round(gain re), round(gain im)]`, clamped to the i16 range
-/// (see [`held_gain`]).
+/// (see [`held_gain`]); to the nearest integer, ties to even.
+///
+/// The rounding adds and subtracts `1.5 2^23` (the f32 whose unit in the last place is 1):
+/// exact for any value clamped to the i16 range, and plain SIMD adds where `round` would be a
+/// library call per value (it was a third of a cu8 run's CPU time).
 pub fn quantize_to_ci16(x: &[Complex32], gain: f32, out: &mut [[i16; 2]]) {
+    const MAGIC: f32 = 12_582_912.0; // 1.5 * 2^23
     let q = |v: f32| {
-        (v * gain)
-            .round()
-            .clamp(f32::from(i16::MIN), f32::from(i16::MAX)) as i16
+        let v = (v * gain).clamp(f32::from(i16::MIN), f32::from(i16::MAX));
+        ((v + MAGIC) - MAGIC) as i16
     };
     for (o, c) in out.iter_mut().zip(x) {
         *o = [q(c.re), q(c.im)];
