@@ -145,9 +145,12 @@ pub fn held_gain(format: &SampleFormat) -> Option<f32> {
 /// library call per value (it was a third of a cu8 run's CPU time).
 pub fn quantize_to_ci16(x: &[Complex32], gain: f32, out: &mut [[i16; 2]]) {
     const MAGIC: f32 = 12_582_912.0; // 1.5 * 2^23
+                                     // The f32 `MAGIC + k` for an integer |k| < 2^22 has the bits of MAGIC plus k.
+    const MAGIC_BITS: i32 = 0x4B40_0000;
     let q = |v: f32| {
-        let v = (v * gain).clamp(f32::from(i16::MIN), f32::from(i16::MAX));
-        ((v + MAGIC) - MAGIC) as i16
+        // max/min (not clamp): a NaN reads as the lower bound instead of passing through.
+        let v = (v * gain).max(f32::from(i16::MIN)).min(f32::from(i16::MAX));
+        ((v + MAGIC).to_bits() as i32 - MAGIC_BITS) as i16
     };
     for (o, c) in out.iter_mut().zip(x) {
         *o = [q(c.re), q(c.im)];

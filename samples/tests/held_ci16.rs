@@ -229,3 +229,65 @@ proptest! {
         assert_same_correlations(&f, &h, gain, &on_signal, &format!("{} on the signal", format.name()));
     }
 }
+
+/// A real recording on an IF of exactly fs/4 (the usual 16.368 MHz / 4.092 MHz front end) is
+/// mixed in integers, straight from the bytes: the same ci16 as rounding `read`'s f32 mixing
+/// times the gain, sample for sample, across the reader's chunks and in uneven reads, the
+/// extreme codes included (-32768 negated saturates to 32767 on both paths).
+#[test]
+fn real_recordings_on_a_quarter_rate_if_are_mixed_exactly_in_integers() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+    for format in [SampleFormat::Ri8, SampleFormat::Ri16Le] {
+        let n = 1_234_567; // several 1 MiB chunks for ri16
+        let mut bytes: Vec<u8> = match format {
+            SampleFormat::Ri8 => (0..n).map(|_| rng.random::<u8>()).collect(),
+            _ => (0..n)
+                .flat_map(|_| rng.random_range(-32768i32..=32767).to_le_bytes()[..2].to_vec())
+                .collect(),
+        };
+        // The extremes at every phase of the oscillator.
+        let width = if format == SampleFormat::Ri8 { 1 } else { 2 };
+        for k in 0..8 {
+            let v: i16 = if k % 2 == 0 { i16::MIN } else { i16::MAX };
+            let b = if width == 1 {
+                vec![(v >> 8) as u8]
+            } else {
+                v.to_le_bytes().to_vec()
+            };
+            bytes[k * width..(k + 1) * width].copy_from_slice(&b);
+        }
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("x.bin");
+        std::fs::write(&path, &bytes).expect("write");
+        for skip_s in [0.0, 0.25e-6] {
+            let cfg = SourceConfig {
+                if_hz: FS / 4.0,
+                skip_s,
+                ..SourceConfig::new(&path)
+                    .with_format(format.clone())
+                    .with_fs_hz(FS)
+            };
+            let mut by_read = open_source(&cfg).expect("open");
+            let mut by_int = open_source(&cfg).expect("open");
+            let gain = by_int.integer_gain();
+            let mut want = Vec::new();
+            let mut got = Vec::new();
+            for size in [1usize, 3, 100_000, 7, 999_999, 400_000] {
+                let mut f = vec![Complex32::new(0.0, 0.0); size];
+                let (first, m) = by_read.read(&mut f).expect("read");
+                let mut q = vec![[0i16; 2]; m];
+                gpsrx_samples::quantize_to_ci16(&f[..m], gain, &mut q);
+                want.extend(q);
+                let mut h = vec![[0i16; 2]; size];
+                let (first_h, mh) = by_int
+                    .read_integer(IntegerSamplesMut::Ci16(&mut h))
+                    .expect("integer read");
+                assert_eq!((first_h, mh), (first, m), "{format}");
+                got.extend_from_slice(&h[..mh]);
+            }
+            assert!(got.len() > 1_000_000, "{format}: {}", got.len());
+            let bad = got.iter().zip(&want).position(|(a, b)| a != b);
+            assert_eq!(bad, None, "{format} skip {skip_s}: first difference");
+        }
+    }
+}
