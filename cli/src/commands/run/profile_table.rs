@@ -70,7 +70,11 @@ pub fn write_profile(
         "navigation between rounds (observables, fixes, rows)",
         p.navigation_s,
     )?;
-    row(out, "  - reading the next block, beside it", p.read_s)?;
+    row(
+        out,
+        "  - reading the next block, beside it (then its channels, no INS)",
+        p.read_s,
+    )?;
     row(out, "outputs at the end (plots, files)", p.finish_s)?;
     row(
         out,
