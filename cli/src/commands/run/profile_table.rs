@@ -67,14 +67,10 @@ pub fn write_profile(
     )?;
     row(
         out,
-        "navigation between rounds (observables, fixes, rows)",
+        "navigation between rounds (next block's channels beside)",
         p.navigation_s,
     )?;
-    row(
-        out,
-        "  - reading the next block, beside it (then its channels, no INS)",
-        p.read_s,
-    )?;
+    row(out, "  - reading the next block, beside it", p.read_s)?;
     row(out, "outputs at the end (plots, files)", p.finish_s)?;
     row(
         out,
