@@ -7,11 +7,9 @@
 //! the cold start's search, the parallel rounds, the navigation between rounds and the
 //! completion of the outputs at the end. Within a round the channels and a due search run side
 //! by side on the rayon pool ([`crate::pipeline::channels::channel_manager::ChannelManager::work`]);
-//! the next block of the source is read on the pool while the navigation runs, and without an
-//! INS the channels then work that block ahead on a copy of themselves
-//! ([`crate::pipeline::channels::ring::SampleWindow::read_during_then`]; before the cold start,
-//! and when the receiver is pushed samples, there is no such overlap): that work counts in
-//! the channels' time and, where it outlasts the navigation, in the navigation stage's. Each part is timed from its start to
+//! the next block of the source is read on the pool while the navigation runs
+//! ([`crate::pipeline::channels::ring::SampleWindow::read_during`]; before the cold start, and when the
+//! receiver is pushed samples, there is no such overlap). Each part is timed from its start to
 //! its end on its own, so parts that overlap can add up to more than their stage, and each
 //! includes the time its own parallel parts waited for a thread.
 
@@ -35,8 +33,8 @@ pub struct StageTimes {
     /// Reading the source (and converting it): beside the navigation, s.
     pub read_s: f64,
     /// Between the rounds: the channels' reports to the navigation processor (observables,
-    /// fixes, rows written to the sink) while the next block is read (and worked ahead by the
-    /// channels, without an INS), the channels started by a search, the samples dropped, s.
+    /// fixes, rows written to the sink) while the next block is read, the channels started
+    /// by a search, the samples dropped, s.
     pub navigation_s: f64,
     /// At the end: the sink completing its outputs (plots, files), s.
     pub finish_s: f64,

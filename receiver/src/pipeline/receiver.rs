@@ -11,10 +11,8 @@ use crate::config::ReceiverConfig;
 use crate::landmarks::LandmarkObservation;
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::aiding::{AidMonitor, AidingStats, GatedAid};
-use crate::pipeline::channels::channel_manager::{
-    ChannelManager, ColdStartError, SearchSettings, Speculation,
-};
-use crate::pipeline::channels::ring::{block_samples, SampleView, SampleWindow};
+use crate::pipeline::channels::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
+use crate::pipeline::channels::ring::{block_samples, SampleWindow};
 use crate::pipeline::channels::search_schedule::SearchBudget;
 use crate::pipeline::navigation::NavigationProcessor;
 use crate::pipeline::profile::{add_timed, StageTimes};
@@ -444,10 +442,9 @@ impl Receiver {
             }
         }
         // Every block: the channels (and a due search) work on the samples held, on the pool;
-        // then their reports go to the navigation processor on this thread while the next
-        // block is read behind them and, without an INS, the channels work it ahead on a copy
-        // of themselves (taken in the next round unless the end of this one changed them).
-        let mut ahead: Option<Speculation> = None;
+        // then their reports go to the navigation processor while the next block is read
+        // behind them (the channels have two threads; the read hides behind the navigation,
+        // which runs on this thread alone).
         loop {
             let view = self.window.view();
             let (nav, fs) = (&self.nav, self.fs_hz);
@@ -459,14 +456,9 @@ impl Receiver {
             let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
             let manager = &mut self.manager;
             let end = view.end();
-            let found = add_timed(&mut self.stages.rounds_s, || match ahead.take() {
-                Some(worked) => manager.work_ahead(worked, view, due),
-                None => manager.work(view, due, aid),
-            });
+            let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
             self.processed_to = Some(end);
-            let (got, worked) = self.deliver_while_reading(found, source, sink)?;
-            ahead = worked;
-            if got == 0 {
+            if self.deliver_while_reading(found, source, sink)? == 0 {
                 break;
             }
         }
@@ -642,19 +634,16 @@ impl Receiver {
     }
 
     /// [`Receiver::deliver`] while the next block is read: the reports go to the navigation
-    /// processor on this thread while the pool reads (they need no sample) and, without an
-    /// INS (whose aid for the next block the navigation decides), works the block read ahead
-    /// on a copy of the channels ([`ChannelManager::speculate`]); then the rest of the
-    /// round's end with the end of the samples read. Returns the samples read (0 at the end
-    /// of the source) and the channels worked ahead, if they were.
+    /// processor on this thread while the pool reads (they need no sample), then the rest of
+    /// the round's end with the end of the samples read. Returns the samples read (0 at the
+    /// end of the source).
     fn deliver_while_reading(
         &mut self,
         found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
         source: &mut dyn SampleSource,
         sink: &mut dyn Sink,
-    ) -> Result<(usize, Option<Speculation>), ReceiverError> {
+    ) -> Result<usize, ReceiverError> {
         let t0 = std::time::Instant::now();
-        let mut ahead = self.aiding.is_none().then(|| self.manager.speculate());
         let reports = ReportsOut {
             nav: &mut self.nav,
             manager: &mut self.manager,
@@ -662,19 +651,14 @@ impl Receiver {
             monitor: &mut self.monitor,
             span: done_span(self.first_sample, self.processed_to, self.fs_hz),
         };
-        let work_ahead = |view: Option<SampleView<'_>>| {
-            let (view, worked) = (view?, ahead.as_mut()?);
-            worked.run(view);
-            Some(())
-        };
-        let (got, done, passed) =
-            self.window
-                .read_during_then(source, self.block, work_ahead, || reports.pass(sink))?;
+        let (got, passed) = self
+            .window
+            .read_during(source, self.block, || reports.pass(sink))?;
         passed?;
         let end = self.window.end();
         self.end_round(found, end, sink)?;
         self.stages.navigation_s += t0.elapsed().as_secs_f64();
-        Ok((got, done.and(ahead)))
+        Ok(got)
     }
 
     /// The parts of the receiver that take the channels' reports.

@@ -67,7 +67,7 @@ pub fn write_profile(
     )?;
     row(
         out,
-        "navigation between rounds (next block's channels beside)",
+        "navigation between rounds (observables, fixes, rows)",
         p.navigation_s,
     )?;
     row(out, "  - reading the next block, beside it", p.read_s)?;

@@ -15,7 +15,7 @@ pub(crate) mod search_schedule;
 mod tracker;
 pub(crate) mod visibility;
 
-pub use channel_manager::{ChannelManager, RealignSearch, Realigned, SearchSettings, Speculation};
+pub use channel_manager::{ChannelManager, RealignSearch, Realigned, SearchSettings};
 pub use search_schedule::{
     cost_s, fixed_cost_s, level_config, SearchBudget, Visibility, BURST_S, DEFAULT_PER_SIGNAL_S,
     LEVELS,

@@ -401,52 +401,30 @@ impl SampleWindow {
     /// work that needs no sample, such as the navigation after a round. Returns the samples
     /// read (0 at the end of the source) and `f`'s result; `f` runs even when the read fails
     /// or the source has ended. Gaps as in [`SampleWindow::fill`].
-    #[cfg(test)]
     pub fn read_during<R>(
         &mut self,
         src: &mut dyn SampleSource,
         n: usize,
         f: impl FnOnce() -> R,
     ) -> Result<(usize, R), SampleError> {
-        let (got, (), r) = self.read_during_then(src, n, |_| (), f)?;
-        Ok((got, r))
-    }
-
-    /// [`SampleWindow::read_during`], and on the pool, once the read has arrived, `then` on
-    /// the samples held together with the ones just read when they follow them (`None` at
-    /// the end of the source, after a failed read or before a gap): work on the next block
-    /// beside `f`. Returns the samples read, `then`'s result and `f`'s.
-    pub fn read_during_then<T: Send, R>(
-        &mut self,
-        src: &mut dyn SampleSource,
-        n: usize,
-        then: impl FnOnce(Option<SampleView<'_>>) -> T + Send,
-        f: impl FnOnce() -> R,
-    ) -> Result<(usize, T, R), SampleError> {
         if self.end_of_stream {
-            return Ok((0, then(None), f()));
+            return Ok((0, f()));
         }
-        let (start, end) = (self.start, self.end());
-        let (read, t, r) = match &mut self.store {
-            Store::Cf32(b) => beside_then(b, (start, end), n, |room| src.read(room), then, f),
-            Store::Ci8(b) => beside_then(
-                b,
-                (start, end),
-                n,
-                |room| src.read_integer(IntegerSamplesMut::Ci8(room)),
-                then,
-                f,
-            ),
-            Store::Ci16(b) => beside_then(
-                b,
-                (start, end),
-                n,
-                |room| src.read_integer(IntegerSamplesMut::Ci16(room)),
-                then,
-                f,
-            ),
+        let (read, r) = match &mut self.store {
+            Store::Cf32(b) => {
+                let room = b.split(n).1;
+                beside(|| src.read(room), f)
+            }
+            Store::Ci8(b) => {
+                let room = b.split(n).1;
+                beside(|| src.read_integer(IntegerSamplesMut::Ci8(room)), f)
+            }
+            Store::Ci16(b) => {
+                let room = b.split(n).1;
+                beside(|| src.read_integer(IntegerSamplesMut::Ci16(room)), f)
+            }
         };
-        Ok((self.take_read(read)?, t, r))
+        Ok((self.take_read(read)?, r))
     }
 
     /// Takes in the samples a read put behind the live ones (its result and how long it
@@ -475,43 +453,20 @@ impl SampleWindow {
     }
 }
 
-/// A read's result and how long it took.
-type TimedRead = (Result<(u64, usize), SampleError>, Duration);
-
-/// [`SampleWindow::read_during_then`] on one buffer (its samples `[start, end)`): `read` into
-/// the room for `n` samples behind the live ones, then `then` on the live samples and the
-/// ones read (when they follow), on the pool, while `f` runs on the calling thread.
-fn beside_then<H: Held + Send + Sync, T: Send, R>(
-    b: &mut Buffer<H>,
-    (start, end): (u64, u64),
-    n: usize,
-    read: impl FnOnce(&mut [H]) -> Result<(u64, usize), SampleError> + Send,
-    then: impl FnOnce(Option<SampleView<'_>>) -> T + Send,
+/// Runs `read` on the rayon pool (timed) while `f` runs on the calling thread; returns both
+/// results when both are done.
+fn beside<T: Send, R>(
+    read: impl FnOnce() -> T + Send,
     f: impl FnOnce() -> R,
-) -> (TimedRead, T, R) {
-    b.reserve(n);
+) -> ((T, Duration), R) {
     let mut out = None;
     let r = rayon::in_place_scope(|scope| {
-        let out = &mut out;
-        scope.spawn(move |_| {
-            let tail = b.tail;
-            let (result, took) = timed(|| read(&mut b.buf[tail..tail + n]));
-            let view = match &result {
-                Ok((first, got)) if *got > 0 && (b.len() == 0 || *first == end) => {
-                    Some(SampleView {
-                        start: if b.len() == 0 { *first } else { start },
-                        data: Held::slice(&b.buf[b.head..tail + got]),
-                    })
-                }
-                _ => None,
-            };
-            *out = Some(((result, took), then(view)));
-        });
+        scope.spawn(|_| out = Some(timed(read)));
         f()
     });
-    // The scope returns once the spawned work has run (a panic in it is resumed here).
-    let (read, t) = out.expect("the scope waits for its spawned read");
-    (read, t, r)
+    // The scope returns once the spawned read has run (a panic in it is resumed here).
+    let read = out.expect("the scope waits for its spawned read");
+    (read, r)
 }
 
 #[cfg(test)]
@@ -640,39 +595,5 @@ mod tests {
             .read_during(&mut src, 40, || true)
             .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!((got, ran), (0, true));
-    }
-
-    /// `then` sees the samples held and the ones just read as one view when they follow
-    /// each other; nothing after a gap (the source jumped ahead) or at the end of the stream.
-    #[test]
-    fn read_during_then_shows_the_held_and_read_samples_unless_a_gap_or_the_end() {
-        let mut src = Counter { next: 10, end: 100 };
-        let mut w = SampleWindow::new();
-        let span = |v: Option<SampleView<'_>>| {
-            v.map(|v| {
-                let ok = (v.start()..v.end()).all(|i| re(&v, i) == Some(i as f32));
-                (v.start(), v.end(), ok)
-            })
-        };
-        let (got, seen, ()) = w
-            .read_during_then(&mut src, 40, span, || ())
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!((got, seen), (40, Some((10, 50, true))));
-        w.discard_before(30);
-        let (_, seen, ()) = w
-            .read_during_then(&mut src, 40, span, || ())
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(seen, Some((30, 90, true)));
-        // A gap: the source jumps from 90 to 95.
-        src.next = 95;
-        let (got, seen, ()) = w
-            .read_during_then(&mut src, 40, span, || ())
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!((got, seen), (5, None));
-        assert_eq!((w.start(), w.end()), (95, 100));
-        let (got, seen, ran) = w
-            .read_during_then(&mut src, 40, span, || true)
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!((got, seen, ran), (0, None, true));
     }
 }

@@ -139,34 +139,6 @@ pub struct ChannelManager {
     realign_engine: Option<AcquisitionEngine>,
     /// Time spent in [`ChannelManager::work`] so far.
     times: WorkTimes,
-    /// Changes made to the channels outside their work (bit sync restarted, code moved): a
-    /// [`Speculation`] made before one of them is stale.
-    mutations: u64,
-}
-
-/// The channels' next block worked ahead, on a copy, while the navigation takes the reports
-/// of the last one ([`ChannelManager::speculate`], [`ChannelManager::work_ahead`]).
-#[derive(Debug)]
-pub struct Speculation {
-    channels: Vec<Channel>,
-    reports: Vec<Vec<ChannelEpoch>>,
-    mutations: u64,
-    tracking_s: f64,
-}
-
-impl Speculation {
-    /// Every channel of the copy processes the code periods `window` holds (in parallel), as
-    /// [`ChannelManager::work`] does without an aid.
-    pub fn run(&mut self, window: SampleView<'_>) {
-        let (channels, reports) = (&mut self.channels, &mut self.reports);
-        let (_, took) = timed(|| {
-            channels
-                .par_iter_mut()
-                .zip(reports.par_iter_mut())
-                .for_each(|(ch, out)| run_channel(ch, window, None, out));
-        });
-        self.tracking_s += took.as_secs_f64();
-    }
 }
 
 /// Wall time of the channels' work and of the searches beside it, summed over
@@ -213,7 +185,6 @@ impl ChannelManager {
             realign: None,
             realign_engine,
             times: WorkTimes::default(),
-            mutations: 0,
         })
     }
 
@@ -231,7 +202,6 @@ impl ChannelManager {
             realign: None,
             realign_engine: None,
             times: WorkTimes::default(),
-            mutations: 0,
         }
     }
 
@@ -391,57 +361,9 @@ impl ChannelManager {
         search: Option<DueSearch>,
         aid: Option<&dyn AidingPort>,
     ) -> Option<SearchOutcome> {
-        self.work_from(0, window, search, aid)
-    }
-
-    /// A copy of the channels, to work the next block ahead ([`Speculation::run`]) while the
-    /// reports of the last one go to the navigation.
-    pub fn speculate(&self) -> Speculation {
-        Speculation {
-            channels: self.channels.clone(),
-            reports: (0..self.channels.len()).map(|_| Vec::new()).collect(),
-            mutations: self.mutations,
-            tracking_s: 0.0,
-        }
-    }
-
-    /// [`ChannelManager::work`] (without an aid) with the block worked ahead by `ahead`: its
-    /// channels and reports are taken when nothing changed the channels since the copy was
-    /// made ([`ChannelManager::restart_bit_sync`], a code realignment), and only the channels
-    /// started since then process the block; else every channel processes it, as `work`.
-    /// The channels' work is deterministic, so both give the same channels and reports.
-    pub fn work_ahead(
-        &mut self,
-        ahead: Speculation,
-        window: SampleView<'_>,
-        search: Option<DueSearch>,
-    ) -> Option<SearchOutcome> {
-        let n = ahead.channels.len();
-        if ahead.mutations != self.mutations || n > self.channels.len() {
-            return self.work_from(0, window, search, None);
-        }
-        for (ch, worked) in self.channels.iter_mut().zip(ahead.channels) {
-            *ch = worked;
-        }
         self.reports.resize_with(self.channels.len(), Vec::new);
-        for (r, worked) in self.reports.iter_mut().zip(ahead.reports) {
-            *r = worked;
-        }
-        self.times.tracking_s += ahead.tracking_s;
-        self.work_from(n, window, search, None)
-    }
-
-    /// [`ChannelManager::work`] of the channels from index `from` on.
-    fn work_from(
-        &mut self,
-        from: usize,
-        window: SampleView<'_>,
-        search: Option<DueSearch>,
-        aid: Option<&dyn AidingPort>,
-    ) -> Option<SearchOutcome> {
-        self.reports.resize_with(self.channels.len(), Vec::new);
-        let channels = &mut self.channels[from..];
-        let reports = &mut self.reports[from..];
+        let channels = &mut self.channels;
+        let reports = &mut self.reports;
         let mut run_all = || {
             timed(|| {
                 channels
@@ -652,7 +574,6 @@ impl ChannelManager {
 
     /// Every live channel forgets its data-bit edges ([`Channel::restart_bit_sync`]).
     pub fn restart_bit_sync(&mut self) {
-        self.mutations += 1;
         for c in self
             .channels
             .iter_mut()

@@ -160,7 +160,6 @@ impl ChannelManager {
     /// held before (when the gap's length is unknown, at the Doppler the search found: the one
     /// held may have drifted over the gap); the others keep their loops.
     pub fn realign(&mut self, search: RealignSearch, plan: &RealignPlan) -> Option<Realigned> {
-        self.mutations += 1;
         let RealignSearch {
             realign: r,
             found,
