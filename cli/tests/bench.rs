@@ -39,11 +39,11 @@ fn quick_bench_reports_every_kernel_acquisition_and_end_to_end() {
     let kernels = Correlator::available();
     assert_eq!(
         rows.len(),
-        kernels.len() * 3 * 3,
+        kernels.len() * 6 * 3,
         "one row per kernel, format, taps"
     );
     for k in &kernels {
-        for format in ["ci8", "ci16", "cf32"] {
+        for format in ["ci8", "ci16", "cf32", "cu8", "ri8", "ri16"] {
             for taps in [1u64, 3, 5] {
                 let hits: Vec<&Value> = rows
                     .iter()
@@ -71,12 +71,15 @@ fn quick_bench_reports_every_kernel_acquisition_and_end_to_end() {
     let auto = v["auto"]
         .as_array()
         .unwrap_or_else(|| panic!("no auto array"));
-    assert_eq!(auto.len(), 3);
+    assert_eq!(auto.len(), 6);
     let resolver = Correlator::best_up_to(
         gpsrx_dsp::correlator::Isa::Avx512,
         gpsrx_dsp::correlator::Arithmetic::Auto,
     );
-    for (a, format) in auto.iter().zip(["ci8", "ci16", "cf32"]) {
+    for (a, format) in auto
+        .iter()
+        .zip(["ci8", "ci16", "cf32", "cu8", "ri8", "ri16"])
+    {
         assert_eq!(a["format"], format);
         let k = resolver.resolved_for(format, 4e6);
         assert_eq!(a["kernel"].as_str(), Some(k.name().as_str()));
@@ -87,6 +90,13 @@ fn quick_bench_reports_every_kernel_acquisition_and_end_to_end() {
                 && r["runs"] == a["runs"]),
             "auto's {format} kernel {a} is not a row"
         );
+    }
+    // cu8, ri8 and ri16 are held as ci16: auto runs on them what it runs on ci16 (the int16
+    // kernel wherever the CPU has AVX2).
+    for format in ["cu8", "ri8", "ri16"] {
+        let a = auto.iter().find(|a| a["format"] == format);
+        let c = auto.iter().find(|a| a["format"] == "ci16");
+        assert_eq!(a.map(|a| &a["runs"]), c.map(|c| &c["runs"]), "{format}");
     }
     positive(&v["reference_msps_per_core"], "reference correlator");
     // The CPU and its instruction sets come with the figures.
@@ -166,7 +176,7 @@ fn correlator_ceiling_limits_the_kernels_and_bad_names_are_refused() {
         .iter()
         .filter(|k| k.isa() != gpsrx_dsp::correlator::Isa::Avx512)
         .count();
-    assert_eq!(rows.len(), expected * 3 * 3);
+    assert_eq!(rows.len(), expected * 6 * 3);
     assert!(rows.iter().all(|r| r["isa"] != "avx512"));
     // Under the avx2 ceiling auto takes AVX2 kernels (or scalar on a CPU without them).
     let auto = v["auto"]

@@ -11,10 +11,13 @@ use crate::format::SampleFormat;
 use crate::mixer::Mixer;
 use crate::resolve::{resolve, Resolved};
 use crate::source::{
-    non_finite_warning, to_baseband, trailing_bytes_warning, IntegerFormat, IntegerSamplesMut,
-    SampleSource, SourceConfig,
+    held_gain, non_finite_warning, quantize_to_ci16, to_baseband, trailing_bytes_warning,
+    IntegerFormat, IntegerSamplesMut, SampleSource, SourceConfig,
 };
 use crate::span::{bytes_for_samples, sample_position, Span};
+
+/// Samples converted to ci16 per step of [`FileSource::read_converted`] (a 256 KiB f32 copy).
+const CONVERT_SAMPLES: usize = 32 * 1024;
 
 /// Streams samples from a file in chunks of at most 1 MiB.
 #[derive(Debug)]
@@ -28,6 +31,9 @@ pub struct FileSource {
     max_block: usize,
     mixer: Option<Mixer>,
     non_finite: u64,
+    /// The f32 samples of a read converted to ci16 ([`FileSource::read_converted`]), kept
+    /// between reads.
+    converted: Vec<Complex32>,
 }
 
 impl FileSource {
@@ -57,6 +63,7 @@ impl FileSource {
             max_block,
             mixer,
             non_finite: 0,
+            converted: Vec::new(),
         })
     }
 
@@ -108,9 +115,126 @@ impl FileSource {
         Ok((first, done))
     }
 
+    /// Whether the samples are complex integers the int16 correlators read as stored: ci8 or
+    /// ci16 at IF 0 with Q as stored.
+    fn as_stored(&self) -> bool {
+        let r = &self.resolved;
+        r.if_hz == 0.0
+            && !r.invert_q
+            && matches!(r.format, SampleFormat::Ci8 | SampleFormat::Ci16Le)
+    }
+
+    /// `2 zero` for cu8 at IF 0 with Q as stored, `gain` 2 and a zero that is a multiple of
+    /// 1/2 within 0..=255 (127.5: 255): the held value `2 code - 2 zero` is then exact integer
+    /// arithmetic.
+    fn cu8_offset(&self, gain: f32) -> Option<i16> {
+        let r = &self.resolved;
+        match r.format {
+            SampleFormat::Cu8 { zero } if r.if_hz == 0.0 && !r.invert_q && gain == 2.0 => {
+                let twice = 2.0 * zero;
+                (twice.fract() == 0.0 && (0.0..=510.0).contains(&twice)).then_some(twice as i16)
+            }
+            _ => None,
+        }
+    }
+
+    /// For a real recording on an IF of exactly +-fs/4 (16.368 MHz sampling with a 4.092 MHz
+    /// IF, say): the oscillator `exp(-j 2 pi IF n / fs)` is `(-j)^n` (+fs/4, `Some(-1)`) or
+    /// `j^n` (-fs/4, `Some(1)`), so the mixing is exact in integers.
+    fn quarter_rate_turn(&self) -> Option<i32> {
+        let r = &self.resolved;
+        if !matches!(r.format, SampleFormat::Ri8 | SampleFormat::Ri16Le) {
+            return None;
+        }
+        // As the mixer reduces it (crate::mixer::Mixer::new).
+        let c = (r.if_hz / r.fs_hz).rem_euclid(1.0);
+        if c == 0.25 {
+            Some(-1)
+        } else if c == 0.75 {
+            Some(1)
+        } else {
+            None
+        }
+    }
+
+    /// [`FileSource::read_converted`] of a real recording on an IF of +-fs/4 ([`FileSource::quarter_rate_turn`]):
+    /// sample `n` (absolute) times `gain` times `turn^n j^n`, straight from the bytes (the
+    /// values the f32 mixer gives, rounded, without it: 4 cases of a sign and a swap).
+    fn read_quarter_rate(
+        &mut self,
+        out: &mut [[i16; 2]],
+        gain: f32,
+        turn: i32,
+    ) -> Result<(u64, usize), SampleError> {
+        let first = self.pos;
+        let gain = gain as i32;
+        let sat = |v: i32| v.clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16;
+        self.for_each_chunk(out.len(), |format, bytes, _, range| {
+            let start = first + range.start as u64;
+            let values: Box<dyn Iterator<Item = i32> + '_> = match format {
+                SampleFormat::Ri8 => Box::new(bytes.iter().map(|&b| i32::from(b as i8))),
+                _ => Box::new(
+                    bytes
+                        .chunks_exact(2)
+                        .map(|b| i32::from(i16::from_le_bytes([b[0], b[1]]))),
+                ),
+            };
+            for (k, (o, x)) in out[range].iter_mut().zip(values).enumerate() {
+                let v = x * gain;
+                // (turn j)^n: 1, turn j, -1, -turn j.
+                *o = match (start + k as u64) % 4 {
+                    0 => [sat(v), 0],
+                    1 => [0, sat(turn * v)],
+                    2 => [sat(-v), 0],
+                    _ => [0, sat(-turn * v)],
+                };
+            }
+        })
+    }
+
     /// Samples left to deliver.
     pub fn remaining(&self) -> u64 {
         self.span.end_sample() - self.pos
+    }
+
+    /// [`SampleSource::read`] into `out` as ci16: the complex baseband values (decoded, Q
+    /// inverted, mixed from the IF) times [`SampleSource::integer_gain`], rounded
+    /// ([`quantize_to_ci16`]), in pieces of at most [`CONVERT_SAMPLES`] so that the f32 copy
+    /// stays small.
+    fn read_converted(&mut self, out: &mut [[i16; 2]]) -> Result<(u64, usize), SampleError> {
+        let gain = self.integer_gain();
+        if let Some(offset) = self.cu8_offset(gain) {
+            // cu8 at IF 0, Q as stored, its zero a multiple of 1/2: gain x code - gain x zero,
+            // exact, straight from the bytes.
+            return self.for_each_chunk(out.len(), |_, bytes, _, range| {
+                for (o, b) in out[range].iter_mut().zip(bytes.chunks_exact(2)) {
+                    *o = [2 * i16::from(b[0]) - offset, 2 * i16::from(b[1]) - offset];
+                }
+            });
+        }
+        if let Some(turn) = self.quarter_rate_turn() {
+            return self.read_quarter_rate(out, gain, turn);
+        }
+        let mut buf = std::mem::take(&mut self.converted);
+        let first = self.pos;
+        let mut done = 0;
+        let result = loop {
+            let want = (out.len() - done).min(CONVERT_SAMPLES);
+            if want == 0 {
+                break Ok((first, done));
+            }
+            buf.resize(want, Complex32::new(0.0, 0.0));
+            match self.read(&mut buf) {
+                Ok((_, 0)) => break Ok((first, done)),
+                Ok((_, n)) => {
+                    quantize_to_ci16(&buf[..n], gain, &mut out[done..done + n]);
+                    done += n;
+                }
+                Err(e) => break Err(e),
+            }
+        };
+        self.converted = buf;
+        result
     }
 }
 
@@ -138,15 +262,23 @@ impl SampleSource for FileSource {
         Ok((first, n))
     }
 
+    /// ci8 and ci16 at IF 0 with Q as stored: handed over as stored; every other integer
+    /// format (cu8, ri8, ri16, and ci8/ci16 mixed from an IF or with Q inverted): ci16, the
+    /// values [`SampleSource::read`] gives times [`held_gain`], rounded
+    /// (converted per 32 Ki samples as they are read).
     fn integer_format(&self) -> Option<IntegerFormat> {
-        let r = &self.resolved;
-        if r.if_hz != 0.0 || r.invert_q {
-            return None;
+        match self.resolved.format {
+            SampleFormat::Ci8 if self.as_stored() => Some(IntegerFormat::Ci8),
+            SampleFormat::Ci16Le if self.as_stored() => Some(IntegerFormat::Ci16),
+            ref f => held_gain(f).map(|_| IntegerFormat::Ci16),
         }
-        match r.format {
-            SampleFormat::Ci8 => Some(IntegerFormat::Ci8),
-            SampleFormat::Ci16Le => Some(IntegerFormat::Ci16),
-            _ => None,
+    }
+
+    fn integer_gain(&self) -> f32 {
+        if self.as_stored() {
+            1.0
+        } else {
+            held_gain(&self.resolved.format).unwrap_or(1.0)
         }
     }
 
@@ -155,6 +287,7 @@ impl SampleSource for FileSource {
         if self.integer_format() != Some(asked) {
             return Err(SampleError::NoIntegerRead { asked });
         }
+        let as_stored = self.as_stored();
         match out {
             IntegerSamplesMut::Ci8(out) => {
                 // Stored as wanted: read straight into `out`.
@@ -168,14 +301,17 @@ impl SampleSource for FileSource {
                 self.pos += n as u64;
                 Ok((first, n))
             }
-            IntegerSamplesMut::Ci16(out) => self.for_each_chunk(out.len(), |_, bytes, _, range| {
-                for (o, b) in out[range].iter_mut().zip(bytes.chunks_exact(4)) {
-                    *o = [
-                        i16::from_le_bytes([b[0], b[1]]),
-                        i16::from_le_bytes([b[2], b[3]]),
-                    ];
-                }
-            }),
+            IntegerSamplesMut::Ci16(out) if as_stored => {
+                self.for_each_chunk(out.len(), |_, bytes, _, range| {
+                    for (o, b) in out[range].iter_mut().zip(bytes.chunks_exact(4)) {
+                        *o = [
+                            i16::from_le_bytes([b[0], b[1]]),
+                            i16::from_le_bytes([b[2], b[3]]),
+                        ];
+                    }
+                })
+            }
+            IntegerSamplesMut::Ci16(out) => self.read_converted(out),
         }
     }
 

@@ -29,6 +29,9 @@ pub mod writer;
 
 pub use error::SampleError;
 pub use format::SampleFormat;
-pub use source::{open_source, IntegerFormat, IntegerSamplesMut, SampleSource, SourceConfig};
+pub use source::{
+    held_gain, open_source, quantize_to_ci16, IntegerFormat, IntegerSamplesMut, SampleSource,
+    SourceConfig,
+};
 pub use stream_source::ReaderSource;
 pub use writer::{create_wav_writer, create_writer, SampleWriter, WriteStats};

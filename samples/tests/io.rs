@@ -1428,8 +1428,9 @@ fn sigmf_datetime_is_read_as_utc_and_round_trips() {
 }
 
 /// Samples handed over as stored (`read_integer`) are the values `read` gives, across the
-/// 1 MiB read chunks and in uneven requests, for ci8 and ci16; formats that need converting,
-/// a non-zero IF and an inverted Q offer no integer read.
+/// 1 MiB read chunks and in uneven requests, for ci8 and ci16; with a non-zero IF or an
+/// inverted Q they are offered converted, as ci16 within half a unit of `read`'s values times
+/// the gain.
 #[test]
 fn integer_reads_give_the_values_read_gives() {
     use gpsrx_samples::{IntegerFormat, IntegerSamplesMut};
@@ -1496,7 +1497,9 @@ fn integer_reads_give_the_values_read_gives() {
         assert_eq!(got.len(), n, "{format}");
         assert!(got == want, "{format}: integer read differs from read()");
         assert_eq!(got, samples, "{format}: not the samples written");
-        // What needs converting is not offered.
+        assert_eq!(by_int.integer_gain(), 1.0, "{format}: held as stored");
+        // What needs converting (mixed from an IF, Q inverted) is offered as ci16, `read`'s
+        // values times the format's gain, rounded; never as ci8.
         for cfg in [
             SourceConfig {
                 if_hz: 1.0e6,
@@ -1508,12 +1511,30 @@ fn integer_reads_give_the_values_read_gives() {
             },
         ] {
             let mut s = open_source(&cfg).expect("open");
-            assert_eq!(s.integer_format(), None);
+            assert_eq!(s.integer_format(), Some(IntegerFormat::Ci16));
+            let gain = gpsrx_samples::held_gain(&format).expect("integer format");
+            assert_eq!(s.integer_gain(), gain);
             let mut room = [[0i8; 2]; 4];
             assert!(matches!(
                 s.read_integer(IntegerSamplesMut::Ci8(&mut room)),
                 Err(SampleError::NoIntegerRead { .. })
             ));
+            let mut held = vec![[0i16; 2]; 5000];
+            let (first, m) = s
+                .read_integer(IntegerSamplesMut::Ci16(&mut held))
+                .expect("converted read");
+            let mut f = open_source(&cfg).expect("open");
+            let mut want = vec![c(0.0, 0.0); 5000];
+            assert_eq!(f.read(&mut want).expect("read"), (first, m));
+            for (h, w) in held.iter().zip(&want) {
+                for (hv, wv) in [(h[0], w.re), (h[1], w.im)] {
+                    let exact = (wv * gain).clamp(-32768.0, 32767.0);
+                    assert!(
+                        (f32::from(hv) - exact).abs() <= 0.5,
+                        "{format}: {hv} for {exact}"
+                    );
+                }
+            }
         }
     }
     let cf = dir.path().join("x.cf32");

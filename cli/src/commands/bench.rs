@@ -6,7 +6,8 @@
 //!
 //! Three measurements, each of the code the receiver runs:
 //! - correlator throughput, Msamples/s on one core, for every kernel this CPU runs
-//!   ([`Correlator::available`]: ISA x arithmetic), input format (ci8, ci16, cf32) and tap count
+//!   ([`Correlator::available`]: ISA x arithmetic), input format (ci8, ci16, cf32; cu8, ri8 and
+//!   ri16 as the receiver holds them: converted to ci16 when read) and tap count
 //!   (1, 3, 5): 1 ms blocks at 4 MHz (4000 samples), code and carrier generated inside the
 //!   kernel, as tracking calls it; the best of many 5 ms stretches (the least disturbed by
 //!   other processes); with the kernel `auto` (the default) takes per format;
@@ -31,9 +32,11 @@ use gpsrx_dsp::correlator::{
 use gpsrx_dsp::Prn;
 use gpsrx_receiver::output::FileSink;
 use gpsrx_receiver::{Assistance, Receiver};
+use gpsrx_samples::format::SampleFormat;
+use gpsrx_samples::mixer::Mixer;
 use gpsrx_samples::sim::scenario::ReceiverConfig;
 use gpsrx_samples::sim::Scenario;
-use gpsrx_samples::{open_source, SourceConfig};
+use gpsrx_samples::{held_gain, open_source, quantize_to_ci16, SourceConfig};
 use gpsrx_tracking::{CorrelatorChoice, CorrelatorIsa};
 use num_complex::Complex32;
 use rand::{Rng, SeedableRng};
@@ -73,7 +76,7 @@ pub struct CorrelatorRow {
     /// The kernel that ran on this format, e.g. `avx2+fma/i16 (16 lanes)` (an i16
     /// correlator runs the f32 kernel on cf32).
     pub runs: String,
-    /// Input format: `ci8`, `ci16` or `cf32`.
+    /// Input format: `ci8`, `ci16`, `cf32`, or `cu8`, `ri8`, `ri16` (held as ci16).
     pub format: String,
     /// Correlator taps accumulated in one pass.
     pub taps: usize,
@@ -85,7 +88,7 @@ pub struct CorrelatorRow {
 /// input format at the benchmark's rate.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct AutoChoice {
-    /// Input format: `ci8`, `ci16` or `cf32`.
+    /// Input format, as in [`CorrelatorRow::format`].
     pub format: String,
     /// The kernel (a `kernel` of the correlator rows), e.g. `avx512/i16`.
     pub kernel: String,
@@ -345,12 +348,19 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
     Ok(report)
 }
 
-/// Seeded random samples in the three formats (the same values: cf32 and ci16 hold the ci8
-/// integers; ci16 scaled by 2^4 as a 12-bit front end would deliver them).
+/// Seeded random samples in every input format the correlators see (the same values: cf32
+/// and ci16 hold the ci8 integers, ci16 scaled by 2^4 as a 12-bit front end would deliver
+/// them); cu8, ri8 and ri16 as the receiver holds them, converted to ci16 when read
+/// ([`gpsrx_samples::held_gain`]): cu8 the ci8 values offset by 128 (`2 code - 255`), ri8 and
+/// ri16 the I values (ri16 scaled by 2^4) as a real recording on an IF of fs/4 + 20 kHz,
+/// mixed down.
 struct Inputs {
     ci8: Vec<[i8; 2]>,
     ci16: Vec<[i16; 2]>,
     cf32: Vec<Complex32>,
+    cu8: Vec<[i16; 2]>,
+    ri8: Vec<[i16; 2]>,
+    ri16: Vec<[i16; 2]>,
 }
 
 impl Inputs {
@@ -367,17 +377,49 @@ impl Inputs {
             .iter()
             .map(|[i, q]| Complex32::new(f32::from(*i), f32::from(*q)))
             .collect();
-        Self { ci8, ci16, cf32 }
+        let held = |format: SampleFormat, values: Vec<Complex32>, if_hz: f64| {
+            let mut x = values;
+            if if_hz != 0.0 {
+                Mixer::new(if_hz, BENCH_FS_HZ).mix(0, &mut x);
+            }
+            let mut out = vec![[0i16; 2]; x.len()];
+            quantize_to_ci16(&x, held_gain(&format).unwrap_or(1.0), &mut out);
+            out
+        };
+        let cu8 = ci8
+            .iter()
+            .map(|[i, q]| Complex32::new(f32::from(*i) + 0.5, f32::from(*q) + 0.5))
+            .collect();
+        let real = |scale: f32| {
+            ci8.iter()
+                .map(|[i, _]| Complex32::new(f32::from(*i) * scale, 0.0))
+                .collect::<Vec<_>>()
+        };
+        let if_hz = BENCH_FS_HZ / 4.0 + 20e3;
+        Self {
+            cu8: held(SampleFormat::Cu8 { zero: 127.5 }, cu8, 0.0),
+            ri8: held(SampleFormat::Ri8, real(1.0), if_hz),
+            ri16: held(SampleFormat::Ri16Le, real(16.0), if_hz),
+            ci8,
+            ci16,
+            cf32,
+        }
     }
 
-    fn slices(&self) -> [(&'static str, SampleSlice<'_>); 3] {
+    fn slices(&self) -> [(&'static str, SampleSlice<'_>); 6] {
         [
             ("ci8", SampleSlice::Ci8(&self.ci8)),
             ("ci16", SampleSlice::Ci16(&self.ci16)),
             ("cf32", SampleSlice::Cf32(&self.cf32)),
+            ("cu8", SampleSlice::Ci16(&self.cu8)),
+            ("ri8", SampleSlice::Ci16(&self.ri8)),
+            ("ri16", SampleSlice::Ci16(&self.ri16)),
         ]
     }
 }
+
+/// The input formats of the correlator rows and of `auto`'s choices.
+const FORMATS: [&str; 6] = ["ci8", "ci16", "cf32", "cu8", "ri8", "ri16"];
 
 /// A tracking-like replica: 2 kHz Doppler, code rate with the matching code Doppler.
 fn bench_state() -> ReplicaState {
@@ -459,7 +501,7 @@ fn bench_correlators(timed_s: f64, max_isa: Isa) -> Vec<CorrelatorRow> {
 /// The kernel `auto` runs per format under the ceiling `max_isa`, at the benchmark's rate.
 fn auto_choices(max_isa: Isa) -> Vec<AutoChoice> {
     let auto = Correlator::best_up_to(max_isa, Arithmetic::Auto);
-    ["ci8", "ci16", "cf32"]
+    FORMATS
         .into_iter()
         .map(|format| {
             let k = auto.resolved_for(format, BENCH_FS_HZ);
@@ -689,7 +731,11 @@ fn print_report(out: &mut dyn Write, r: &BenchReport) -> std::io::Result<()> {
 
 /// The correlator table: one line per kernel and format, the kernel that ran at the end.
 fn print_correlators(out: &mut dyn Write, r: &BenchReport) -> std::io::Result<()> {
-    writeln!(out, "correlator throughput, Msamples/s on one core (4000-sample blocks at 4 MHz, code and carrier generated inside):")?;
+    writeln!(out, "correlator throughput, Msamples/s on one core (4000-sample blocks at 4 MHz, code and carrier generated inside;")?;
+    writeln!(
+        out,
+        "cu8, ri8 and ri16 as the receiver holds them: converted to ci16 when read):"
+    )?;
     writeln!(
         out,
         "  {:<14} {:<6} {:>9} {:>9} {:>9}   ran",

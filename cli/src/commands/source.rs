@@ -93,6 +93,10 @@ impl SampleSource for Interruptible {
         Ok((first, n))
     }
 
+    fn integer_gain(&self) -> f32 {
+        self.inner.integer_gain()
+    }
+
     fn warnings(&self) -> Vec<String> {
         self.inner.warnings()
     }

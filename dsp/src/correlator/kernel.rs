@@ -201,13 +201,14 @@ impl Correlator {
         format!("{}/{}", self.isa().name(), self.arithmetic.name())
     }
 
-    /// The kernel that actually runs on `format` (`"ci8"`, `"ci16"` or `"cf32"`) at `fs_hz`,
-    /// e.g. `"avx2+fma/i16 (16 lanes)"`: an I16 correlator runs the F32 kernel on cf32, the
-    /// int16-lane kernels take ci8 and ci16 from about 1.1 MHz (AVX2, 16 lanes; AVX-512 with
-    /// VNNI from about 2.27 MHz, 32 lanes, else the AVX2 one), and [`Arithmetic::Auto`]
+    /// The kernel that actually runs on `format` (`"ci8"`, `"ci16"` or `"cf32"`; `"cu8"`,
+    /// `"ri8"` and `"ri16"`, which the receiver holds as ci16, as ci16) at `fs_hz`, e.g.
+    /// `"avx2+fma/i16 (16 lanes)"`: an I16 correlator runs the F32 kernel on cf32, the
+    /// int16-lane kernels take the integer formats from about 1.1 MHz (AVX2, 16 lanes; AVX-512
+    /// with VNNI from about 2.27 MHz, 32 lanes, else the AVX2 one), and [`Arithmetic::Auto`]
     /// resolves as [`Arithmetic::Auto`] says.
     pub fn kernel_for(&self, format: &str, fs_hz: f64) -> String {
-        let integer = matches!(format, "ci8" | "ci16");
+        let integer = is_integer_format(format);
         let arithmetic = self.resolve_arithmetic(integer, fs_hz);
         let (isa, lanes) = match (self.isa(), arithmetic) {
             (Isa::Scalar, _) => (Isa::Scalar, ""),
@@ -231,9 +232,9 @@ impl Correlator {
     }
 
     /// The explicit correlator (no [`Arithmetic::Auto`]) that runs blocks of `format`
-    /// (`"ci8"`, `"ci16"` or `"cf32"`) at `fs_hz`: this one with its arithmetic resolved.
+    /// (as in [`Correlator::kernel_for`]) at `fs_hz`: this one with its arithmetic resolved.
     pub fn resolved_for(&self, format: &str, fs_hz: f64) -> Correlator {
-        let integer = matches!(format, "ci8" | "ci16");
+        let integer = is_integer_format(format);
         Correlator {
             kernel: self.kernel,
             arithmetic: self.resolve_arithmetic(integer, fs_hz),
@@ -311,6 +312,12 @@ impl Correlator {
             }
         }
     }
+}
+
+/// Whether blocks of `format` reach the correlators as integers: ci8 and ci16, and cu8, ri8
+/// and ri16, which the receiver converts to ci16 when it reads them.
+fn is_integer_format(format: &str) -> bool {
+    matches!(format, "ci8" | "ci16" | "cu8" | "ri8" | "ri16")
 }
 
 fn scalar_kernel(

@@ -416,10 +416,18 @@ impl Receiver {
                 receiver_hz: self.fs_hz,
             });
         }
-        // Samples held as stored where the source can (ci8, ci16): the correlators read them
-        // in place.
+        // Samples held as integers where the source can (ci8, ci16 as stored; cu8, ri8, ri16
+        // converted to ci16): the int16 correlators read them in place.
         if let Some(f) = self.window.hold_as_stored(source) {
-            tracing::debug!("samples held as {f}, read by the correlators in place");
+            let gain = self.window.gain();
+            if gain == 1.0 {
+                tracing::debug!("samples held as {f}, read by the correlators in place");
+            } else {
+                tracing::debug!(
+                    "{} samples held as {f} (times {gain}, rounded), read by the correlators in place",
+                    source.format()
+                );
+            }
         }
         // Until the cold start: gather its samples.
         while self.manager.cold_start_pending() {

@@ -9,10 +9,12 @@
 //! the live samples are moved to its front only when the dropped prefix is as long as they
 //! are.
 //!
-//! Samples are held as the source stores them when it can hand them over that way (complex
-//! ci8/ci16 at IF 0: [`SampleSource::integer_format`]) -- the correlators read those in place,
-//! with no conversion and a half or a quarter of the memory traffic of complex f32 -- else as
-//! complex f32. The searches, which need f32, convert the span they read.
+//! Samples are held as integers when the source can hand them over that way
+//! ([`SampleSource::integer_format`]): complex ci8/ci16 at IF 0 as stored, every other integer
+//! format (cu8, ri8, ri16, or ci8/ci16 mixed from an IF) converted to ci16 when read
+//! ([`gpsrx_samples::held_gain`]) -- the int16 correlators read those in place, with a half or
+//! a quarter of the memory traffic of complex f32 -- else as complex f32. The searches, which
+//! need f32, convert the span they read.
 
 use crate::pipeline::profile::timed;
 use gpsrx_dsp::correlator::SampleSlice;
@@ -151,6 +153,8 @@ pub struct SampleWindow {
     compact_bytes: usize,
     /// Wall time spent reading the source, s.
     read_s: f64,
+    /// The integers held are the source's values times this ([`SampleSource::integer_gain`]).
+    gain: f32,
 }
 
 impl Default for SampleWindow {
@@ -161,6 +165,7 @@ impl Default for SampleWindow {
             end_of_stream: false,
             compact_bytes: COMPACT_BYTES,
             read_s: 0.0,
+            gain: 1.0,
         }
     }
 }
@@ -236,14 +241,19 @@ impl SampleWindow {
         Self::default()
     }
 
-    /// Holds the samples of `src` as it stores them, if it can hand them over that way and
-    /// nothing is held yet (else nothing changes). Returns the format now held, if integer.
+    /// Holds the samples of `src` as the integers it hands over (as stored, or converted:
+    /// [`SampleSource::integer_format`]), if it can and nothing is held yet (else nothing
+    /// changes). Returns the format now held, if integer.
     pub fn hold_as_stored(&mut self, src: &dyn SampleSource) -> Option<IntegerFormat> {
         if each!(&self.store, b => b.len()) == 0 {
             self.store = match src.integer_format() {
                 Some(IntegerFormat::Ci8) => Store::Ci8(Buffer::default()),
                 Some(IntegerFormat::Ci16) => Store::Ci16(Buffer::default()),
                 None => Store::Cf32(Buffer::default()),
+            };
+            self.gain = match self.store {
+                Store::Cf32(_) => 1.0,
+                _ => src.integer_gain(),
             };
         }
         match self.store {
@@ -301,12 +311,25 @@ impl SampleWindow {
         self.start = index;
     }
 
+    /// The factor from the source's values to the integers held (1 for f32 and for integers
+    /// held as stored; [`gpsrx_samples::held_gain`]).
+    pub fn gain(&self) -> f32 {
+        self.gain
+    }
+
     /// Appends samples that follow the ones held (a stream pushed block by block). A window
-    /// holding integers (after a run from a source) goes over to f32 first.
+    /// holding integers (after a run from a source) goes over to f32 first (the source's
+    /// values: the integers divided by the gain).
     pub fn push(&mut self, samples: &[Complex32]) {
         if !matches!(self.store, Store::Cf32(_)) {
+            let gain = std::mem::replace(&mut self.gain, 1.0);
             let held = self.get_cf32(self.start, (self.end() - self.start) as usize);
-            let held = held.map(Cow::into_owned).unwrap_or_default();
+            let held: Vec<Complex32> = held
+                .map(Cow::into_owned)
+                .unwrap_or_default()
+                .into_iter()
+                .map(|c| c / gain)
+                .collect();
             let mut b = Buffer::default();
             b.split(held.len()).1.copy_from_slice(&held);
             b.tail = held.len();
