@@ -133,7 +133,7 @@ pub const BURST_S: f64 = 1.25;
 pub const DEFAULT_PER_SIGNAL_S: f64 = 0.005;
 
 /// The CPU time searches may spend. Searches of a satellite lost in the last `HOT_FOR_S`
-/// (re-acquisitions, see [`hot_interval_s`]) are not charged.
+/// (re-acquisitions, see `hot_interval_s`) are not charged.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SearchBudget {
     /// Refill per second of signal, CPU s (0.005: searching costs at most 0.5 % of a core

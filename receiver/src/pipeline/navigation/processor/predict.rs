@@ -15,7 +15,7 @@ impl NavigationProcessor {
     /// What is predicted of `prn` at stream time `t_stream_s` for the acquisition scheduler:
     /// with a valid fix (position, velocity, acceleration, clock drift; kept across gaps) and
     /// the satellite's ephemeris (decoded or from `--nav`), whether it is above the horizon and
-    /// its Doppler within the uncertainty of [`PredictionAnchor::at`]
+    /// its Doppler within the uncertainty of `PredictionAnchor::at`
     /// (`crate::pipeline::channels::visibility`); else nothing.
     pub fn visibility(&self, prn: u8, t_stream_s: f64) -> Visibility {
         let Some((rx, t, drift, half_width_hz)) = self.prediction_origin(t_stream_s) else {
