@@ -129,23 +129,17 @@ pub fn peak_to_noise(
     dopplers_hz: (f64, f64),
     max_periods: usize,
 ) -> Option<(f64, usize)> {
-    let correlator = Correlator::best();
-    let code = PackedCode::new(CaCode::new(prn).chips());
     let per_chip = fs_hz / CA_CHIP_RATE_HZ;
     let mut offsets = vec![0.0];
     offsets.extend(NOISE_LAGS_CHIPS.iter().map(|c| c * per_chip));
-    let mut out: Vec<Vec<Complex64>> = vec![Vec::new(); offsets.len()];
-    correlate_periods(
-        SampleSlice::Cf32(samples),
-        &mut Vec::new(),
-        &correlator,
-        &code,
+    let out = period_correlations(
+        samples,
         fs_hz,
+        prn,
         code_phase_samples,
         dopplers_hz,
         max_periods,
         &offsets,
-        &mut out,
     );
     let k = out[0].len();
     if k == 0 {
