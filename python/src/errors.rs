@@ -71,3 +71,13 @@ pub fn snapshot_error(e: &SnapshotError) -> PyErr {
         SnapshotError::Output(_) | SnapshotError::Plot(_) => PyOSError::new_err(message),
     }
 }
+
+/// Creates the output directory `dir` (and its parents), or an `OSError` naming it.
+pub(crate) fn create_out_dir(dir: &std::path::Path) -> pyo3::PyResult<()> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        pyo3::exceptions::PyOSError::new_err(format!(
+            "cannot create the output directory {}: {e}",
+            dir.display()
+        ))
+    })
+}

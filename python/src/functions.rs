@@ -12,7 +12,7 @@ use gpsrx_receiver::MemorySink;
 use gpsrx_samples::sim::Scenario;
 use num_complex::Complex32;
 use numpy::PyReadonlyArray1;
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
@@ -247,12 +247,7 @@ pub fn process_recording<'py>(
     let json = py_to_json(spec)?;
     let spec: RecordingSpec = serde_json::from_value(json)
         .map_err(|e| PyValueError::new_err(format!("recording spec: {e}")))?;
-    std::fs::create_dir_all(&out_root).map_err(|e| {
-        PyOSError::new_err(format!(
-            "cannot create the output directory {}: {e}",
-            out_root.display()
-        ))
-    })?;
+    crate::errors::create_out_dir(&out_root)?;
     let row = py.detach(|| batch::process(&spec, &out_root));
     to_py(py, &row)
 }

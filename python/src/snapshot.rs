@@ -6,7 +6,7 @@ use crate::errors::snapshot_error;
 use crate::records;
 use gpsrx_receiver::batch;
 use gpsrx_receiver::snapshot::{run_set, write_set, SnapshotSetSpec};
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -76,12 +76,7 @@ pub fn process_snapshots<'py>(
     out_root: PathBuf,
 ) -> PyResult<Bound<'py, PyAny>> {
     let spec = spec_from(spec)?;
-    std::fs::create_dir_all(&out_root).map_err(|e| {
-        PyOSError::new_err(format!(
-            "cannot create the output directory {}: {e}",
-            out_root.display()
-        ))
-    })?;
+    crate::errors::create_out_dir(&out_root)?;
     let row = py.detach(|| batch::process_snapshots(&spec, &out_root));
     to_py(py, &row)
 }
