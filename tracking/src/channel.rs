@@ -353,6 +353,12 @@ pub struct Channel {
     code_lock: CodeLockDetector,
     cn0: SmoothedNwpr,
     cn0_started: bool,
+    /// The bit edges are sought again ([`Channel::restart_bit_sync`]): the Costas gain holds
+    /// its C/N0 until the first new edge and [`COSTAS_HOLD_AFTER_EDGE_MS`] after it
+    /// (`Some(u32::MAX)` while waiting for the edge, then the milliseconds left). The
+    /// phase-lock detector's blocks straddle data-bit transitions meanwhile and read a C/N0
+    /// too low, which would raise the loop's gain and bandwidth.
+    costas_hold_ms: Option<u32>,
     cn0_window_blocks: u32,
     bit_sync: BitSync,
     /// Next integration's first sample (absolute index).
@@ -459,6 +465,7 @@ impl Channel {
             fade: FadeDetector::new(),
             code_lock: CodeLockDetector::new(cfg.cn0_lost_dbhz, cfg.lost_estimates),
             cn0_started: false,
+            costas_hold_ms: None,
             cn0_window_blocks,
             cn0: SmoothedNwpr::new(
                 1e-3,
@@ -598,8 +605,8 @@ impl Channel {
     /// did): the bit synchroniser starts again on the coming prompts; the loops keep running.
     /// A channel integrating longer than 1 ms (aligned to the old edges, so now straddling
     /// the new ones) goes back to its 1 ms loops at the frequency and Doppler rate it held; a
-    /// weak pull-in goes
-    /// back to its frequency stage, whose sums need no edges.
+    /// weak pull-in goes back to its frequency stage, whose sums need no edges. The C/N0 and
+    /// the phase-lock indicator hold until the first new edge.
     pub fn restart_bit_sync(&mut self) {
         if self.weak_stage.is_none() && (self.carrier.t_coh_s() * 1e3).round() as usize != 1 {
             // Integrations aligned to the old bit edges straddle the new ones: back to the
@@ -620,6 +627,12 @@ impl Channel {
         self.bit_sync.reset();
         self.bit_sync_origin_ms = self.ms_count;
         self.pending_bit = None;
+        // The C/N0 and phase-lock blocks are aligned to the bits: until the new edges are
+        // found the C/N0 holds its last estimate and the Costas gain its C/N0 (the lock
+        // detector still reports; the fade detector, whose blocks need no edges, flags a
+        // signal that is gone; the bit synchroniser releases a channel that finds no edges).
+        self.cn0_started = false;
+        self.costas_hold_ms = Some(u32::MAX);
     }
 
     fn advance(&mut self, n: usize) {
@@ -769,11 +782,20 @@ impl Channel {
     fn update_detectors(&mut self, p: Complex64, next_is_edge: bool) {
         self.update_cn0(p, next_is_edge);
         self.pll_lock.update(p);
-        // The carrier loop's Costas gain follows the detector's C/N0 (bit-aligned, unbiased).
-        self.carrier.set_cn0_hz(self.pll_lock.cn0_hz(1e-3));
+        match self.costas_hold_ms {
+            // The carrier loop's Costas gain follows the detector's C/N0 (bit-aligned,
+            // unbiased).
+            None => self.carrier.set_cn0_hz(self.pll_lock.cn0_hz(1e-3)),
+            Some(u32::MAX) => {}
+            Some(0) => self.costas_hold_ms = None,
+            Some(n) => self.costas_hold_ms = Some(n - 1),
+        }
         if next_is_edge {
             // Lock-detector blocks hold whole data bits (no transition cancels a block's sum).
             self.pll_lock.align_block();
+            if self.costas_hold_ms == Some(u32::MAX) {
+                self.costas_hold_ms = Some(COSTAS_HOLD_AFTER_EDGE_MS);
+            }
         }
         self.fade.push(p);
         if matches!(self.bit_sync.state(), BitSyncState::Failed) {
@@ -1110,6 +1132,11 @@ impl Channel {
         self.loops == TrackLoops::Weak
     }
 }
+
+/// How long the Costas gain keeps its C/N0 after the first new bit edge of a restarted bit
+/// synchronisation, ms: the phase-lock detector's memory then holds the unaligned blocks;
+/// its power-change test restarts it from five aligned 20 ms tests.
+const COSTAS_HOLD_AFTER_EDGE_MS: u32 = 200;
 
 /// Which of the configured tracking loops a channel runs after pull-in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

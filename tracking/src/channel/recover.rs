@@ -105,7 +105,8 @@ mod tests {
 
     /// PRN 7 at `cn0_dbhz` in unit complex noise (`A^2 fs / 2 = C/N0`), 50 bit/s data
     /// alternating in pairs, the carrier Doppler stepping by `step_hz` at `step_s`
-    /// (phase-continuous); no signal at all from `off_s` on.
+    /// (phase-continuous); no signal at all from `off_s` on; from `cut.0` s on, `cut.1` s of
+    /// signal lost (as when samples are dropped).
     struct Signal {
         code: CaCode,
         step_s: f64,
@@ -113,11 +114,13 @@ mod tests {
         off_s: f64,
         cn0_dbhz: f64,
         rng: SimRng,
+        cut: (f64, f64),
     }
 
     impl Signal {
         fn sample(&mut self, k: u64) -> Complex32 {
             let t = k as f64 / FS;
+            let t = if t >= self.cut.0 { t + self.cut.1 } else { t };
             let n = Complex64::new(self.rng.gauss(), self.rng.gauss());
             if t >= self.off_s {
                 return Complex32::new(n.re as f32, n.im as f32);
@@ -215,6 +218,7 @@ mod tests {
             step_s: 4.0,
             step_hz: 5.0,
             off_s: f64::INFINITY,
+            cut: (f64::INFINITY, 0.0),
             cn0_dbhz: 45.0,
             rng: SimRng::new(11),
         };
@@ -249,6 +253,7 @@ mod tests {
             step_s: 6.0,
             step_hz: 5.0,
             off_s: f64::INFINITY,
+            cut: (f64::INFINITY, 0.0),
             cn0_dbhz: 31.0,
             rng: SimRng::new(23),
         };
@@ -307,6 +312,7 @@ mod tests {
             step_s: f64::INFINITY,
             step_hz: 0.0,
             off_s: 2.0,
+            cut: (f64::INFINITY, 0.0),
             cn0_dbhz: 45.0,
             rng: SimRng::new(5),
         };
@@ -333,5 +339,51 @@ mod tests {
             lost.0
         );
         assert!(longest_unlocked_track(&eps) < 1.1);
+    }
+
+    /// Samples lost by 31 ms move the data-bit edges by 11 ms: the channel forgets them
+    /// ([`Channel::restart_bit_sync`]) and finds them again. Until then its C/N0 and lock
+    /// blocks would straddle data-bit transitions: the C/N0 held at its last estimate keeps a
+    /// 38 dB-Hz satellite off the weak-signal loops (20 ms at 6 Hz, which would not hold a
+    /// 10 g turn), and it tracks locked on its 1 ms loops after the new edges.
+    #[test]
+    fn a_bit_sync_restart_keeps_the_c_n0_and_the_loops() {
+        let mut sig = Signal {
+            code: CaCode::new(Prn::new(7).expect("PRN")),
+            step_s: f64::INFINITY,
+            step_hz: 0.0,
+            off_s: f64::INFINITY,
+            cut: (3.0, 0.031),
+            cn0_dbhz: 38.0,
+            rng: SimRng::new(11),
+        };
+        let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
+        let eps = run(&mut ch, &mut sig, 2.95);
+        assert!(eps
+            .last()
+            .is_some_and(|e| e.1 == ChannelState::Track && e.2));
+        assert!((ch.cn0_dbhz() - 38.0).abs() < 1.5, "{}", ch.cn0_dbhz());
+        // The receiver finds the gap a little after it.
+        let _ = run(&mut ch, &mut sig, 3.04);
+        ch.restart_bit_sync();
+        let mut lowest = f64::INFINITY;
+        let mut weak = false;
+        while ch.next_span().0 as f64 / FS < 5.0 {
+            let before = ch.next_span().0;
+            let _ = run(&mut ch, &mut sig, (before as f64 / FS) + 0.02);
+            lowest = lowest.min(ch.cn0_dbhz());
+            weak |= ch.weak_loops();
+        }
+        assert!(
+            !weak,
+            "the restart put the channel on its weak-signal loops"
+        );
+        assert!(lowest > 33.0, "C/N0 fell to {lowest:.1} dB-Hz");
+        let eps = run(&mut ch, &mut sig, 6.0);
+        assert!(eps.iter().all(|e| e.1 == ChannelState::Track));
+        assert!(
+            eps.iter().filter(|e| e.0 > 5.5).all(|e| e.2),
+            "not locked again"
+        );
     }
 }

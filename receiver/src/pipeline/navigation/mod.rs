@@ -6,12 +6,15 @@
 //!   time across lost samples, as navigation meets them; `solve`: the solution of an epoch and
 //!   its fix; `predict`: what the last fix predicts for the acquisition scheduler);
 //! - `navdata`: frame sync, subframes, ephemerides and SV time per satellite ([`NavDecoder`]);
+//! - `frame_memory`: the bits of the frames before by frame position, which place a bit stream
+//!   in time after lost samples;
 //! - `observables`: pseudoranges, carrier phase, Doppler at common receiver epochs;
 //! - `smoothing`: carrier smoothing of the pseudoranges (Hatch filter, bridged over gaps);
 //! - `fix_output`: the fix, observables and integrity verdict of an epoch, fix statistics
 //!   ([`FixStats`]).
 
 pub(crate) mod fix_output;
+mod frame_memory;
 pub(crate) mod navdata;
 pub(crate) mod observables;
 mod processor;

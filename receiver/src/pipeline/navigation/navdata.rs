@@ -13,6 +13,7 @@
 //! starts that bit left the satellite at `tow_start`; code period `m` later left it at
 //! `tow_start + (m - m0) ms`, and a point `c` chips into that period at `+ c / 1.023e6 s`.
 
+use crate::pipeline::navigation::frame_memory::FrameMemory;
 use gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
 use gpsrx_nav::atmosphere::{KlobucharParams, UtcParams};
 use gpsrx_nav::ephemeris::Ephemeris;
@@ -119,6 +120,9 @@ pub struct NavDecoder {
     /// Subframes that failed parity after frame sync.
     pub parity_failures: u32,
     consecutive_failures: u32,
+    /// The bits of the frames before, by position (kept over losses of sync): the time of a
+    /// bit stream after lost samples ([`NavDecoder::sv_time_from_frames`]).
+    frames: FrameMemory,
 }
 
 impl NavDecoder {
@@ -146,6 +150,7 @@ impl NavDecoder {
             subframes_ok: 0,
             parity_failures: 0,
             consecutive_failures: 0,
+            frames: FrameMemory::default(),
         }
     }
 
@@ -316,6 +321,7 @@ impl NavDecoder {
             }
         }
         self.bits.push_back((u8::from(value < 0), ms));
+        self.remember(ms);
         if self.carried && self.next_subframe.is_none() {
             self.align_from_time(ms, &mut events);
             return events;
@@ -344,6 +350,63 @@ impl NavDecoder {
             None => self.search(&mut events),
         }
         events
+    }
+
+    /// Keeps the newest bit, starting code period `ms`, in the frame memory when its time was
+    /// read from a HOW (not carried over a gap): bit number `TOW / 20 ms`.
+    fn remember(&mut self, ms: u64) {
+        if self.carried {
+            return;
+        }
+        let (Some(sv), Some(&(raw, _))) = (self.sv_tow_s(ms, 0.0), self.bits.back()) else {
+            return;
+        };
+        let n = (sv * 50.0).round();
+        if (sv * 50.0 - n).abs() < 0.01 && n >= 0.0 {
+            self.frames.record(n as u32, raw);
+        }
+    }
+
+    /// The SV time (TOW, s) at the start of code period `ms_count` read from the bits held
+    /// since the channel's bit sync, matched against the frames before
+    /// ([`FrameMemory::place`]) among the 20 ms bit edges whose time falls in
+    /// `[lo_s, hi_s]`: `None` until they match one edge and only one. For a time kept over
+    /// lost samples of unknown length (IS-GPS-200 20.3.2: subframes 1-3 repeat every 30 s).
+    pub fn sv_time_from_frames(&self, ms_count: u64, lo_s: f64, hi_s: f64) -> Option<f64> {
+        let &(_, m_first) = self.bits.front()?;
+        let raw: Vec<u8> = self.bits.iter().map(|&(b, _)| b).collect();
+        // The time at ms_count of the first held bit's candidate bit number c:
+        // 20 ms c + (ms_count - m_first) ms.
+        let since_s = (ms_count as f64 - m_first as f64) * 1e-3;
+        let first = ((lo_s - since_s) * 50.0).ceil() as i64;
+        let last = ((hi_s - since_s) * 50.0).floor() as i64;
+        if last < first || last - first > 1000 {
+            return None;
+        }
+        let n = self.frames.place(&raw, first, last)?;
+        let tow_s = f64::from(n) * 0.02 + since_s;
+        // Back into the window's week (a match across the week's end).
+        Some(tow_s + ((lo_s - tow_s) / 604_800.0).ceil() * 604_800.0)
+    }
+
+    /// Frame sync at a time read from the data bits ([`NavDecoder::sv_time_from_frames`]): code
+    /// period `ms_count`, a bit edge just after the newest bit held, started at SV time
+    /// `sv_tow_s`. The time counts as read from a HOW; the subframes are decoded from the
+    /// start of the one in progress if its bits are held, else from the next.
+    pub fn sync_from_frames(&mut self, ms_count: u64, sv_tow_s: f64) {
+        let n = (sv_tow_s * 50.0).round().max(0.0) as u64;
+        let into_subframe = (n % SUBFRAME_BITS as u64) as usize;
+        let held = self.bits.len();
+        let start = if into_subframe <= held {
+            held - into_subframe
+        } else {
+            held + SUBFRAME_BITS - into_subframe
+        };
+        self.hint = None;
+        self.candidate = None;
+        self.time_tag = Some((ms_count, sv_tow_s));
+        self.carried = false;
+        self.next_subframe = Some(start);
     }
 
     /// Confirms a candidate with the next TLM preamble, or looks for a subframe ending at the
@@ -479,4 +542,100 @@ pub fn current_gps_week() -> u32 {
         .unwrap_or(0.0);
     // GPS epoch 1980-01-06 is 315,964,800 s after the Unix epoch.
     (((secs - 315_964_800.0) / 604_800.0).floor().max(0.0)) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::navigation::frame_memory;
+    use gpsrx_nav::lnav::LnavEncoder;
+    use gpsrx_nav::rinex_nav::parse_rinex_nav;
+
+    /// The transmitted bits (0/1) of PRN 7 from the subframe starting at `tow0_s` (a multiple of
+    /// 6 s) for `n_subframes`, encoded from the project's broadcast file (IS-GPS-200 20.3.2).
+    fn lnav_bits(tow0_s: u32, n_subframes: u32) -> Vec<u8> {
+        let text = include_str!("../../../../samples/data/brdc0010.22n");
+        let nav = parse_rinex_nav(text).expect("the shipped broadcast file");
+        let eph = nav.ephemerides.iter().find(|e| e.prn == 7).expect("PRN 7");
+        let enc = LnavEncoder::new(eph, nav.iono.as_ref(), nav.utc.as_ref()).expect("fits");
+        (0..n_subframes)
+            .flat_map(|k| enc.subframe_bits(tow0_s + 6 * k, 2190))
+            .collect()
+    }
+
+    #[test]
+    fn a_bit_stream_after_lost_samples_is_timed_from_the_frame_before() {
+        // Frame sync on a stream starting at TOW 538 200 s (subframe 1 at 538 230 s).
+        let tow0 = 538_200;
+        let bits = lnav_bits(tow0, 15);
+        let mut dec = NavDecoder::new(7, 2190);
+        let ms0 = 1_000u64;
+        let push = |dec: &mut NavDecoder, i: usize, ms: u64, invert: bool| {
+            let b = bits[i] ^ u8::from(invert);
+            dec.push_bit(if b == 1 { -1 } else { 1 }, ms)
+        };
+        for i in 0..1800 {
+            push(&mut dec, i, ms0 + 20 * i as u64, false);
+        }
+        assert!(dec.synced());
+        // 1234 bits (24.68 s) are lost and 31 ms of stream with them: the channel's code
+        // periods go on counting, the decoder starts again, the polarity flipped.
+        dec.reset_sync();
+        let resume = 1800 + 1234; // bit 3034: the HOW of subframe 1, two frames on
+        let ms_resume = ms0 + 20 * 1800 + 11;
+        // The truth: bit `resume`; the time kept is 2.2 s off it (sought within 3 s).
+        let true_s = f64::from(tow0) + resume as f64 * 0.02;
+        let kept_s = true_s + 2.2;
+        let mut found = None;
+        for j in 0..120 {
+            let ms = ms_resume + 20 * j as u64;
+            push(&mut dec, resume + j, ms, true);
+            // The time at the next bit edge, sought within 3 s of the kept one.
+            let next = ms + 20;
+            let kept = kept_s + 20.0 * (j + 1) as f64 * 1e-3;
+            if let Some(t) = dec.sv_time_from_frames(next, kept - 3.0, kept + 3.0) {
+                found = Some((j, t, next));
+                break;
+            }
+        }
+        let (j, t, next) = found.expect("placed in the frame before");
+        let truth = true_s + 20.0 * (j + 1) as f64 * 1e-3;
+        assert!((t - truth).abs() < 1e-9, "{t} against {truth}");
+        assert!(
+            j + 1 >= frame_memory::MIN_COMPARED as usize && j < 60,
+            "after {} bits",
+            j + 1
+        );
+        // Synchronised on it: the next subframe decodes and its HOW agrees.
+        dec.sync_from_frames(next, t);
+        let mut events = Vec::new();
+        for k in (j + 1)..700 {
+            events.extend(push(&mut dec, resume + k, ms_resume + 20 * k as u64, true));
+        }
+        assert!(events
+            .iter()
+            .any(|e| matches!(e, NavEvent::Subframe { .. })));
+        assert!(!events
+            .iter()
+            .any(|e| matches!(e, NavEvent::TowMismatch { .. } | NavEvent::ParityFailure)));
+    }
+
+    #[test]
+    fn a_stream_in_subframes_4_and_5_is_not_timed_from_its_data() {
+        let tow0 = 538_200;
+        let bits = lnav_bits(tow0, 15);
+        let mut dec = NavDecoder::new(7, 2190);
+        for (i, &b) in bits.iter().take(1800).enumerate() {
+            dec.push_bit(if b == 1 { -1 } else { 1 }, 20 * i as u64);
+        }
+        dec.reset_sync();
+        // Bits 2640-2699: subframe 4 of the next frame, past its TLM.
+        let start = 2640;
+        for (j, &b) in bits[start..start + 60].iter().enumerate() {
+            dec.push_bit(if b == 1 { -1 } else { 1 }, 100_000 + 20 * j as u64);
+        }
+        let next = 100_000 + 20 * 60;
+        let t = f64::from(tow0) + (start + 60) as f64 * 0.02;
+        assert_eq!(dec.sv_time_from_frames(next, t - 3.0, t + 3.0), None);
+    }
 }

@@ -331,9 +331,18 @@ impl NavigationProcessor {
         };
         match note {
             Some(CarryNote::Refused(off_ms)) => self.on_refused(e.t_rx_s, e.prn, off_ms, sink)?,
-            Some(CarryNote::GapResolved { t_s, length_ms }) => {
+            Some(CarryNote::GapResolved {
+                t_s,
+                length_ms,
+                from_bits,
+            }) => {
+                let from = if from_bits {
+                    "the data bits, matched in the frames before"
+                } else {
+                    "the carrier-phase steps and the code at the new bit edges"
+                };
                 tracing::warn!(
-                    "{:.3} s: the samples lost at {t_s:.3} s were {length_ms:.3} ms of signal (from the carrier-phase steps and the new bit edges): SV times carried over the gap",
+                    "{:.3} s: the samples lost at {t_s:.3} s were {length_ms:.3} ms of signal (from {from}): SV times carried over the gap",
                     e.t_rx_s
                 );
                 sink.event(&ReceiverEvent::GapMeasured { t_s, length_ms })?;

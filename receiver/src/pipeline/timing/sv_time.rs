@@ -17,6 +17,14 @@ use std::collections::BTreeMap;
 /// How long the length of lost samples is sought after the code offsets may be used, s.
 pub const GAP_RESOLVE_S: f64 = 1.0;
 
+/// Satellites whose data bits must give the same length of lost samples
+/// ([`GapRecovery::note_bit_length`]).
+pub const BIT_LENGTH_SATELLITES: usize = 2;
+
+/// Longest gap sought in the data bits, ms (the bits after it are matched against the frames
+/// before at every 20 ms edge from the kept time to this much later).
+const BITS_GAP_MAX_MS: f64 = 3000.0;
+
 /// Refused carried SV times that agree: per satellite `(PRN, offset of the kept SV time from
 /// the new bit edge ms, SV time rate)`.
 pub type EdgeOffsets = Vec<(u8, f64, f64)>;
@@ -32,6 +40,9 @@ pub enum CarryNote {
         t_s: f64,
         /// Its length, ms.
         length_ms: f64,
+        /// Read from the data bits placed in the frames before (else from the carrier-phase
+        /// steps and the code at the new bit edges).
+        from_bits: bool,
     },
 }
 
@@ -61,6 +72,9 @@ pub struct GapRecovery {
     pub unresolved: bool,
     /// Receiver clock steps made while re-establishing the time, ms.
     pub stepped_ms: i64,
+    /// Per PRN: the length (ms) read from its data bits, placed in the frames before
+    /// ([`NavDecoder::sv_time_from_frames`]).
+    pub bit_lengths: BTreeMap<u8, f64>,
 }
 
 impl GapRecovery {
@@ -84,7 +98,31 @@ impl GapRecovery {
             length_ms: None,
             unresolved,
             stepped_ms: 0,
+            bit_lengths: BTreeMap::new(),
         }
+    }
+
+    /// The length read from the data bits of `prn` (ms); once [`BIT_LENGTH_SATELLITES`]
+    /// satellites agree (0.1 ms), it is the gap's length (the mean), whatever the carrier and
+    /// the code say. Returns whether that resolved it.
+    pub fn note_bit_length(&mut self, prn: u8, length_ms: f64) -> bool {
+        self.bit_lengths.insert(prn, length_ms);
+        let agreeing: Vec<f64> = self
+            .bit_lengths
+            .values()
+            .copied()
+            .filter(|l| (l - length_ms).abs() < 0.1)
+            .collect();
+        if agreeing.len() < BIT_LENGTH_SATELLITES || self.length_ms.is_some() {
+            return false;
+        }
+        let length = agreeing.iter().sum::<f64>() / agreeing.len() as f64;
+        tracing::debug!(
+            "gap length {length:.4} ms from the data bits of {} satellites placed in the frames before",
+            agreeing.len()
+        );
+        self.length_ms = Some(length);
+        true
     }
 
     /// Takes the offset `off_ms` of `prn`'s kept SV time from its new bit edge and the
@@ -432,12 +470,26 @@ impl SvTimeKeeper {
         let elapsed_s = (e.sample_index as f64 - clock.sample as f64) / fs_hz;
         let unresolved_gap = self.gap.as_ref().is_some_and(|g| g.unresolved);
         if clock.rough || unresolved_gap {
-            // Known roughly (samples may have been lost): frame sync from the first TLM and
-            // HOW whose time agrees with it.
-            if !dec.has_hint() && elapsed_s <= SV_CLOCK_HINT_S {
+            // Known roughly (samples may have been lost): frame sync from the data bits placed
+            // in the frames before, or from the first TLM and HOW whose time agrees with it.
+            if elapsed_s <= SV_CLOCK_HINT_S {
                 let sv = clock.at(e.sample_index, fs_hz)
                     - e.code_phase_chips / gpsrx_dsp::constants::CA_CHIP_RATE_HZ;
-                dec.hint_time(e.ms_count, sv, SV_CLOCK_HINT_TOLERANCE_S);
+                if e.bit_edge && (e.ms_count / 20).is_multiple_of(5) {
+                    let tol = SV_CLOCK_HINT_TOLERANCE_S;
+                    if let Some(tow) = dec.sv_time_from_frames(e.ms_count, sv - tol, sv + tol) {
+                        tracing::info!(
+                            "G{:02}: SV time read from its data bits (matched in the frames before): {:+.1} ms from the time kept",
+                            e.prn,
+                            (tow - sv) * 1e3
+                        );
+                        dec.sync_from_frames(e.ms_count, tow);
+                        return None;
+                    }
+                }
+                if !dec.has_hint() {
+                    dec.hint_time(e.ms_count, sv, SV_CLOCK_HINT_TOLERANCE_S);
+                }
             }
             return None;
         }
@@ -454,17 +506,29 @@ impl SvTimeKeeper {
                 // Across lost samples: first their length, from the offsets of the kept time
                 // from the new bit edges and the carrier-phase steps.
                 let off = nearest_remainder(edge_ms, 20.0);
-                if gap.add_edge_offset(e.prn, off, clock.rate, e.t_rx_s) {
+                // The data bits since the new bit sync, placed in the frames before: the SV
+                // time ran g r over the gap.
+                let by_bits = dec
+                    .sv_time_from_frames(
+                        e.ms_count,
+                        (edge_ms - 1.0) * 1e-3,
+                        (edge_ms + BITS_GAP_MAX_MS) * 1e-3,
+                    )
+                    .is_some_and(|sv_s| {
+                        gap.note_bit_length(e.prn, (sv_s * 1e3 - edge_ms) / clock.rate)
+                    });
+                if by_bits || gap.add_edge_offset(e.prn, off, clock.rate, e.t_rx_s) {
                     let length_ms = gap.length_ms.unwrap_or(0.0);
                     note = Some(CarryNote::GapResolved {
                         t_s: gap.t_s,
                         length_ms,
+                        from_bits: by_bits,
                     });
                     self.move_over_gap(length_ms);
                     edge_ms += length_ms;
                 } else if gap.unresolved {
                     tracing::warn!(
-                        "the length of the samples lost at {:.3} s cannot be resolved from the carrier-phase steps or the code: waiting for frame sync",
+                        "the length of the samples lost at {:.3} s cannot be resolved from the carrier-phase steps, the code or the data bits yet: waiting for frame sync",
                         gap.t_s
                     );
                     self.make_rough(None);
