@@ -20,7 +20,7 @@ pub use encoder::{
     LnavEncoder, PAGE18_SV_ID, PAGE25_SV_ID, PAGES_PER_CYCLE, PREAMBLE, SF4_PAGE_SV_IDS,
     SF5_PAGE25_SV_ID, SUBFRAMES_PER_WEEK,
 };
-pub use parity::{parity_bits, parity_check, parity_encode};
+pub use parity::{parity_bits, parity_check, parity_encode, solve_trailing_bits};
 
 /// LNAV encoding/decoding errors.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

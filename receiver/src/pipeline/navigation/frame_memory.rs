@@ -4,19 +4,24 @@
 //! LNAV (IS-GPS-200 20.3.2, 20.3.3) sends a 1500-bit frame every 30 s, aligned with the GPS week
 //! (bit `n` of the week, `n = TOW / 20 ms`, sits at position `n mod 1500` of its frame).
 //! Subframes 1-3 (positions 0-899) carry the clock and ephemeris and repeat word for word
-//! from one frame to the next while the issue of data holds (hours), except the hand-over
-//! word, whose time of week counts up; its last two bits are solved so that its parity ends in
-//! `00` (20.3.5.2), so the word after it is sent the same too. The telemetry word opens every
-//! subframe and is the same in all of them. So a bit stream after lost samples, whose receiver
-//! time is known only to within seconds, can be placed exactly: among the 20 ms positions the
-//! kept time allows, the one whose bits equal, in one polarity, the bits sent at the same
-//! frame positions one to four frames before. A stream that falls in subframes 4-5 (pages that
-//! change from frame to frame) matches only on its telemetry words and waits for them.
+//! from one frame to the next while the issue of data holds (hours). The telemetry word opens
+//! every subframe and is the same in all of them. The hand-over word that follows carries the
+//! time of week of the next subframe (20.3.3.2), 5 counts (30 s) more each frame, with its
+//! last two bits solved so that its parity ends in `00` (20.3.5.2); the word before it (the
+//! telemetry word) is the same every time, so from the hand-over word one frame before the
+//! one sent now is computed exactly ([`FrameMemory::expected_how`]), and the word after it is
+//! sent the same too. So a bit stream after lost samples, whose receiver time is known only to
+//! within seconds, can be placed exactly: among the 20 ms positions the kept time allows, the
+//! one whose bits equal, in one polarity, the bits sent at the same frame positions one to
+//! four frames before. A stream in subframes 4-5 (pages that change from frame to frame)
+//! matches on their telemetry and hand-over words only.
 //!
 //! A chance match needs every comparable bit to agree: with [`MIN_COMPARED`] bits and at most
 //! [`MAX_ERRORS`] disagreeing, `2 (1 + N) 2^-N` per candidate, under `2e-7` over the 150
 //! candidates of 3 s; a second candidate that agrees nearly as well (at most three errors: data
 //! with a period, such as a reserved field) leaves the time undecided until the stream is longer.
+
+use gpsrx_nav::lnav::{parity_check, parity_encode, solve_trailing_bits};
 
 /// Bits in a frame (5 subframes of 300 bits: 30 s).
 pub const FRAME_BITS: u32 = 1500;
@@ -36,6 +41,16 @@ pub fn repeats(p: u32) -> bool {
     let word = (p % 300) / 30;
     word == 0 || (subframe < 3 && word != 1)
 }
+
+/// Whether frame position `p` is in a hand-over word (word 2 of a subframe).
+fn in_how(p: u32) -> bool {
+    (p % 300) / 30 == 1
+}
+
+/// The 8-bit preamble that opens every telemetry word (IS-GPS-200 20.3.3.1).
+const PREAMBLE_BITS: [u8; 8] = [1, 0, 0, 0, 1, 0, 1, 1];
+/// Subframes (6 s) in a week: the hand-over word's time-of-week count wraps there.
+const TOW_COUNTS_PER_WEEK: u32 = 100_800;
 
 /// The last bit received at each position of the frame, with its bit number in the week.
 #[derive(Debug, Clone)]
@@ -73,17 +88,82 @@ impl FrameMemory {
             .then_some(raw)
     }
 
+    /// The bits (0/1 as received, D1 in bit 29) of the hand-over word of subframe `s` of the
+    /// week (its first bit is number `300 s + 30`), computed from the telemetry and hand-over
+    /// words of the same subframe one to [`MAX_FRAMES_BACK`] frames before: their polarity
+    /// from the preamble, the source bits from the parity (20.3.5.2, which must pass), the
+    /// time-of-week count advanced by 5 a frame, the two solved bits and the parity again.
+    pub fn expected_how(&self, s: u32) -> Option<u32> {
+        let word = |first: u32| -> Option<(u32, u32)> {
+            let mut w = 0u32;
+            let mut n0 = None;
+            for i in 0..30 {
+                let (n, b) = self.slots[((first + i) % FRAME_BITS) as usize]?;
+                let n_first = n.checked_sub(i)?;
+                if *n0.get_or_insert(n_first) != n_first {
+                    return None;
+                }
+                w = (w << 1) | u32::from(b);
+            }
+            Some((n0?, w))
+        };
+        let first = (s * 300) % WEEK_BITS;
+        let (n_tlm, tlm) = word(first)?;
+        let (n_how, how) = word(first + 30)?;
+        let back = (first + WEEK_BITS - n_tlm) % WEEK_BITS;
+        if n_how != n_tlm + 30
+            || back % FRAME_BITS != 0
+            || !(FRAME_BITS..=MAX_FRAMES_BACK * FRAME_BITS).contains(&back)
+        {
+            return None;
+        }
+        let preamble = tlm >> 22;
+        let expected: u32 = PREAMBLE_BITS.iter().fold(0, |w, &b| (w << 1) | u32::from(b));
+        let invert = match preamble {
+            p if p == expected => false,
+            p if p == (!expected & 0xFF) => true,
+            _ => return None,
+        };
+        let flip = |w: u32| if invert { w ^ 0x3FFF_FFFF } else { w };
+        let tlm = flip(tlm);
+        let (d29, d30) = (tlm & 0b10 != 0, tlm & 0b1 != 0);
+        let data = parity_check(flip(how), d29, d30)?;
+        let tow = ((data >> 7) + 5 * (back / FRAME_BITS)) % TOW_COUNTS_PER_WEEK;
+        let data = solve_trailing_bits((tow << 7) | (data & 0x7F), d29, d30);
+        Some(flip(parity_encode(data, d29, d30)))
+    }
+
     /// The bit number of the first of `bits` (consecutive bits, 0/1 as received), among the
     /// candidates `first..=last` (bit numbers, may exceed a week), found by matching them
     /// against the frames before (module documentation): `None` while no candidate matches
     /// or more than one does.
     pub fn place(&self, bits: &[u8], first: i64, last: i64) -> Option<u32> {
         let mut found = None;
+        // The hand-over words computed so far: (subframe of the week, word).
+        let mut hows: Vec<(u32, Option<u32>)> = Vec::new();
+        let mut how_bit = |n: u32| -> Option<u8> {
+            let s = n / 300;
+            let w = match hows.iter().find(|h| h.0 == s) {
+                Some(h) => h.1,
+                None => {
+                    let w = self.expected_how(s);
+                    hows.push((s, w));
+                    w
+                }
+            }?;
+            Some(((w >> (29 - (n % 300 - 30))) & 1) as u8)
+        };
         for c in first..=last {
             let c = c.rem_euclid(i64::from(WEEK_BITS)) as u32;
             let (mut compared, mut agree) = (0u32, 0u32);
             for (j, &b) in bits.iter().enumerate() {
-                if let Some(e) = self.expected(c + j as u32) {
+                let n = (c + j as u32) % WEEK_BITS;
+                let e = if in_how(n % FRAME_BITS) {
+                    how_bit(n)
+                } else {
+                    self.expected(n)
+                };
+                if let Some(e) = e {
                     compared += 1;
                     agree += u32::from(e == b);
                 }
@@ -161,10 +241,10 @@ mod tests {
     }
 
     #[test]
-    fn hand_over_words_and_subframes_4_and_5_are_not_compared() {
+    fn subframes_4_and_5_past_their_tlm_and_how_are_not_compared() {
         let n0 = 3 * FRAME_BITS;
         let (mem, next) = frames(11, n0);
-        // Bits of subframe 4 beyond its TLM: nothing to compare, no time.
+        // Bits of subframe 4 beyond its TLM and HOW: nothing to compare, no time.
         let n = n0 + FRAME_BITS + 940;
         assert_eq!(
             mem.place(&next[940..1100], i64::from(n) - 50, i64::from(n) + 50),

@@ -638,4 +638,31 @@ mod tests {
         let t = f64::from(tow0) + (start + 60) as f64 * 0.02;
         assert_eq!(dec.sv_time_from_frames(next, t - 3.0, t + 3.0), None);
     }
+
+    #[test]
+    fn the_hand_over_word_is_computed_from_the_frame_before() {
+        let tow0 = 538_200;
+        let bits = lnav_bits(tow0, 20);
+        let n0 = tow0 * 50;
+        // One frame received in inverted polarity.
+        let mut mem = FrameMemory::default();
+        for (j, &b) in bits.iter().take(1500).enumerate() {
+            mem.record(n0 + j as u32, b ^ 1);
+        }
+        let word = |first: usize| -> u32 {
+            bits[first..first + 30]
+                .iter()
+                .fold(0, |w, &b| (w << 1) | u32::from(b ^ 1))
+        };
+        // The HOWs the encoder sends one to three frames later, every subframe ID.
+        for later in [5u32, 6, 7, 8, 9, 13, 19] {
+            let s = n0 / 300 + later;
+            let how = word(later as usize * 300 + 30);
+            assert_eq!(mem.expected_how(s), Some(how), "subframe {later}");
+        }
+        // Five frames later: too old; a HOW that fails parity: none.
+        assert_eq!(mem.expected_how(n0 / 300 + 25), None);
+        mem.record(n0 + 40, bits[40]);
+        assert_eq!(mem.expected_how(n0 / 300 + 5), None);
+    }
 }
