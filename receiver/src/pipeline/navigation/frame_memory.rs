@@ -112,13 +112,15 @@ impl FrameMemory {
         let (n_how, how) = word(first + 30)?;
         let back = (first + WEEK_BITS - n_tlm) % WEEK_BITS;
         if n_how != n_tlm + 30
-            || back % FRAME_BITS != 0
+            || !back.is_multiple_of(FRAME_BITS)
             || !(FRAME_BITS..=MAX_FRAMES_BACK * FRAME_BITS).contains(&back)
         {
             return None;
         }
         let preamble = tlm >> 22;
-        let expected: u32 = PREAMBLE_BITS.iter().fold(0, |w, &b| (w << 1) | u32::from(b));
+        let expected: u32 = PREAMBLE_BITS
+            .iter()
+            .fold(0, |w, &b| (w << 1) | u32::from(b));
         let invert = match preamble {
             p if p == expected => false,
             p if p == (!expected & 0xFF) => true,
