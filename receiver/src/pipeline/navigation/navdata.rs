@@ -373,8 +373,10 @@ impl NavDecoder {
     /// `[lo_s, hi_s]`: `None` until they match one edge and only one. For a time kept over
     /// lost samples of unknown length (IS-GPS-200 20.3.2: subframes 1-3 repeat every 30 s).
     pub fn sv_time_from_frames(&self, ms_count: u64, lo_s: f64, hi_s: f64) -> Option<f64> {
-        let &(_, m_first) = self.bits.front()?;
-        let raw: Vec<u8> = self.bits.iter().map(|&(b, _)| b).collect();
+        // The newest 300 bits at most (a subframe: enough, and the cost bounded).
+        let skip = self.bits.len().saturating_sub(SUBFRAME_BITS);
+        let &(_, m_first) = self.bits.get(skip)?;
+        let raw: Vec<u8> = self.bits.iter().skip(skip).map(|&(b, _)| b).collect();
         // The time at ms_count of the first held bit's candidate bit number c:
         // 20 ms c + (ms_count - m_first) ms.
         let since_s = (ms_count as f64 - m_first as f64) * 1e-3;
