@@ -633,6 +633,14 @@ impl Channel {
         // signal that is gone; the bit synchroniser releases a channel that finds no edges).
         self.cn0_started = false;
         self.costas_hold_ms = Some(u32::MAX);
+        // The estimates since the samples were lost (before the gap was found) read the moved
+        // bits already: the level the signal had stands, and decides the loops.
+        if self.tracked_cn0_dbhz.is_finite() && self.tracked_cn0_dbhz > self.cn0_dbhz {
+            self.cn0_dbhz = self.tracked_cn0_dbhz;
+            if self.cn0_dbhz > self.cfg.weak_leave_dbhz {
+                self.weak = false;
+            }
+        }
     }
 
     fn advance(&mut self, n: usize) {

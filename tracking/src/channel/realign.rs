@@ -125,6 +125,10 @@ impl Channel {
             self.loops = which;
         }
         self.weak = false;
+        // A narrowing under way aims at the loops left behind (the weak ones, switched to a
+        // moment before on a C/N0 the moved bits had already lowered): it ends here, or it
+        // would narrow the 1 ms loops to the weak-signal ones at the first new bit edge.
+        self.narrowing = None;
         self.cn0.reset();
         self.cn0_started = false;
         Some(())

@@ -341,6 +341,45 @@ mod tests {
         assert!(longest_unlocked_track(&eps) < 1.1);
     }
 
+    /// A satellite at 34 dB-Hz, 2 dB over the weak-signal threshold: the C/N0 estimates
+    /// between lost samples and their detection straddle the moved bits and fall below it, so
+    /// the channel starts narrowing to its weak-signal loops (20 ms, 6 Hz) at the next old bit
+    /// edge. The restart of the bit synchronisation that follows puts it back on its 1 ms loops
+    /// and must end that narrowing too (it used to go on at the first new edge: a 37 dB-Hz
+    /// satellite on 6 Hz loops in a 10 g turn, lost seconds later). From the restart on every
+    /// interval is 1 ms, and the C/N0 stands at the level before the gap.
+    #[test]
+    fn a_bit_sync_restart_ends_a_narrowing_begun_on_the_moved_bits() {
+        let mut sig = Signal {
+            code: CaCode::new(Prn::new(7).expect("PRN")),
+            step_s: f64::INFINITY,
+            step_hz: 0.0,
+            off_s: f64::INFINITY,
+            cut: (3.0, 0.031),
+            cn0_dbhz: 34.0,
+            rng: SimRng::new(5),
+        };
+        let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
+        let _ = run(&mut ch, &mut sig, 2.95);
+        assert!(!ch.weak_loops() && !ch.narrowing(), "weak before the gap");
+        // Found late: the estimates of 0.15 s read the moved bits.
+        let _ = run(&mut ch, &mut sig, 3.15);
+        ch.restart_bit_sync();
+        assert!(ch.cn0_dbhz() > 32.5, "C/N0 {:.1} dB-Hz", ch.cn0_dbhz());
+        let mut longest_ms = 0.0f64;
+        while ch.next_span().0 as f64 / FS < 5.0 {
+            let (start, n) = ch.next_span();
+            let x: Vec<Complex32> = (start..start + n as u64).map(|k| sig.sample(k)).collect();
+            if let Some(e) = ch.process_code_period(&x) {
+                longest_ms = longest_ms.max(e.t_coh_s * 1e3);
+            }
+        }
+        assert!(
+            longest_ms < 1.5,
+            "integrations of {longest_ms} ms after the restart"
+        );
+    }
+
     /// Samples lost by 31 ms move the data-bit edges by 11 ms: the channel forgets them
     /// ([`Channel::restart_bit_sync`]) and finds them again. Until then its C/N0 and lock
     /// blocks would straddle data-bit transitions: the C/N0 held at its last estimate keeps a
