@@ -86,21 +86,28 @@ pub(super) struct LanePlan<const L: usize> {
 }
 
 impl<const L: usize> LanePlan<L> {
-    /// The plan for the taps of `nco` (`n_taps`), compare lane `j` serving the sample at
-    /// position `cmp_position[j]` of `positions`; thresholds XORed with `flip`. `None` if some
-    /// lane lies 16 or more chips past its tap's window.
-    pub(super) fn new(
+    /// An all-zero plan, to be [`LanePlan::fill`]ed.
+    pub(super) const ZERO: Self = Self {
+        thr: [[0; L]; MAX_TAPS],
+        hi_dup: [[0; L]; MAX_TAPS],
+        whole: [0; MAX_TAPS],
+    };
+
+    /// Writes the plan for the taps of `nco` (`n_taps`) in place, compare lane `j` serving the
+    /// sample at position `cmp_position[j]` of `positions`; thresholds XORed with `flip`.
+    /// `false` if some lane lies 16 or more chips past its tap's window (the plan is then
+    /// unusable). Only the first `n_taps` taps are written: a kernel of `n_taps` taps reads no
+    /// other, so a plan kept from call to call (see `with_plan` in the kernels) is neither
+    /// zeroed nor moved per call (1.5 KB at 32 lanes: with the zeroing and the move of a plan
+    /// returned by value, 4-5 % of a 4 MHz run's CPU time).
+    pub(super) fn fill(
+        &mut self,
         nco: &CodeNco,
         n_taps: usize,
         positions: &[usize; L],
         cmp_position: impl Fn(usize) -> usize,
         flip: u32,
-    ) -> Option<Self> {
-        let mut plan = Self {
-            thr: [[0; L]; MAX_TAPS],
-            hi_dup: [[0; L]; MAX_TAPS],
-            whole: [0; MAX_TAPS],
-        };
+    ) -> bool {
         // Each compare lane's position and `o S` (below 32 * 1023 * 2^32 < 2^47: no overflow).
         let mut pos = [0usize; L];
         let mut o_s = [0u64; L];
@@ -113,18 +120,19 @@ impl<const L: usize> LanePlan<L> {
         let b0 = nco.phases[0];
         for t in 0..n_taps.min(MAX_TAPS) {
             let delta = (nco.phases[t] + CODE_LEN_FIX - b0) % CODE_LEN_FIX;
-            plan.whole[t] = (delta >> 32) as usize;
+            self.whole[t] = (delta >> 32) as usize;
             let frac = delta & 0xFFFF_FFFF;
             if (frac + last) >> 32 > MAX_OFFSET {
-                return None;
+                return false;
             }
+            let (thr, hi_dup) = (&mut self.thr[t], &mut self.hi_dup[t]);
             for j in 0..L {
                 let l = frac + o_s[j];
-                plan.thr[t][j] = !(l as u32) ^ flip;
-                plan.hi_dup[t][pos[j]] = ((l >> 32) as u16 * 0x0101) as i16;
+                thr[j] = !(l as u32) ^ flip;
+                hi_dup[pos[j]] = ((l >> 32) as u16 * 0x0101) as i16;
             }
         }
-        Some(plan)
+        true
     }
 }
 
