@@ -48,6 +48,8 @@ pub(super) struct Plan16 {
     code: LanePlan<L>,
     /// The sample each rotator lane (A then B) is seeded at.
     rotator: [usize; L],
+    /// The sample format `rotator` is for (`u8::MAX`: none yet).
+    format: u8,
 }
 
 impl Plan16 {
@@ -55,6 +57,7 @@ impl Plan16 {
     const ZERO: Self = Self {
         code: LanePlan::ZERO,
         rotator: [0; L],
+        format: u8::MAX,
     };
 
     /// Runs `f` with the plan for the taps of `nco` (`n_taps`) on samples of format `F` (ci8
@@ -81,7 +84,10 @@ impl Plan16 {
         } else {
             ci8_positions::<L>()
         };
-        self.rotator = rotator_order(&positions);
+        if self.format != F {
+            self.rotator = rotator_order(&positions);
+            self.format = F;
+        }
         // Compare lane j (vectors A, B) lands on the position vpackssdw puts it.
         self.code
             .fill(nco, n_taps, &positions, pack_position::<L>, 0x8000_0000)

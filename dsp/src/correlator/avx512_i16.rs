@@ -40,6 +40,8 @@ pub(super) struct Plan32 {
     code: LanePlan<L>,
     /// The sample each rotator lane (A then B) is seeded at.
     rotator: [usize; L],
+    /// The sample format `rotator` is for (`u8::MAX`: none yet).
+    format: u8,
 }
 
 impl Plan32 {
@@ -47,6 +49,7 @@ impl Plan32 {
     const ZERO: Self = Self {
         code: LanePlan::ZERO,
         rotator: [0; L],
+        format: u8::MAX,
     };
 
     /// Runs `f` with the plan for the taps of `nco` (`n_taps`) on samples of format `F` (ci8
@@ -73,7 +76,10 @@ impl Plan32 {
         } else {
             ci8_positions::<L>()
         };
-        self.rotator = rotator_order(&positions);
+        if self.format != F {
+            self.rotator = rotator_order(&positions);
+            self.format = F;
+        }
         // Compare lane j sets mask bit j: position j. Unsigned compares: no sign flip.
         self.code.fill(nco, n_taps, &positions, |j| j, 0)
     }

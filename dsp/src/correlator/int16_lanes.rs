@@ -94,10 +94,11 @@ impl<const L: usize> LanePlan<L> {
     };
 
     /// Writes the plan for the taps of `nco` (`n_taps`) in place, compare lane `j` serving the
-    /// sample at position `cmp_position[j]` of `positions`; thresholds XORed with `flip`.
+    /// sample at position `cmp_position(j)` of `positions` (`cmp_position` a permutation of
+    /// `0..L`); thresholds XORed with `flip`.
     /// `false` if some lane lies 16 or more chips past its tap's window (the plan is then
     /// unusable). Only the first `n_taps` taps are written: a kernel of `n_taps` taps reads no
-    /// other, so a plan kept from call to call (see `with_plan` in the kernels) is neither
+    /// other, so a plan kept from call to call (see `Plan32::with` and `Plan16::with`) is neither
     /// zeroed nor moved per call (1.5 KB at 32 lanes: with the zeroing and the move of a plan
     /// returned by value, 4-5 % of a 4 MHz run's CPU time).
     pub(super) fn fill(
@@ -108,12 +109,16 @@ impl<const L: usize> LanePlan<L> {
         cmp_position: impl Fn(usize) -> usize,
         flip: u32,
     ) -> bool {
-        // Each compare lane's position and `o S` (below 32 * 1023 * 2^32 < 2^47: no overflow).
-        let mut pos = [0usize; L];
+        // `o S` per position and per compare lane (below 32 * 1023 * 2^32 < 2^47: no
+        // overflow). `cmp_position` is a permutation, so the offsets written per position
+        // below are those of the compare lanes serving them: two contiguous loops, no scatter.
+        let mut pos_s = [0u64; L];
+        for (s, &o) in pos_s.iter_mut().zip(positions) {
+            *s = o as u64 * nco.step;
+        }
         let mut o_s = [0u64; L];
-        for j in 0..L {
-            pos[j] = cmp_position(j);
-            o_s[j] = positions[pos[j]] as u64 * nco.step;
+        for (j, s) in o_s.iter_mut().enumerate() {
+            *s = pos_s[cmp_position(j)];
         }
         // The last sample of a step is the furthest from its window.
         let last = (L as u64 - 1) * nco.step;
@@ -125,11 +130,11 @@ impl<const L: usize> LanePlan<L> {
             if (frac + last) >> 32 > MAX_OFFSET {
                 return false;
             }
-            let (thr, hi_dup) = (&mut self.thr[t], &mut self.hi_dup[t]);
-            for j in 0..L {
-                let l = frac + o_s[j];
-                thr[j] = !(l as u32) ^ flip;
-                hi_dup[pos[j]] = ((l >> 32) as u16 * 0x0101) as i16;
+            for (thr, &s) in self.thr[t].iter_mut().zip(&o_s) {
+                *thr = !((frac + s) as u32) ^ flip;
+            }
+            for (hi, &s) in self.hi_dup[t].iter_mut().zip(&pos_s) {
+                *hi = (((frac + s) >> 32) as u16 * 0x0101) as i16;
             }
         }
         true
