@@ -1,6 +1,6 @@
 //! The element-wise loops of a search compiled a second time for AVX2, taken when the CPU has
 //! it: the build targets baseline x86-64 (SSE2), where these loops ran four lanes wide or,
-//! for the rounding of [`quantize`], one value at a time through `roundf`.
+//! for the rounding of [`super::spectra::quantize`], one value at a time through `roundf`.
 //!
 //! Each AVX2 version is the very same Rust body (`#[inline(always)]` into a
 //! `#[target_feature(enable = "avx2")]` function): the same operations on each element in the
