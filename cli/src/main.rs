@@ -13,6 +13,7 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     return_large_blocks_to_the_system();
+    main_thread_in_the_pool();
     let cli = Cli::parse();
     let filter = tracing_subscriber::EnvFilter::try_from_env("GPSRX_LOG").unwrap_or_else(|_| {
         tracing_subscriber::EnvFilter::new(if cli.verbose { "debug" } else { "info" })
@@ -49,6 +50,21 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The rayon pool takes the main thread as one of its threads (one spawned thread fewer:
+/// the default pool size, one per core, counts it). The main thread calls the rounds of
+/// `gpsrx run` (channels beside a search, `rayon::join`) and runs the navigation between them;
+/// as one of the pool's threads it works on its own rounds instead of waking the pool and
+/// sleeping until the pool wakes it again, and one thread fewer spins idle between rounds
+/// (measured: 60 s of 4 MHz ci8 with the defaults, process CPU 2.91 -> 2.79 s, medians of 5
+/// interleaved runs, outputs identical).
+/// If the pool cannot be made so (it exists already, or a thread cannot be spawned), rayon
+/// makes its default pool when it is first used, as without this.
+fn main_thread_in_the_pool() {
+    let _ = rayon::ThreadPoolBuilder::new()
+        .use_current_thread()
+        .build_global();
 }
 
 /// Large blocks (1 MiB and more: the block spectra and grids of a search, the sample window)

@@ -4,6 +4,7 @@
 use super::engine::{AcquisitionEngine, Scratch};
 use super::input::copy_cf32;
 use super::spectra::{quantize, Spectra};
+use super::wide::add_power;
 use crate::constants::F_L1_HZ;
 use crate::correlator::SampleSlice;
 use crate::Prn;
@@ -123,12 +124,8 @@ impl AcquisitionEngine {
                 let shift = (ideal - l.block_start_sample(ms) as f64) - ideal * f_hz / F_L1_HZ;
                 let rs = ((shift / l.lag_samples).round() as i64).rem_euclid(m as i64) as usize;
                 let first = lags.min(m - rs);
-                for (g, y) in grid_row[..first].iter_mut().zip(&buf[rs..rs + first]) {
-                    *g += power_scale * y.norm_sqr();
-                }
-                for (g, y) in grid_row[first..].iter_mut().zip(&buf[..lags - first]) {
-                    *g += power_scale * y.norm_sqr();
-                }
+                add_power(&mut grid_row[..first], &buf[rs..rs + first], power_scale);
+                add_power(&mut grid_row[first..], &buf[..lags - first], power_scale);
             }
         }
     }

@@ -1,6 +1,7 @@
 //! Reading a search grid: peak, noise floor, peak-to-second-peak ratio and sub-cell
 //! interpolation of the peak in code phase and Doppler; the cross-correlation check.
 
+use super::wide::first_max;
 use super::AcqResult;
 use crate::Prn;
 
@@ -42,17 +43,7 @@ pub(crate) fn analyse(
 ) -> Peak {
     // The window starts around the raw maximum; if a cell elsewhere is larger relative to its
     // row's floor (the raw maximum sat on a raised row), the window moves there once.
-    let raw_max = grid
-        .iter()
-        .enumerate()
-        .fold((f32::NEG_INFINITY, 0usize), |b, (i, &v)| {
-            if v > b.0 {
-                (v, i)
-            } else {
-                b
-            }
-        })
-        .1;
+    let raw_max = first_max(grid).1;
     let lags = lags.max(1);
     let mut centre = raw_max % lags;
     let window = (2 * exclusion + 1).min(lags);
@@ -74,7 +65,7 @@ pub(crate) fn analyse(
         (peak, row, lag) = (0.0, 0, centre);
         for (r, (cells, &floor)) in grid.chunks_exact(lags).zip(floors.iter()).enumerate() {
             // The row's largest cell (the first of equals), then its ratio to the floor.
-            let (l, v) = row_max(cells.iter().copied().enumerate());
+            let (v, l) = first_max(cells);
             let x = f64::from(v) / floor;
             if x > peak {
                 (peak, row, lag) = (x, r, l);

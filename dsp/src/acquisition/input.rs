@@ -7,21 +7,9 @@ use num_complex::Complex32;
 
 /// Writes samples `from..from + out.len()` of `src` into `out` as complex f32 (integers are
 /// exact in f32). Panics if the range is outside `src` (the engine checks lengths first).
+/// (AVX2-wide where the CPU has it: [`super::wide`].)
 pub(super) fn copy_cf32(src: SampleSlice<'_>, from: usize, out: &mut [Complex32]) {
-    let to = from + out.len();
-    match src {
-        SampleSlice::Cf32(x) => out.copy_from_slice(&x[from..to]),
-        SampleSlice::Ci8(x) => {
-            for (o, &[i, q]) in out.iter_mut().zip(&x[from..to]) {
-                *o = Complex32::new(f32::from(i), f32::from(q));
-            }
-        }
-        SampleSlice::Ci16(x) => {
-            for (o, &[i, q]) in out.iter_mut().zip(&x[from..to]) {
-                *o = Complex32::new(f32::from(i), f32::from(q));
-            }
-        }
-    }
+    super::wide::copy_cf32(src, from, out);
 }
 
 /// Samples `from..to` of `src` as complex f32: borrowed when held so, else converted into

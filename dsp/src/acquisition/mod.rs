@@ -129,6 +129,7 @@ mod refine;
 mod replica;
 mod spectra;
 pub mod stats;
+mod wide;
 
 pub use config::{
     AcqConfig, AcqError, MAX_COHERENT_MS, MAX_DOPPLER_SUBDIVISION, SEARCH_SAMPLES_PER_MS,

@@ -41,21 +41,18 @@ impl Spectra {
     }
 }
 
-/// Stores `src` into `dst` (same length) as integers; returns the scale.
+/// Stores `src` into `dst` (same length) as integers; returns the scale (AVX2-wide loops where
+/// the CPU has it: [`super::wide`]).
 pub(super) fn quantize(src: &[Complex32], dst: &mut [[i16; 2]]) -> f32 {
-    let peak = src
-        .iter()
-        .fold(0.0f32, |m, x| m.max(x.re.abs()).max(x.im.abs()));
+    let peak = super::wide::peak_component(src);
     if !(peak > 0.0 && peak.is_finite()) {
         dst.fill([0, 0]);
         return 0.0;
     }
     let scale = peak / f32::from(i16::MAX);
     let inv = 1.0 / scale;
-    for (d, x) in dst.iter_mut().zip(src) {
-        // |x / scale| <= 32767 (rounding stays within i16).
-        *d = [(x.re * inv).round() as i16, (x.im * inv).round() as i16];
-    }
+    // |x / scale| <= 32767 (rounding stays within i16).
+    super::wide::round_scaled(src, inv, dst);
     scale
 }
 

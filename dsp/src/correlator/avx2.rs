@@ -79,30 +79,24 @@ impl Avx2Kernel {
         let carrier = CarrierNco::new(state, fs_hz);
         // SAFETY (both calls): `self` exists only if the CPU check of `new` passed; pointer
         // and length come from one slice of the named format.
-        match samples {
-            SampleSlice::Ci8(x) => {
-                let Some(plan) = avx2_i16::Plan16::new::<CI8>(&nco, taps.len()) else {
-                    return false;
-                };
+        let done = match samples {
+            SampleSlice::Ci8(x) => avx2_i16::Plan16::with::<CI8, _>(&nco, taps.len(), |plan| {
                 let sh = avx2_i16::CI8_SHIFT;
                 let p = x.as_ptr().cast();
                 unsafe {
-                    avx2_i16::correlate::<CI8>(p, x.len(), sh, code, &nco, &carrier, &plan, out)
-                };
-            }
-            SampleSlice::Ci16(x) => {
-                let Some(plan) = avx2_i16::Plan16::new::<CI16>(&nco, taps.len()) else {
-                    return false;
-                };
-                let sh = unsafe { avx2_i16::ci16_block_shift(x) };
+                    avx2_i16::correlate::<CI8>(p, x.len(), sh, code, &nco, &carrier, plan, out)
+                }
+            }),
+            SampleSlice::Ci16(x) => avx2_i16::Plan16::with::<CI16, _>(&nco, taps.len(), |plan| {
                 let p = x.as_ptr().cast();
                 unsafe {
-                    avx2_i16::correlate::<CI16>(p, x.len(), sh, code, &nco, &carrier, &plan, out)
-                };
-            }
-            SampleSlice::Cf32(_) => return false,
-        }
-        true
+                    let sh = avx2_i16::ci16_block_shift(x);
+                    avx2_i16::correlate::<CI16>(p, x.len(), sh, code, &nco, &carrier, plan, out)
+                }
+            }),
+            SampleSlice::Cf32(_) => None,
+        };
+        done.is_some()
     }
 }
 

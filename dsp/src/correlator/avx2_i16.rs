@@ -26,7 +26,7 @@
 //! - Lane sums grow by at most `2 * 2^15` per step: flushed to i64 every 256 steps (with the
 //!   rotator's re-seed), far below 2^31.
 //!
-//! Needs 16 samples within 15 chips (`fs` above about 1.1 MHz); otherwise [`Plan16::new`]
+//! Needs 16 samples within 15 chips (`fs` above about 1.1 MHz); otherwise [`Plan16::with`]
 //! says no and the caller runs the 8-lane kernel.
 
 use super::int16_lanes::{
@@ -48,28 +48,54 @@ pub(super) struct Plan16 {
     code: LanePlan<L>,
     /// The sample each rotator lane (A then B) is seeded at.
     rotator: [usize; L],
+    /// The sample format `rotator` is for (`u8::MAX`: none yet).
+    format: u8,
 }
 
 impl Plan16 {
-    /// The plan for the taps of `nco` (`n_taps`) on samples of format `F` (ci8 or ci16), or
-    /// `None` if some lane lies 16 or more chips past its tap's window.
-    pub(super) fn new<const F: u8>(nco: &CodeNco, n_taps: usize) -> Option<Self> {
+    /// An all-zero plan, to be filled.
+    const ZERO: Self = Self {
+        code: LanePlan::ZERO,
+        rotator: [0; L],
+        format: u8::MAX,
+    };
+
+    /// Runs `f` with the plan for the taps of `nco` (`n_taps`) on samples of format `F` (ci8
+    /// or ci16), or returns `None` if some lane lies 16 or more chips past its tap's window.
+    /// The plan is written in place into one kept per thread ([`LanePlan::fill`]).
+    pub(super) fn with<const F: u8, R>(
+        nco: &CodeNco,
+        n_taps: usize,
+        f: impl FnOnce(&Self) -> R,
+    ) -> Option<R> {
+        thread_local! {
+            static PLAN: std::cell::RefCell<Plan16> = const { std::cell::RefCell::new(Plan16::ZERO) };
+        }
+        PLAN.with(|plan| {
+            let mut plan = plan.try_borrow_mut().ok()?;
+            plan.fill::<F>(nco, n_taps).then(|| f(&plan))
+        })
+    }
+
+    /// Writes the plan in place (see [`Plan16::with`]); `false` if it cannot be made.
+    fn fill<const F: u8>(&mut self, nco: &CodeNco, n_taps: usize) -> bool {
         let positions = if F == CI16 {
             ci16_positions::<L>()
         } else {
             ci8_positions::<L>()
         };
+        if self.format != F {
+            self.rotator = rotator_order(&positions);
+            self.format = F;
+        }
         // Compare lane j (vectors A, B) lands on the position vpackssdw puts it.
-        let code = LanePlan::new(nco, n_taps, &positions, pack_position::<L>, 0x8000_0000)?;
-        Some(Self {
-            code,
-            rotator: rotator_order(&positions),
-        })
+        self.code
+            .fill(nco, n_taps, &positions, pack_position::<L>, 0x8000_0000)
     }
 }
 
 /// Runs the kernel for `out.len()` (1..=8) taps on the `n` samples of format `F` at `data`
-/// with the plan from [`Plan16::new`] (of the same format).
+/// with the plan from [`Plan16::with`] (of the same format).
 ///
 /// # Safety
 /// The CPU must support AVX2 and FMA; `data` must hold `n` samples of format `F`.

@@ -67,45 +67,42 @@ impl Avx512Kernel {
             // SAFETY (every call): `self.vnni` is set only if the CPU has AVX-512 VNNI, and
             // `self` only exists if it has AVX-512 F, BW, AVX2 and FMA; pointer and length
             // come from one slice of the named format.
-            match samples {
-                SampleSlice::Ci8(x) => {
-                    if let Some(plan) = avx512_i16::Plan32::new::<CI8>(&nco, nt) {
-                        let (p, sh) = (x.as_ptr().cast(), avx2_i16::CI8_SHIFT);
-                        unsafe {
-                            avx512_i16::correlate::<CI8>(
-                                p,
-                                x.len(),
-                                sh,
-                                code,
-                                &nco,
-                                &carrier,
-                                &plan,
-                                out,
-                            )
-                        };
-                        return true;
+            let done = match samples {
+                SampleSlice::Ci8(x) => avx512_i16::Plan32::with::<CI8, _>(&nco, nt, |plan| {
+                    let (p, sh) = (x.as_ptr().cast(), avx2_i16::CI8_SHIFT);
+                    unsafe {
+                        avx512_i16::correlate::<CI8>(
+                            p,
+                            x.len(),
+                            sh,
+                            code,
+                            &nco,
+                            &carrier,
+                            plan,
+                            out,
+                        )
                     }
-                }
-                SampleSlice::Ci16(x) => {
-                    if let Some(plan) = avx512_i16::Plan32::new::<CI16>(&nco, nt) {
-                        let p = x.as_ptr().cast();
-                        unsafe {
-                            let sh = avx2_i16::ci16_block_shift(x);
-                            avx512_i16::correlate::<CI16>(
-                                p,
-                                x.len(),
-                                sh,
-                                code,
-                                &nco,
-                                &carrier,
-                                &plan,
-                                out,
-                            )
-                        };
-                        return true;
+                }),
+                SampleSlice::Ci16(x) => avx512_i16::Plan32::with::<CI16, _>(&nco, nt, |plan| {
+                    let p = x.as_ptr().cast();
+                    unsafe {
+                        let sh = avx2_i16::ci16_block_shift(x);
+                        avx512_i16::correlate::<CI16>(
+                            p,
+                            x.len(),
+                            sh,
+                            code,
+                            &nco,
+                            &carrier,
+                            plan,
+                            out,
+                        )
                     }
-                }
+                }),
                 SampleSlice::Cf32(_) => return false,
+            };
+            if done.is_some() {
+                return true;
             }
         }
         self.avx2

@@ -20,7 +20,7 @@
 //!   rotator's re-seed).
 //!
 //! Needs 32 samples within 15 chips (a code step below 14/31 chip per sample, `fs` above
-//! about 2.2 MHz); otherwise [`Plan32::new`] says no and the caller runs the 16-lane AVX2
+//! about 2.2 MHz); otherwise [`Plan32::with`] says no and the caller runs the 16-lane AVX2
 //! kernel.
 
 use super::int16_lanes::{ci16_positions, ci8_positions, rotator_order, w_unit, LanePlan};
@@ -40,28 +40,53 @@ pub(super) struct Plan32 {
     code: LanePlan<L>,
     /// The sample each rotator lane (A then B) is seeded at.
     rotator: [usize; L],
+    /// The sample format `rotator` is for (`u8::MAX`: none yet).
+    format: u8,
 }
 
 impl Plan32 {
-    /// The plan for the taps of `nco` (`n_taps`) on samples of format `F` (ci8 or ci16), or
-    /// `None` if some lane lies 16 or more chips past its tap's window.
-    pub(super) fn new<const F: u8>(nco: &CodeNco, n_taps: usize) -> Option<Self> {
+    /// An all-zero plan, to be filled.
+    const ZERO: Self = Self {
+        code: LanePlan::ZERO,
+        rotator: [0; L],
+        format: u8::MAX,
+    };
+
+    /// Runs `f` with the plan for the taps of `nco` (`n_taps`) on samples of format `F` (ci8
+    /// or ci16), or returns `None` if some lane lies 16 or more chips past its tap's window.
+    /// The plan is written in place into one kept per thread ([`LanePlan::fill`]).
+    pub(super) fn with<const F: u8, R>(
+        nco: &CodeNco,
+        n_taps: usize,
+        f: impl FnOnce(&Self) -> R,
+    ) -> Option<R> {
+        thread_local! {
+            static PLAN: std::cell::RefCell<Plan32> = const { std::cell::RefCell::new(Plan32::ZERO) };
+        }
+        PLAN.with(|plan| {
+            let mut plan = plan.try_borrow_mut().ok()?;
+            plan.fill::<F>(nco, n_taps).then(|| f(&plan))
+        })
+    }
+
+    /// Writes the plan in place (see [`Plan32::with`]); `false` if it cannot be made.
+    fn fill<const F: u8>(&mut self, nco: &CodeNco, n_taps: usize) -> bool {
         let positions = if F == CI16 {
             ci16_positions::<L>()
         } else {
             ci8_positions::<L>()
         };
+        if self.format != F {
+            self.rotator = rotator_order(&positions);
+            self.format = F;
+        }
         // Compare lane j sets mask bit j: position j. Unsigned compares: no sign flip.
-        let code = LanePlan::new(nco, n_taps, &positions, |j| j, 0)?;
-        Some(Self {
-            code,
-            rotator: rotator_order(&positions),
-        })
+        self.code.fill(nco, n_taps, &positions, |j| j, 0)
     }
 }
 
 /// Runs the kernel for `out.len()` (1..=8) taps on the `n` samples of format `F` at `data`
-/// with the plan from [`Plan32::new`] (of the same format) and headroom shift `sh`.
+/// with the plan from [`Plan32::with`] (of the same format) and headroom shift `sh`.
 ///
 /// # Safety
 /// The CPU must support AVX-512 F, BW and VNNI, AVX2 and FMA; `data` must hold `n` samples of

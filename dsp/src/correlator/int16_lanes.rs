@@ -86,45 +86,58 @@ pub(super) struct LanePlan<const L: usize> {
 }
 
 impl<const L: usize> LanePlan<L> {
-    /// The plan for the taps of `nco` (`n_taps`), compare lane `j` serving the sample at
-    /// position `cmp_position[j]` of `positions`; thresholds XORed with `flip`. `None` if some
-    /// lane lies 16 or more chips past its tap's window.
-    pub(super) fn new(
+    /// An all-zero plan, to be [`LanePlan::fill`]ed.
+    pub(super) const ZERO: Self = Self {
+        thr: [[0; L]; MAX_TAPS],
+        hi_dup: [[0; L]; MAX_TAPS],
+        whole: [0; MAX_TAPS],
+    };
+
+    /// Writes the plan for the taps of `nco` (`n_taps`) in place, compare lane `j` serving the
+    /// sample at position `cmp_position(j)` of `positions` (`cmp_position` a permutation of
+    /// `0..L`); thresholds XORed with `flip`.
+    /// `false` if some lane lies 16 or more chips past its tap's window (the plan is then
+    /// unusable). Only the first `n_taps` taps are written: a kernel of `n_taps` taps reads no
+    /// other, so a plan kept from call to call (see `Plan32::with` and `Plan16::with`) is neither
+    /// zeroed nor moved per call (1.5 KB at 32 lanes: with the zeroing and the move of a plan
+    /// returned by value, 4-5 % of a 4 MHz run's CPU time).
+    pub(super) fn fill(
+        &mut self,
         nco: &CodeNco,
         n_taps: usize,
         positions: &[usize; L],
         cmp_position: impl Fn(usize) -> usize,
         flip: u32,
-    ) -> Option<Self> {
-        let mut plan = Self {
-            thr: [[0; L]; MAX_TAPS],
-            hi_dup: [[0; L]; MAX_TAPS],
-            whole: [0; MAX_TAPS],
-        };
-        // Each compare lane's position and `o S` (below 32 * 1023 * 2^32 < 2^47: no overflow).
-        let mut pos = [0usize; L];
+    ) -> bool {
+        // `o S` per position and per compare lane (below 32 * 1023 * 2^32 < 2^47: no
+        // overflow). `cmp_position` is a permutation, so the offsets written per position
+        // below are those of the compare lanes serving them: two contiguous loops, no scatter.
+        let mut pos_s = [0u64; L];
+        for (s, &o) in pos_s.iter_mut().zip(positions) {
+            *s = o as u64 * nco.step;
+        }
         let mut o_s = [0u64; L];
-        for j in 0..L {
-            pos[j] = cmp_position(j);
-            o_s[j] = positions[pos[j]] as u64 * nco.step;
+        for (j, s) in o_s.iter_mut().enumerate() {
+            *s = pos_s[cmp_position(j)];
         }
         // The last sample of a step is the furthest from its window.
         let last = (L as u64 - 1) * nco.step;
         let b0 = nco.phases[0];
         for t in 0..n_taps.min(MAX_TAPS) {
             let delta = (nco.phases[t] + CODE_LEN_FIX - b0) % CODE_LEN_FIX;
-            plan.whole[t] = (delta >> 32) as usize;
+            self.whole[t] = (delta >> 32) as usize;
             let frac = delta & 0xFFFF_FFFF;
             if (frac + last) >> 32 > MAX_OFFSET {
-                return None;
+                return false;
             }
-            for j in 0..L {
-                let l = frac + o_s[j];
-                plan.thr[t][j] = !(l as u32) ^ flip;
-                plan.hi_dup[t][pos[j]] = ((l >> 32) as u16 * 0x0101) as i16;
+            for (thr, &s) in self.thr[t].iter_mut().zip(&o_s) {
+                *thr = !((frac + s) as u32) ^ flip;
+            }
+            for (hi, &s) in self.hi_dup[t].iter_mut().zip(&pos_s) {
+                *hi = (((frac + s) >> 32) as u16 * 0x0101) as i16;
             }
         }
-        Some(plan)
+        true
     }
 }
 

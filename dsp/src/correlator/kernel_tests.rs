@@ -579,6 +579,68 @@ fn int16_lane_kernels_and_their_fallbacks_pick_the_chips_exactly() {
     }
 }
 
+#[test]
+fn a_lane_plan_kept_between_calls_carries_nothing_over() {
+    // The int16-lane kernels keep one code plan per thread and rewrite only the taps of each
+    // call: after a call with 8 taps on ci16, one on ci8 whose 32-lane plan fails part-way
+    // (at 2.187 MHz a step spans 14.5 chips: the first tap fits, the one 0.9 chip further
+    // does not; the 16-lane kernel then runs), a 3-tap call must give exactly the integer
+    // sums of a fresh plan.
+    let mut rng = StdRng::seed_from_u64(2026);
+    let code = CaCode::new(Prn::new(17).unwrap_or_else(|e| panic!("{e}")));
+    let block = Block::random(&mut rng, 4000);
+    let ci16 = ci16_with_headroom(&block.ci8);
+    let state = |phase: f64| ReplicaState {
+        code_phase_chips: phase,
+        code_rate_chips_s: 1.023e6 + 3.5,
+        carrier_phase_cycles: 0.0,
+        carrier_freq_hz: 0.0,
+        carrier_rate_hz_s: 0.0,
+    };
+    let wide_taps = [-2.9, -1.7, -0.6, 0.0, 0.45, 1.3, 2.2, 2.95];
+    let taps = [-0.5, 0.0, 0.5];
+    for c in simd_i16() {
+        let mut out8 = [Complex32::new(0.0, 0.0); 8];
+        c.correlate(
+            SampleSlice::Ci16(&ci16),
+            4.092e6,
+            code.chips(),
+            &state(811.3),
+            &wide_taps,
+            &mut out8,
+        );
+        c.correlate(
+            SampleSlice::Ci8(&block.ci8),
+            2.187e6,
+            code.chips(),
+            &state(5.0),
+            &wide_taps,
+            &mut out8,
+        );
+        for fs in [4.092e6, 16.368e6] {
+            let s = state(97.25);
+            let mut out = [Complex32::new(0.0, 0.0); 3];
+            c.correlate(
+                SampleSlice::Ci8(&block.ci8),
+                fs,
+                code.chips(),
+                &s,
+                &taps,
+                &mut out,
+            );
+            for (o, &d) in out.iter().zip(&taps) {
+                let (re, im) = integer_sum(&block.ci8, fs, &code, &s, d);
+                assert_eq!(
+                    (f64::from(o.re), f64::from(o.im)),
+                    (re, im),
+                    "{} fs {fs} tap {d}",
+                    c.name()
+                );
+            }
+        }
+    }
+}
+
 mod prop {
     use super::*;
     use proptest::prelude::*;
