@@ -46,6 +46,13 @@ pub struct RunArgs {
     /// time and peak memory (with --json the stage times are in the summary's `profile`).
     #[arg(long)]
     pub profile: bool,
+    /// Who drives the channels: `scalar` (each channel's own loops) or `vector` (after the
+    /// first valid fix a navigation filter predicts every satellite's Doppler and feeds it
+    /// forward into the carrier NCOs; back to scalar when its health test fails). Not with
+    /// `--ins` yet. Config file: `[tracking] mode`; `[vector]` tunes the filter
+    /// [default: scalar].
+    #[arg(long, value_name = "MODE")]
+    pub tracking: Option<gpsrx_tracking::TrackingMode>,
     /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
     #[arg(long, value_name = "FILE")]
     pub nav: Option<PathBuf>,
@@ -224,6 +231,9 @@ impl RunArgs {
         }
         r.allow_unhealthy |= self.allow_unhealthy;
         r.plots &= !self.no_plots;
+        if let Some(mode) = self.tracking {
+            c.tracking.mode = mode;
+        }
         c.validate()?;
         Ok(c)
     }
