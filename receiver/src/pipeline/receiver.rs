@@ -415,6 +415,11 @@ impl Receiver {
         self.aiding.as_ref()
     }
 
+    /// Vector tracking, with `[tracking] mode = "vector"`.
+    pub fn vector(&self) -> Option<&VectorTracking> {
+        self.vector.as_ref()
+    }
+
     /// Reads `source` to its end, front to back, once; returns the summary.
     pub fn run(
         &mut self,

@@ -2,17 +2,22 @@
 //! them back, and what it is fed.
 //!
 //! - **Scalar until the first valid fix.** The first least-squares fix that passes the
-//!   integrity test (RAIM, PDOP) starts the filter from its position, velocity, clock and
-//!   covariance ([`NavFilter::from_solution`]); from then on the filter's prediction is fed
-//!   forward into every channel ([`VectorPort`]).
+//!   integrity test (RAIM, PDOP) with at least [`MIN_START_SATELLITES`] satellites and a
+//!   velocity good to [`MAX_START_VELOCITY_SIGMA_MPS`] per axis starts the filter from its
+//!   position, velocity, clock and covariance ([`NavFilter::from_solution`]); from then on the
+//!   filter's prediction is fed forward into every channel ([`VectorPort`]). (A fix of 4
+//!   satellites has a velocity good to 1-5 m/s only: 5-25 Hz of feed-forward error, enough to
+//!   throw a 20 ms loop into a false lock 25 Hz off.)
 //! - **Vector.** Every epoch of observables (the navigation rate, `[run] rate_hz`) predicts
 //!   the filter to the epoch and updates it with the pseudoranges and Dopplers of the tracked
 //!   channels (`measure`), each weighted by its C/N0 (`noise`), each tested (`ekf`).
 //! - **Back to scalar** when the filter's health test fails [`UNHEALTHY_EPOCHS`] epochs in a
-//!   row, or when no epoch came for [`MAX_COAST_S`] (the channels lost everything): an epoch is
-//!   unhealthy with fewer than 4 pseudoranges admitted, more rows excluded than admitted, or a
-//!   3-D position sigma above [`MAX_POSITION_SIGMA_M`]. The next valid fix starts the filter
-//!   again.
+//!   row, or when no row was admitted for [`MAX_COAST_S`] (the channels lost everything): an
+//!   epoch is unhealthy when it had measurements and none was admitted, when more rows were
+//!   excluded than admitted, or when the 3-D position sigma is above [`MAX_POSITION_SIGMA_M`].
+//!   Fewer than 4 satellites do not make it unhealthy: the filter coasts on its prediction
+//!   through a partial blockage (its covariance grows, the sigma test ends it). The next valid
+//!   fix starts the filter again.
 //!
 //! The least-squares fixes stay the receiver's output; the filter only drives the channels.
 //!
@@ -44,6 +49,10 @@ use std::sync::Arc;
 pub const UNHEALTHY_EPOCHS: u32 = 3;
 /// 3-D position sigma above which the filter is unhealthy, m.
 pub const MAX_POSITION_SIGMA_M: f64 = 100.0;
+/// Fewest satellites of a fix that starts the filter (RAIM can check it).
+pub const MIN_START_SATELLITES: usize = 5;
+/// Largest per-axis velocity sigma of a fix that starts the filter, m/s.
+pub const MAX_START_VELOCITY_SIGMA_MPS: f64 = 0.5;
 
 /// What the navigation processor emitted in a round that vector tracking takes.
 #[derive(Debug, Clone)]
@@ -70,6 +79,14 @@ impl Captured {
             valid: report.fix.quality != FixQuality::None,
         }
     }
+}
+
+/// Whether a valid fix may start the filter (module docs).
+fn starts_the_filter(sol: &PvtSolution) -> bool {
+    let velocity_ok = sol.vel_covariance.is_some_and(|c| {
+        (0..3).all(|i| c[(i, i)].is_finite() && c[(i, i)].sqrt() <= MAX_START_VELOCITY_SIGMA_MPS)
+    });
+    sol.n_sv >= MIN_START_SATELLITES && velocity_ok && sol.vel_ecef_mps.is_some()
 }
 
 /// Vector tracking over a run.
@@ -102,6 +119,8 @@ pub struct VectorTracking {
     filter: Option<NavFilter>,
     /// Receiver time and stream time of the last update.
     last: Option<(GpsTime, f64)>,
+    /// Stream time of the last update that admitted a row.
+    last_admitted_s: f64,
     /// Receiver time and stream time of the last epoch with a fix (module docs, "Time").
     pair: Option<(GpsTime, f64)>,
     unhealthy_in_row: u32,
@@ -137,6 +156,7 @@ impl VectorTracking {
             assist,
             filter: None,
             last: None,
+            last_admitted_s: 0.0,
             pair: None,
             unhealthy_in_row: 0,
             port: VectorPort::default(),
@@ -187,7 +207,9 @@ impl VectorTracking {
             let t_stream_s = t0 + epoch.time.diff_s(rx0);
             self.on_epoch(&epoch, t_stream_s, nav);
             if let (None, Some((_, sol, true))) = (&self.filter, &fix) {
-                self.engage(&epoch, t_stream_s, sol, nav);
+                if starts_the_filter(sol) {
+                    self.engage(&epoch, t_stream_s, sol, nav);
+                }
             }
         }
     }
@@ -207,6 +229,7 @@ impl VectorTracking {
         );
         self.filter = Some(filter);
         self.last = Some((epoch.time, t_stream_s));
+        self.last_admitted_s = t_stream_s;
         self.unhealthy_in_row = 0;
         self.summary.engagements += 1;
         self.publish(epoch, t_stream_s, nav);
@@ -255,8 +278,8 @@ impl VectorTracking {
         if !(dt.is_finite() && dt > 0.0) {
             return;
         }
-        if t_stream_s - t_last > MAX_COAST_S {
-            self.disengage(t_stream_s, "no measurements for too long");
+        if t_stream_s - self.last_admitted_s > MAX_COAST_S {
+            self.disengage(t_stream_s, "no measurement admitted for too long");
             return;
         }
         filter.predict(dt);
@@ -296,7 +319,22 @@ impl VectorTracking {
                 "{t_stream_s:.2} s: vector filter excluded the {what} of G{prn:02} (NIS {nis:.1})"
             );
         }
-        let healthy = out.admitted_code >= 4
+        if out.admitted > 0 {
+            self.last_admitted_s = t_stream_s;
+        }
+        let v = filter.velocity_mps();
+        tracing::debug!(
+            "{t_stream_s:.2} s: vector filter: {} rows admitted ({} pseudoranges), {} excluded; velocity {:.3} {:.3} {:.3} m/s, drift {:.3} m/s, position sigma {:.2} m",
+            out.admitted,
+            out.admitted_code,
+            out.rejected.len(),
+            v.x,
+            v.y,
+            v.z,
+            filter.state()[super::ekf::DRIFT],
+            filter.position_sigma_m()
+        );
+        let healthy = (rows.is_empty() || out.admitted > 0)
             && out.rejected.len() <= out.admitted
             && filter.position_sigma_m() <= MAX_POSITION_SIGMA_M;
         self.unhealthy_in_row = if healthy {
