@@ -76,25 +76,38 @@ fn vector_tracking_takes_the_channels_and_its_feed_forward_follows_the_truth() {
         "median {median} Hz, worst {worst} Hz"
     );
 
-    // The filter's position at the end within 4 of its 3-D sigmas of the truth (and within
-    // 10 m), and every valid fix of the vector run within 4 of its own sigmas (and 10 m).
+    // The filter's position at the end: horizontally within 4 of its horizontal sigmas of the
+    // truth, vertically within 10 m (this simulation leaves every solution a steady 6-8 m
+    // vertical error, the residual of the ionosphere model, which no white-noise sigma
+    // covers: see `fix_bounds` in `pipeline.rs`); every valid fix likewise.
     let f = rx
         .vector()
         .and_then(|v| v.filter())
         .unwrap_or_else(|| panic!("the filter is not running at the end"));
     let (_, truth) = sim.receiver_truth(summary.duration_s);
-    let err = (f.position_m() - truth.pos_m).norm();
-    let sigma = f.position_sigma_m();
-    eprintln!("filter position error {err:.2} m, 3-D sigma {sigma:.2} m");
-    assert!(err < 4.0 * sigma && err < 10.0, "{err} m, sigma {sigma} m");
+    let llh = gpsrx_nav::frames::Llh::from_ecef(&truth.pos_m);
+    let r = gpsrx_nav::frames::enu_rotation(&llh);
+    let p = f.covariance().fixed_view::<3, 3>(0, 0).into_owned();
+    let p_enu = r * p * r.transpose();
+    let d = r * (f.position_m() - truth.pos_m);
+    let (h_err, h_sigma) = (d.x.hypot(d.y), (p_enu[(0, 0)] + p_enu[(1, 1)]).sqrt());
+    eprintln!(
+        "filter position error: horizontal {h_err:.2} m (sigma {h_sigma:.2} m), vertical {:.2} m (sigma {:.2} m)",
+        d.z,
+        p_enu[(2, 2)].sqrt()
+    );
+    assert!(h_err < 4.0 * h_sigma, "{h_err} m, sigma {h_sigma} m");
+    assert!(d.z.abs() < 10.0, "vertical {} m", d.z);
     for fix in &sink.fixes {
-        let c = fix.solution.covariance;
-        let s = (c[(0, 0)] + c[(1, 1)] + c[(2, 2)]).sqrt();
-        let e = (fix.solution.pos_ecef_m - truth.pos_m).norm();
+        let c = fix.solution.position_covariance_enu();
+        let s = (c[(0, 0)] + c[(1, 1)]).sqrt();
+        let d = r * (fix.solution.pos_ecef_m - truth.pos_m);
+        let h = d.x.hypot(d.y);
         assert!(
-            e < 4.0 * s.max(1.0) && e < 10.0,
-            "fix at {:.1} s: {e:.2} m off, sigma {s:.2} m",
-            fix.t_stream_s
+            h < 4.0 * s && d.z.abs() < 10.0,
+            "fix at {:.1} s: {h:.2} m off horizontally (sigma {s:.2} m), {:.2} m vertically",
+            fix.t_stream_s,
+            d.z
         );
     }
 }

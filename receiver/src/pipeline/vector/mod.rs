@@ -7,6 +7,8 @@
 //! - `measure`: the filter's rows from an epoch of pseudoranges and Dopplers;
 //! - `feed`: the filter's Doppler prediction for every satellite through the aiding port
 //!   ([`VectorPort`]);
+//! - `dynamics`: the acceleration test that keeps the filter's feed-forward, 0.2-0.3 s ahead
+//!   of its last measurement, off the channels while the receiver accelerates hard;
 //! - `tracker`: [`VectorTracking`], the handover scalar to vector and back, fed with what the
 //!   navigation processor emits ([`Captured`], taken by [`Tap`]).
 //!
@@ -14,6 +16,7 @@
 //! carrier-aided), long coherent integration with data-bit wipe-off, the INS error states
 //! (`--tracking vector` with `--ins` is refused), re-acquisition from the filter's prediction.
 
+mod dynamics;
 pub mod ekf;
 pub mod feed;
 pub mod measure;

@@ -11,6 +11,10 @@
 //! - **Vector.** Every epoch of observables (the navigation rate, `[run] rate_hz`) predicts
 //!   the filter to the epoch and updates it with the pseudoranges and Dopplers of the tracked
 //!   channels (`measure`), each weighted by its C/N0 (`noise`), each tested (`ekf`).
+//! - **Not under hard dynamics** (`dynamics`): the filter takes the channels only once the
+//!   fixes' velocities have shown less than 3 m/s^2 for 1 s, and hands them back as soon as
+//!   they show more (its feed-forward is a prediction 0.2-0.3 s ahead of its last
+//!   measurement).
 //! - **Back to scalar** when the filter's health test fails [`UNHEALTHY_EPOCHS`] epochs in a
 //!   row, or when no row was admitted for [`MAX_COAST_S`] (the channels lost everything): an
 //!   epoch is unhealthy when it had measurements and none was admitted, when more rows were
@@ -29,6 +33,7 @@
 //! last pair (a whole-millisecond step of the receiver clock moves it by 1 ms, nothing for a
 //! Doppler prediction).
 
+use super::dynamics::AccelWatch;
 use super::ekf::{ClockModel, FilterParams, NavFilter, RowKind, BIAS};
 use super::feed::{Snapshot, VectorPort, MAX_COAST_S};
 use super::measure::{epoch_rows, RowModel};
@@ -124,6 +129,8 @@ pub struct VectorTracking {
     /// Receiver time and stream time of the last epoch with a fix (module docs, "Time").
     pair: Option<(GpsTime, f64)>,
     unhealthy_in_row: u32,
+    /// The acceleration from the valid fixes' velocities.
+    dynamics: AccelWatch,
     port: VectorPort,
     summary: VectorSummary,
 }
@@ -159,6 +166,7 @@ impl VectorTracking {
             last_admitted_s: 0.0,
             pair: None,
             unhealthy_in_row: 0,
+            dynamics: AccelWatch::default(),
             port: VectorPort::default(),
             summary: VectorSummary::default(),
         }
@@ -198,16 +206,27 @@ impl VectorTracking {
                 },
                 _ => None,
             };
-            if let Some((t, _, _)) = &fix {
+            if let Some((t, sol, valid)) = &fix {
                 self.pair = Some((epoch.time, *t));
+                match (valid, sol.vel_ecef_mps) {
+                    (true, Some(v)) => self.dynamics.push(*t, v),
+                    _ => self.dynamics.reset(),
+                }
             }
             let Some((rx0, t0)) = self.pair else {
                 continue;
             };
             let t_stream_s = t0 + epoch.time.diff_s(rx0);
+            if self.filter.is_some() && self.dynamics.too_high() {
+                let a = self.dynamics.accel_mps2().unwrap_or(f64::NAN);
+                self.disengage(
+                    t_stream_s,
+                    &format!("the receiver accelerates at {a:.1} m/s^2, more than its feed-forward can follow"),
+                );
+            }
             self.on_epoch(&epoch, t_stream_s, nav);
             if let (None, Some((_, sol, true))) = (&self.filter, &fix) {
-                if starts_the_filter(sol) {
+                if starts_the_filter(sol) && self.dynamics.calm_at(t_stream_s) {
                     self.engage(&epoch, t_stream_s, sol, nav);
                 }
             }
