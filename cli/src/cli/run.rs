@@ -273,3 +273,35 @@ pub fn parse_llh(text: &str) -> Result<[f64; 3], String> {
     config::check_approx_llh(&llh)?;
     Ok(llh)
 }
+
+#[cfg(test)]
+mod tracking_option_tests {
+    use crate::cli::{Cli, Command};
+    use clap::Parser;
+    use gpsrx_tracking::TrackingMode;
+
+    fn run_args(extra: &[&str]) -> Result<Box<super::RunArgs>, String> {
+        let mut argv = vec!["gpsrx", "run", "rec.ci8", "--fs", "2e6", "--out", "o"];
+        argv.extend_from_slice(extra);
+        match Cli::try_parse_from(argv) {
+            Ok(Cli {
+                command: Command::Run(a),
+                ..
+            }) => Ok(a),
+            Ok(_) => Err("not a run".into()),
+            Err(e) => Err(e.to_string()),
+        }
+    }
+
+    #[test]
+    fn tracking_defaults_to_scalar_and_takes_vector() {
+        let a = run_args(&[]).unwrap_or_else(|e| panic!("{e}"));
+        let c = a.receiver_config().unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(c.tracking.mode, TrackingMode::Scalar);
+        let a = run_args(&["--tracking", "vector"]).unwrap_or_else(|e| panic!("{e}"));
+        let c = a.receiver_config().unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(c.tracking.mode, TrackingMode::Vector);
+        let err = run_args(&["--tracking", "vectorish"]).err().unwrap_or_default();
+        assert!(err.contains("scalar") && err.contains("vector"), "{err}");
+    }
+}
