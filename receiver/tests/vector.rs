@@ -26,11 +26,12 @@ fn vector_tracking_takes_the_channels_and_its_feed_forward_follows_the_truth() {
         .unwrap_or_else(|| panic!("no vector summary"));
     let first = summary.first_fix_s.unwrap_or(f64::INFINITY);
     eprintln!("first fix {first:.2} s, {} fixes, {v:?}", summary.fixes);
-    // Scalar until the first valid fix, vector from then on to the end, never handed back.
+    // Scalar until the first valid fix (and 1 s of fixes showing no hard acceleration, the
+    // dynamics test), vector from then on to the end, never handed back.
     assert_eq!(v.engagements, 1, "{v:?}");
     assert_eq!(v.disengagements, 0, "{v:?}");
     assert!(
-        v.vector_s > summary.duration_s - first - 1.0,
+        v.vector_s > summary.duration_s - first - 1.5,
         "vector for {:.2} s of {:.2} s after the first fix",
         v.vector_s,
         summary.duration_s - first

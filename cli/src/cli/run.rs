@@ -301,7 +301,9 @@ mod tracking_option_tests {
         let a = run_args(&["--tracking", "vector"]).unwrap_or_else(|e| panic!("{e}"));
         let c = a.receiver_config().unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(c.tracking.mode, TrackingMode::Vector);
-        let err = run_args(&["--tracking", "vectorish"]).err().unwrap_or_default();
+        let err = run_args(&["--tracking", "vectorish"])
+            .err()
+            .unwrap_or_default();
         assert!(err.contains("scalar") && err.contains("vector"), "{err}");
     }
 }

@@ -6,10 +6,12 @@
 //!   chips, integration `T`: `sigma_tau = sqrt((Bn d / (2 CN0)) (1 + 2 / (T CN0 (2 - d))))`
 //!   chips (Kaplan eq. 5.41), times 293.05 m per chip; plus a floor for what the formula
 //!   leaves out (multipath, the model's residual atmosphere).
-//! - Doppler: the frequency jitter of a frequency discriminator at the carrier loop's
-//!   bandwidth, `sigma_f = (1 / (2 pi T)) sqrt((4 F Bn / CN0) (1 + 1 / (T CN0)))` Hz (Kaplan
-//!   eq. 5.21, `F` = 1 above 35 dB-Hz, 2 near threshold): an upper bound of a PLL's frequency
-//!   noise, so the filter does not over-trust a PLL that is about to slip; plus a floor.
+//! - Doppler: the observables' Doppler is the carrier phase differenced across the epoch,
+//!   `(phi(t + dt) - phi(t - dt)) / (2 dt)` (`navigation::observables`), so its noise is the
+//!   PLL's phase jitter `sigma_phi = sqrt((Bn / CN0) (1 + 1 / (2 T CN0))) / (2 pi)` cycles
+//!   (Kaplan eq. 5.6) times `sqrt(2) / (2 dt)`; plus a floor. (A channel whose PLL is not
+//!   locked gives no observables.) [`fll_jitter_hz`], the frequency jitter of a frequency
+//!   discriminator (Kaplan eq. 5.21), is the bound for a channel tracked by its FLL alone.
 //!
 //! `CN0` is linear (Hz): `10^(C/N0 / 10)`.
 //!
@@ -25,8 +27,8 @@ use std::f64::consts::PI;
 pub const CHIP_M: f64 = SPEED_OF_LIGHT_MPS / CA_CHIP_RATE_HZ;
 /// Floor of the pseudorange sigma, m: multipath and the residual of the atmosphere models.
 pub const CODE_FLOOR_M: f64 = 1.0;
-/// Floor of the Doppler sigma, Hz (0.02 m/s).
-pub const DOPPLER_FLOOR_HZ: f64 = 0.1;
+/// Floor of the Doppler sigma, Hz (0.01 m/s): oscillator and model residuals.
+pub const DOPPLER_FLOOR_HZ: f64 = 0.05;
 /// Lowest C/N0 the formulas are evaluated at, dB-Hz (below, the loops are not tracking).
 pub const CN0_FLOOR_DBHZ: f64 = 15.0;
 
@@ -71,6 +73,12 @@ pub fn dll_jitter_chips(bn_hz: f64, d_chips: f64, cn0_dbhz: f64, t_s: f64) -> f6
     (bn_hz * d / (2.0 * cn0) * (1.0 + 2.0 / (t_s * cn0 * (2.0 - d)))).sqrt()
 }
 
+/// PLL thermal phase jitter of a Costas loop, cycles (Kaplan eq. 5.6; module docs).
+pub fn pll_jitter_cycles(bn_hz: f64, cn0_dbhz: f64, t_s: f64) -> f64 {
+    let cn0 = linear_cn0(cn0_dbhz);
+    (bn_hz / cn0 * (1.0 + 1.0 / (2.0 * t_s * cn0))).sqrt() / (2.0 * PI)
+}
+
 /// Frequency-discriminator jitter, Hz (Kaplan eq. 5.21; module docs).
 pub fn fll_jitter_hz(bn_hz: f64, cn0_dbhz: f64, t_s: f64) -> f64 {
     let cn0 = linear_cn0(cn0_dbhz);
@@ -99,9 +107,11 @@ pub fn code_variance_m2(loops: &LoopNoise, cn0_dbhz: f64, dt_s: f64) -> f64 {
     (s * s + CODE_FLOOR_M * CODE_FLOOR_M) * correlation_scale(loops.dll_bn_hz, dt_s)
 }
 
-/// Doppler variance, Hz^2, of a channel at `cn0_dbhz` read every `dt_s`.
+/// Doppler variance, Hz^2, of a channel at `cn0_dbhz` whose Doppler is its carrier phase
+/// differenced over `2 dt_s` (module docs).
 pub fn doppler_variance_hz2(loops: &LoopNoise, cn0_dbhz: f64, dt_s: f64) -> f64 {
-    let s = fll_jitter_hz(loops.carrier_bn_hz, cn0_dbhz, loops.t_coh_s);
+    let phi = pll_jitter_cycles(loops.carrier_bn_hz, cn0_dbhz, loops.t_coh_s);
+    let s = phi * std::f64::consts::SQRT_2 / (2.0 * dt_s.max(1e-3));
     (s * s + DOPPLER_FLOOR_HZ * DOPPLER_FLOOR_HZ) * correlation_scale(loops.carrier_bn_hz, dt_s)
 }
 
@@ -124,6 +134,28 @@ mod tests {
         // 18 Hz, 45 dB-Hz, 1 ms, F = 1: sqrt(72/31,623 (1 + 1/31.62)) / (2 pi 1e-3) = 7.713 Hz.
         let s = fll_jitter_hz(18.0, 45.0, 1e-3);
         assert!((s - 7.713).abs() < 1e-3, "{s}");
+    }
+
+    #[test]
+    fn pll_jitter_matches_a_hand_computation() {
+        // 18 Hz, 45 dB-Hz, 1 ms: sqrt(18/31,623 (1 + 1/63.25)) / 2 pi = 0.003827 cycle
+        // (1.38 deg, as Kaplan's Fig. 5.11 reads).
+        let s = pll_jitter_cycles(18.0, 45.0, 1e-3);
+        assert!((s - 0.003_827).abs() < 1e-6, "{s}");
+        // The Doppler of phases 0.2 s apart: sqrt(2) x 0.003827 / 0.2 = 0.02706 Hz, under the
+        // 0.05 Hz floor.
+        let loops = LoopNoise {
+            dll_bn_hz: 1.0,
+            el_spacing_chips: 1.0,
+            carrier_bn_hz: 18.0,
+            t_coh_s: 1e-3,
+        };
+        let v = doppler_variance_hz2(&loops, 45.0, 0.1);
+        assert!(
+            (v.sqrt() - (0.027_06f64.powi(2) + 0.0025).sqrt()).abs() < 1e-4,
+            "{}",
+            v.sqrt()
+        );
     }
 
     #[test]
