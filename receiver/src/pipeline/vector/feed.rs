@@ -16,7 +16,8 @@
 //! The whole receiver clock drift is fed forward: the aid comes on when the filter starts,
 //! with its drift already estimated, and the channel keeps its NCO frequency when an aid comes
 //! or goes (its loop's base frequency takes up the difference, `Channel::set_aid`).
-//! Predictions more than [`MAX_COAST_S`] from the last update give no aid.
+//! Predictions more than [`MAX_COAST_S`] from the last update give no aid, and neither do
+//! satellites the filter has not taken in ([`Snapshot::taken_in`]).
 
 use super::ekf::{State, BIAS, DRIFT};
 use gpsrx_core::constants::SPEED_OF_LIGHT_MPS;
@@ -30,8 +31,14 @@ use std::sync::Arc;
 
 /// Step of the Doppler rate, s.
 pub const RATE_STEP_S: f64 = 0.01;
-/// Longest prediction from the last update that still aids the channels, s.
-pub const MAX_COAST_S: f64 = 5.0;
+/// Longest prediction from the last update that still aids the channels, s; also the longest
+/// time without an admitted measurement before the filter gives the channels back
+/// (`super::tracker`). After a blockage of every signal the channels are found again by the
+/// search, and the first fixes after it (4-5 satellites, a velocity good to metres per second)
+/// are no base for a feed-forward: a filter that had coasted 3 s and took the returning
+/// channels in from them threw one out of lock again (35 m fixes on 4 satellites). Taking
+/// channels in from the filter's prediction without a search is a later part.
+pub const MAX_COAST_S: f64 = 1.0;
 
 /// The filter's state at one update, as the channels need it.
 #[derive(Debug, Clone)]
@@ -44,6 +51,10 @@ pub struct Snapshot {
     pub x: State,
     /// The ephemerides of the satellites the filter uses.
     pub ephemerides: Arc<BTreeMap<u8, Ephemeris>>,
+    /// The satellites whose channels get the feed-forward (`super::tracker`: a channel is
+    /// taken in once the filter has admitted its Doppler for a while; a channel that has just
+    /// been (re)acquired pulls in on its own loops first).
+    pub taken_in: std::collections::BTreeSet<u8>,
 }
 
 impl Snapshot {
@@ -92,7 +103,10 @@ pub struct VectorPort {
 
 impl gpsrx_tracking::AidingPort for VectorPort {
     fn doppler_aid(&self, prn: gpsrx_dsp::Prn, t_s: f64) -> Option<DopplerAid> {
-        let snap = self.snapshot.as_ref()?;
+        let snap = self
+            .snapshot
+            .as_ref()
+            .filter(|s| s.taken_in.contains(&prn.get()))?;
         let f = snap.doppler_hz(prn.get(), t_s)?;
         let f2 = snap.doppler_hz(prn.get(), t_s + RATE_STEP_S).unwrap_or(f);
         Some(DopplerAid {
