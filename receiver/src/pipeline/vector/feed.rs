@@ -16,8 +16,9 @@
 //! The whole receiver clock drift is fed forward: the aid comes on when the filter starts,
 //! with its drift already estimated, and the channel keeps its NCO frequency when an aid comes
 //! or goes (its loop's base frequency takes up the difference, `Channel::set_aid`).
-//! Predictions more than [`MAX_COAST_S`] from the last update give no aid, and neither do
-//! satellites the filter has not taken in ([`Snapshot::taken_in`]).
+//! Every satellite with an ephemeris gets the aid, its channel locked or not: the filter's
+//! prediction is what holds a channel whose own loop is losing a weak signal. Predictions
+//! more than [`MAX_COAST_S`] from the last update give no aid.
 
 use super::ekf::{State, BIAS, DRIFT};
 use gpsrx_core::constants::SPEED_OF_LIGHT_MPS;
@@ -51,10 +52,6 @@ pub struct Snapshot {
     pub x: State,
     /// The ephemerides of the satellites the filter uses.
     pub ephemerides: Arc<BTreeMap<u8, Ephemeris>>,
-    /// The satellites whose channels get the feed-forward (`super::tracker`: a channel is
-    /// taken in once the filter has admitted its Doppler for a while; a channel that has just
-    /// been (re)acquired pulls in on its own loops first).
-    pub taken_in: std::collections::BTreeSet<u8>,
 }
 
 impl Snapshot {
@@ -103,10 +100,7 @@ pub struct VectorPort {
 
 impl gpsrx_tracking::AidingPort for VectorPort {
     fn doppler_aid(&self, prn: gpsrx_dsp::Prn, t_s: f64) -> Option<DopplerAid> {
-        let snap = self
-            .snapshot
-            .as_ref()
-            .filter(|s| s.taken_in.contains(&prn.get()))?;
+        let snap = self.snapshot.as_ref()?;
         let f = snap.doppler_hz(prn.get(), t_s)?;
         let f2 = snap.doppler_hz(prn.get(), t_s + RATE_STEP_S).unwrap_or(f);
         Some(DopplerAid {

@@ -159,6 +159,7 @@ fn the_filter_is_consistent_on_a_synthetic_constellation() {
         pos_err_over_sigma = pos_err_over_sigma.max(err / f.position_sigma_m());
     }
     let mean = sum / runs as f64;
+    eprintln!("mean NEES {mean:.2} over {runs} runs, largest position error {pos_err_over_sigma:.2} sigma");
     assert!((6.1..=10.2).contains(&mean), "mean NEES {mean}");
     // Every run's position within 4 of its 3-D sigmas (an 8-satellite fix: about 2 m).
     assert!(pos_err_over_sigma < 4.0, "{pos_err_over_sigma}");

@@ -11,12 +11,6 @@
 //! - **Vector.** Every epoch of observables (the navigation rate, `[run] rate_hz`) predicts
 //!   the filter to the epoch and updates it with the pseudoranges and Dopplers of the tracked
 //!   channels (`measure`), each weighted by its C/N0 (`noise`), each tested (`ekf`).
-//! - **Channels taken in one by one.** A satellite's channel gets the feed-forward once the
-//!   filter has admitted its Doppler at [`TAKE_IN_EPOCHS`] epochs in a row (it is locked and
-//!   agrees with the others), and keeps it until the satellite is missing from the epochs for
-//!   [`LET_GO_S`] (its channel lost it): a channel that has just been (re)acquired pulls in on
-//!   its own loops first, as the INS aid's monitor does (an aid on a channel in pull-in
-//!   delayed the weak satellites' return after a blockage by about 1 s).
 //! - **Not under hard dynamics** (`dynamics`): the filter takes the channels only once the
 //!   fixes' velocities have shown less than 3 m/s^2 for 1 s, and hands them back as soon as
 //!   they show more (its feed-forward is a prediction 0.2-0.3 s ahead of its last
@@ -60,10 +54,6 @@ use std::sync::Arc;
 pub const UNHEALTHY_EPOCHS: u32 = 3;
 /// 3-D position sigma above which the filter is unhealthy, m.
 pub const MAX_POSITION_SIGMA_M: f64 = 100.0;
-/// Consecutive epochs with its Doppler admitted that take a satellite's channel in.
-pub const TAKE_IN_EPOCHS: u32 = 5;
-/// A satellite missing from the epochs this long is let go (its channel lost it), s.
-pub const LET_GO_S: f64 = 0.5;
 /// Fewest satellites of a fix that starts the filter (RAIM can check it).
 pub const MIN_START_SATELLITES: usize = 5;
 /// Largest per-axis velocity sigma of a fix that starts the filter, m/s.
@@ -94,31 +84,6 @@ impl Captured {
             valid: report.fix.quality != FixQuality::None,
         }
     }
-}
-
-/// Counts, per satellite, the epochs in a row its Doppler was admitted; forgets the
-/// satellites missing for [`LET_GO_S`].
-fn count_admitted(
-    counts: &mut BTreeMap<u8, (u32, f64)>,
-    rows: &[super::ekf::Row],
-    rejected: &[(u8, RowKind, f64)],
-    t_s: f64,
-) {
-    for r in rows.iter().filter(|r| r.kind == RowKind::Doppler) {
-        let ok = !rejected
-            .iter()
-            .any(|(p, k, _)| *p == r.prn && *k == RowKind::Doppler);
-        let e = counts.entry(r.prn).or_insert((0, t_s));
-        // Once taken in, an excluded Doppler does not let the channel go: the filter's
-        // prediction is what holds a channel whose own measurement goes astray.
-        let n = match (ok, e.0 >= TAKE_IN_EPOCHS) {
-            (true, _) => e.0.saturating_add(1),
-            (false, true) => e.0,
-            (false, false) => 0,
-        };
-        *e = (n, t_s);
-    }
-    counts.retain(|_, (_, seen)| t_s - *seen < LET_GO_S);
 }
 
 /// Whether a valid fix may start the filter (module docs).
@@ -166,9 +131,6 @@ pub struct VectorTracking {
     unhealthy_in_row: u32,
     /// The acceleration from the valid fixes' velocities.
     dynamics: AccelWatch,
-    /// Per satellite: consecutive epochs with its Doppler admitted, and the stream time it
-    /// was last in an epoch (module docs, "Channels taken in").
-    admitted_in_row: BTreeMap<u8, (u32, f64)>,
     port: VectorPort,
     summary: VectorSummary,
 }
@@ -205,7 +167,6 @@ impl VectorTracking {
             pair: None,
             unhealthy_in_row: 0,
             dynamics: AccelWatch::default(),
-            admitted_in_row: BTreeMap::new(),
             port: VectorPort::default(),
             summary: VectorSummary::default(),
         }
@@ -300,7 +261,6 @@ impl VectorTracking {
             self.summary.disengagements += 1;
         }
         self.port.snapshot = None;
-        self.admitted_in_row.clear();
         self.last = None;
         self.unhealthy_in_row = 0;
     }
@@ -369,7 +329,6 @@ impl VectorTracking {
         self.summary.rejected_rows += out.rejected.len();
         self.summary.vector_s += t_stream_s - t_last;
         self.last = Some((epoch.time, t_stream_s));
-        count_admitted(&mut self.admitted_in_row, &rows, &out.rejected, t_stream_s);
         for (prn, kind, nis) in &out.rejected {
             let what = match kind {
                 RowKind::Code => "pseudorange",
@@ -429,12 +388,6 @@ impl VectorTracking {
             gps_time: epoch.time.add_seconds(-x[BIAS] / SPEED_OF_LIGHT_MPS),
             x,
             ephemerides: Arc::new(ephemerides),
-            taken_in: self
-                .admitted_in_row
-                .iter()
-                .filter(|(_, (n, _))| *n >= TAKE_IN_EPOCHS)
-                .map(|(p, _)| *p)
-                .collect(),
         });
     }
 }
