@@ -20,7 +20,8 @@ class Receiver:
     """The receiver on pushed blocks of complex baseband samples (any chunking, same fixes).
 
     Options by name as ``gpsrx run`` takes them: ``rate_hz``, ``tropo="none"``,
-    ``elevation_mask_deg``, ``approx_llh=[lat_deg, lon_deg, h_m]``, ``prns=[...]``, ...
+    ``elevation_mask_deg``, ``approx_llh=[lat_deg, lon_deg, h_m]``, ``prns=[...]``,
+    ``tracking="vector"`` (``[tracking] mode``: the navigation filter drives the channels), ...
     """
 
     def __init__(

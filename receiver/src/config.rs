@@ -137,6 +137,76 @@ pub struct ReceiverConfig {
     pub run: RunSettings,
     /// Dead-reckoning fusion.
     pub dr: DrRunConfig,
+    /// The navigation filter of vector tracking (`[tracking] mode = "vector"`).
+    pub vector: VectorSettings,
+}
+
+/// The `[vector]` table: the navigation filter of vector tracking
+/// (`crate::pipeline::vector`), used when `[tracking] mode = "vector"`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct VectorSettings {
+    /// Acceleration power spectral density of the white-noise-acceleration model, per ECEF
+    /// axis, m^2/s^3 (default 10: a car or a gently manoeuvring aircraft; a 10 g turn wants
+    /// 1000 or more).
+    pub accel_psd_m2_s3: f64,
+    /// Receiver oscillator white frequency noise `h0`, s (default 2e-19, a TCXO).
+    pub clock_h0: f64,
+    /// Receiver oscillator random-walk frequency noise `h-2`, 1/s (default 2e-20, a TCXO).
+    pub clock_h_2: f64,
+    /// False-alarm probability of the innovation test that excludes a channel's measurement
+    /// (chi-square, 1 degree of freedom), in (0, 0.5) (default 1e-3).
+    pub gate_pfa: f64,
+}
+
+impl Default for VectorSettings {
+    fn default() -> Self {
+        Self {
+            accel_psd_m2_s3: 10.0,
+            clock_h0: 2e-19,
+            clock_h_2: 2e-20,
+            gate_pfa: 1e-3,
+        }
+    }
+}
+
+impl VectorSettings {
+    /// Checks every value against its valid range.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let bad = |key: &str, v: f64, range: &str| {
+            Err(ConfigError::Invalid(format!(
+                "[vector] {key} = {v}: use {range}"
+            )))
+        };
+        if !(self.accel_psd_m2_s3.is_finite()
+            && self.accel_psd_m2_s3 > 0.0
+            && self.accel_psd_m2_s3 <= 1e6)
+        {
+            return bad(
+                "accel_psd_m2_s3",
+                self.accel_psd_m2_s3,
+                "a value in (0, 1e6] m^2/s^3",
+            );
+        }
+        if !(self.clock_h0.is_finite() && self.clock_h0 > 0.0 && self.clock_h0 < 1e-15) {
+            return bad(
+                "clock_h0",
+                self.clock_h0,
+                "a value in (0, 1e-15) s (a TCXO: 2e-19)",
+            );
+        }
+        if !(self.clock_h_2.is_finite() && self.clock_h_2 > 0.0 && self.clock_h_2 < 1e-15) {
+            return bad(
+                "clock_h_2",
+                self.clock_h_2,
+                "a value in (0, 1e-15) /s (a TCXO: 2e-20)",
+            );
+        }
+        if !(self.gate_pfa > 0.0 && self.gate_pfa < 0.5) {
+            return bad("gate_pfa", self.gate_pfa, "a probability in (0, 0.5)");
+        }
+        Ok(())
+    }
 }
 
 /// A configuration that cannot be used; the message names the setting and its valid range.
@@ -205,6 +275,7 @@ impl ReceiverConfig {
             )));
         }
         self.run.validate()?;
+        self.vector.validate()?;
         self.dr.validate()
     }
 }

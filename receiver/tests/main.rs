@@ -9,3 +9,4 @@ mod pipeline;
 mod plots;
 mod sigmf_lo;
 mod snapshot;
+mod vector;

@@ -36,6 +36,47 @@ impl DopplerAid {
     }
 }
 
+/// Who drives the channels' NCOs (`[tracking] mode`, `gpsrx run --tracking`).
+///
+/// - `scalar`: every channel's own loops (PLL/FLL and DLL) track alone (or aided by an INS,
+///   `--ins`);
+/// - `vector`: after the first valid fix a navigation filter (position, velocity, clock bias
+///   and drift) predicts every satellite's Doppler and feeds it forward through the aiding
+///   port ([`AidingPort`]); the channels' own loops stay on top and track the residual
+///   (a VDFLL-style feed-forward, issue 29). Back to scalar when the filter's health test fails.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TrackingMode {
+    /// Scalar tracking loops (the default).
+    #[default]
+    Scalar,
+    /// The navigation filter feeds every carrier NCO forward.
+    Vector,
+}
+
+impl std::str::FromStr for TrackingMode {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "scalar" => Ok(Self::Scalar),
+            "vector" => Ok(Self::Vector),
+            other => Err(format!(
+                "tracking mode `{other}`: use `scalar` (each channel's own loops) or `vector` (the navigation filter drives the channels)"
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for TrackingMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Scalar => "scalar",
+            Self::Vector => "vector",
+        })
+    }
+}
+
 /// The aiding port of the tracking channels: where an external Doppler estimate comes from.
 ///
 /// The receiver asks it for every channel at the start of every code period (seed 004 Fig. 4:

@@ -96,6 +96,10 @@ pub struct ChannelConfig {
     /// The correlator's arithmetic: `auto` (the faster per block format: int16 on ci8 with
     /// AVX2, f32 otherwise), `f32` or `i16` ([`CorrelatorArithmetic`]).
     pub correlator_arithmetic: CorrelatorArithmetic,
+    /// Who drives the NCOs: `scalar` (the default) or `vector` (the receiver's navigation
+    /// filter feeds every channel forward, [`crate::aiding::TrackingMode`]). The channel itself
+    /// only sees the aiding port; the receiver reads this.
+    pub mode: crate::aiding::TrackingMode,
 }
 
 impl Default for ChannelConfig {
@@ -152,6 +156,7 @@ impl Default for ChannelConfig {
             weak_pull_in: Some(WeakPullInConfig::default()),
             correlator: CorrelatorIsa::Auto,
             correlator_arithmetic: CorrelatorArithmetic::Auto,
+            mode: crate::aiding::TrackingMode::Scalar,
         }
     }
 }

@@ -46,6 +46,13 @@ pub struct RunArgs {
     /// time and peak memory (with --json the stage times are in the summary's `profile`).
     #[arg(long)]
     pub profile: bool,
+    /// Who drives the channels: `scalar` (each channel's own loops) or `vector` (after the
+    /// first valid fix a navigation filter predicts every satellite's Doppler and feeds it
+    /// forward into the carrier NCOs; back to scalar when its health test fails). Not with
+    /// `--ins` yet. Config file: `[tracking] mode`; `[vector]` tunes the filter
+    /// [default: scalar].
+    #[arg(long, value_name = "MODE")]
+    pub tracking: Option<gpsrx_tracking::TrackingMode>,
     /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
     #[arg(long, value_name = "FILE")]
     pub nav: Option<PathBuf>,
@@ -224,6 +231,9 @@ impl RunArgs {
         }
         r.allow_unhealthy |= self.allow_unhealthy;
         r.plots &= !self.no_plots;
+        if let Some(mode) = self.tracking {
+            c.tracking.mode = mode;
+        }
         c.validate()?;
         Ok(c)
     }
@@ -262,4 +272,38 @@ pub fn parse_llh(text: &str) -> Result<[f64; 3], String> {
     let llh = [lat, lon, h];
     config::check_approx_llh(&llh)?;
     Ok(llh)
+}
+
+#[cfg(test)]
+mod tracking_option_tests {
+    use crate::cli::{Cli, Command};
+    use clap::Parser;
+    use gpsrx_tracking::TrackingMode;
+
+    fn run_args(extra: &[&str]) -> Result<Box<super::RunArgs>, String> {
+        let mut argv = vec!["gpsrx", "run", "rec.ci8", "--fs", "2e6", "--out", "o"];
+        argv.extend_from_slice(extra);
+        match Cli::try_parse_from(argv) {
+            Ok(Cli {
+                command: Command::Run(a),
+                ..
+            }) => Ok(a),
+            Ok(_) => Err("not a run".into()),
+            Err(e) => Err(e.to_string()),
+        }
+    }
+
+    #[test]
+    fn tracking_defaults_to_scalar_and_takes_vector() {
+        let a = run_args(&[]).unwrap_or_else(|e| panic!("{e}"));
+        let c = a.receiver_config().unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(c.tracking.mode, TrackingMode::Scalar);
+        let a = run_args(&["--tracking", "vector"]).unwrap_or_else(|e| panic!("{e}"));
+        let c = a.receiver_config().unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(c.tracking.mode, TrackingMode::Vector);
+        let err = run_args(&["--tracking", "vectorish"])
+            .err()
+            .unwrap_or_default();
+        assert!(err.contains("scalar") && err.contains("vector"), "{err}");
+    }
 }

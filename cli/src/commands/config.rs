@@ -53,6 +53,7 @@ pub fn default_toml() -> anyhow::Result<String> {
          # Unknown keys are errors.\n\
          \n\
          [tracking]\n\
+         mode = \"scalar\"           # scalar, or vector: the navigation filter ([vector]) drives the channels after the first fix (--tracking)\n\
          min_pull_in_s = {:?}      # minimum pull-in time before the hand-over to [tracking.track], s\n\
          fll_assist_s = {:?}       # the pull-in FLL assist is switched off after this, s\n\
          cn0_lost_dbhz = {:?}      # C/N0 below which a channel counts as lost, dB-Hz\n\
@@ -134,7 +135,16 @@ pub fn default_toml() -> anyhow::Result<String> {
         loops("weak_pull_in.fll", &w.fll)?,
         loops("weak_pull_in.pll", &w.pll)?,
     );
-    Ok(text)
+    let v = gpsrx_receiver::config::VectorSettings::default();
+    let vector = format!(
+        "\n[vector]                  # the navigation filter of vector tracking ([tracking] mode = \"vector\")\n\
+         accel_psd_m2_s3 = {:?}    # white-noise acceleration PSD per ECEF axis, m^2/s^3 (static: 0.1; a 10 g turn: 1000)\n\
+         clock_h0 = {:e}          # receiver oscillator white frequency noise h0, s (a TCXO)\n\
+         clock_h_2 = {:e}         # receiver oscillator random-walk frequency noise h-2, 1/s (a TCXO)\n\
+         gate_pfa = {:?}          # false-alarm probability of the innovation test that excludes a channel\n",
+        v.accel_psd_m2_s3, v.clock_h0, v.clock_h_2, v.gate_pfa,
+    );
+    Ok(text + &vector)
 }
 
 fn enum_name<T: serde::Serialize>(v: &T) -> anyhow::Result<String> {
@@ -157,6 +167,7 @@ mod tests {
         let defaults = gpsrx_receiver::ReceiverConfig::default();
         assert_eq!(f.tracking, ChannelConfig::default());
         assert_eq!(f.run, defaults.run);
+        assert_eq!(f.vector, defaults.vector);
         let nominal = gpsrx_ins_aiding::DrParams::default();
         assert_eq!(f.dr.sf_g_dps_per_v, Some(nominal.sf_g_dps_per_v));
         assert_eq!(f.dr.v_nom_v, Some(nominal.v_nom_v));

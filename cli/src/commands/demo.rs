@@ -53,6 +53,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         // The plots only when the files are kept.
         no_plots: args.keep.is_none(),
         profile: false,
+        tracking: None,
         nav: None,
         iono: Some(IonoModel::Klobuchar),
         tropo: Some(TropoModel::Saastamoinen),

@@ -3,7 +3,8 @@
 //!
 //! A plain key is a field of the `[run]` table ([`crate::config::RunSettings`]: `rate_hz`,
 //! `tropo`, `elevation_mask_deg`, `approx_llh`, ...); a dotted key `table.field` names another
-//! table (`tracking.cn0_lost_dbhz`, `dr.filter`). Values are TOML values. Unknown keys and
+//! table (`tracking.cn0_lost_dbhz`, `dr.filter`); the plain key `tracking` is
+//! `tracking.mode` (`tracking = "vector"`). Values are TOML values. Unknown keys and
 //! values of the wrong type are errors that list the valid keys (serde `deny_unknown_fields`),
 //! and the result is validated as a `gpsrx.toml` file is.
 
@@ -30,6 +31,9 @@ pub fn config_with_options(
     for (key, value) in options {
         let path: Vec<&str> = if key.contains('.') {
             key.split('.').collect()
+        } else if key == "tracking" {
+            // `tracking="vector"` (a Python keyword, a manifest column): `[tracking] mode`.
+            vec!["tracking", "mode"]
         } else {
             vec!["run", key.as_str()]
         };

@@ -2,7 +2,7 @@
 //!
 //! [`Receiver`] (in `receiver`) is the whole receiver, driven by a
 //! [`gpsrx_samples::SampleSource`] (`run`) or by sample blocks (`push`), writing to a [`Sink`].
-//! Around it, four wings, a folder each with one public face:
+//! Around it, five wings, a folder each with one public face:
 //!
 //! - [`channels`]: the cold start, re-acquisition, the search schedule, the sample window and
 //!   the channels' work per block (and channels alone over a stream, [`channels::track`]);
@@ -11,6 +11,8 @@
 //! - [`navigation`]: LNAV decoders, observables and carrier smoothing, PVT with RAIM, fix
 //!   output and clock steering ([`navigation::NavigationProcessor`]);
 //! - [`aiding`]: the INS-velocity Doppler feed-forward and its integrity monitor;
+//! - [`vector`]: vector tracking, the navigation filter that drives the channels through the
+//!   same aiding port (`--tracking vector`);
 //!
 //! and what the receiver emits: [`sink`] (the [`Sink`] trait and the products [`Fix`],
 //! [`ObsEpoch`], [`ChannelRow`]); `profile`: where a run's time goes, stage by stage
@@ -25,6 +27,7 @@ pub mod sink;
 #[cfg(test)]
 mod test_support;
 pub mod timing;
+pub mod vector;
 
 pub use channels::SearchSettings;
 pub use profile::StageTimes;
@@ -37,3 +40,4 @@ pub use sink::{
     Progress, ReceiverEvent, SatObs, SatView, Sink, SinkError, Tee,
 };
 pub use timing::{WeekReference, WeekSource};
+pub use vector::VectorSummary;

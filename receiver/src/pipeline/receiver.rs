@@ -20,13 +20,14 @@ use crate::pipeline::sink::{ReceiverEvent, Sink, SinkError};
 use crate::pipeline::timing::code_jump::plan_realignment;
 use crate::pipeline::timing::dating::WeekReference;
 use crate::pipeline::timing::BlockEvent;
+use crate::pipeline::vector::{Captured, Tap, VectorSummary, VectorTracking};
 use gpsrx_dsp::acquisition::{AcqConfig, AcqResult};
 use gpsrx_dsp::Prn;
 use gpsrx_ins_aiding::InsTrack;
 use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_samples::sigmf::RecordingStart;
 use gpsrx_samples::{SampleError, SampleSource};
-use gpsrx_tracking::AidingPort;
+use gpsrx_tracking::{AidingPort, TrackingMode};
 use num_complex::Complex32;
 use std::path::Path;
 
@@ -209,6 +210,9 @@ pub struct RunSummary {
     /// With `--ins`: how much of the recording was aided, and how often the INS was rejected
     /// for disagreeing with the tracked Doppler ([`crate::pipeline::aiding::AidMonitor`]).
     pub ins_aiding: Option<InsAidingSummary>,
+    /// With `--tracking vector`: how long the navigation filter drove the channels, its
+    /// handovers and its innovation test ([`crate::pipeline::vector`]).
+    pub vector: Option<VectorSummary>,
     /// Where the wall time went, stage by stage ([`crate::pipeline::StageTimes`]).
     pub profile: StageTimes,
 }
@@ -252,6 +256,8 @@ pub struct Receiver {
     aiding: Option<InsFeedForward>,
     /// The integrity monitor of the aiding (with `aiding`).
     monitor: AidMonitor,
+    /// Vector tracking (`[tracking] mode = "vector"`).
+    vector: Option<VectorTracking>,
     /// Samples up to this index have been processed by the channels.
     processed_to: Option<u64>,
     /// Index of the first sample of the stream.
@@ -303,6 +309,13 @@ impl Receiver {
         search: SearchSettings,
     ) -> Result<Self, ReceiverError> {
         config.validate()?;
+        if config.tracking.mode == TrackingMode::Vector && assistance.ins.is_some() {
+            return Err(ReceiverError::Ins(
+                "--tracking vector does not take --ins yet (the vector + INS coupling is a later part of issue 29): run with --tracking scalar --ins, or --tracking vector without --ins".into(),
+            ));
+        }
+        let vector = (config.tracking.mode == TrackingMode::Vector)
+            .then(|| VectorTracking::new(config, assistance.nav.clone()));
         let run = &config.run;
         let manager = ChannelManager::new(fs_hz, config.tracking, search)?;
         // The week that labels receiver time until subframe 1 is decoded, and resolves the
@@ -356,6 +369,7 @@ impl Receiver {
             nav,
             aiding,
             monitor: AidMonitor::new(),
+            vector,
             processed_to: None,
             first_sample: None,
             started: std::time::Instant::now(),
@@ -399,6 +413,11 @@ impl Receiver {
     /// The INS feed-forward, when the receiver is aided.
     pub fn aiding(&self) -> Option<&InsFeedForward> {
         self.aiding.as_ref()
+    }
+
+    /// Vector tracking, with `[tracking] mode = "vector"`.
+    pub fn vector(&self) -> Option<&VectorTracking> {
+        self.vector.as_ref()
     }
 
     /// Reads `source` to its end, front to back, once; returns the summary.
@@ -453,7 +472,7 @@ impl Receiver {
                 .manager
                 .due_search(view, &|p| nav.visibility(p.get(), t_s));
             let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
-            let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
+            let aid = round_aid(gated.as_ref(), self.vector.as_ref());
             let manager = &mut self.manager;
             let end = view.end();
             let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
@@ -543,6 +562,7 @@ impl Receiver {
                 .aiding
                 .as_ref()
                 .map(|_| InsAidingSummary::new(self.monitor.stats(), duration_s)),
+            vector: self.vector.as_ref().map(VectorTracking::summary),
             profile: self.profile(),
         })
     }
@@ -600,7 +620,7 @@ impl Receiver {
             .manager
             .due_search(view, &|p| nav.visibility(p.get(), t_s));
         let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
-        let aid = gated.as_ref().map(|a| a as &dyn AidingPort);
+        let aid = round_aid(gated.as_ref(), self.vector.as_ref());
         let manager = &mut self.manager;
         let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
         self.processed_to = Some(limit);
@@ -649,6 +669,7 @@ impl Receiver {
             manager: &mut self.manager,
             aiding: self.aiding.as_ref(),
             monitor: &mut self.monitor,
+            vector: self.vector.as_mut(),
             span: done_span(self.first_sample, self.processed_to, self.fs_hz),
         };
         let (got, passed) = self
@@ -668,6 +689,7 @@ impl Receiver {
             manager: &mut self.manager,
             aiding: self.aiding.as_ref(),
             monitor: &mut self.monitor,
+            vector: self.vector.as_mut(),
             span: done_span(self.first_sample, self.processed_to, self.fs_hz),
         }
     }
@@ -759,6 +781,8 @@ struct ReportsOut<'a> {
     manager: &'a mut ChannelManager,
     aiding: Option<&'a InsFeedForward>,
     monitor: &'a mut AidMonitor,
+    /// Vector tracking, which takes the round's observables and fixes.
+    vector: Option<&'a mut VectorTracking>,
     /// [`done_span`] of the round.
     span: Option<(f64, f64)>,
 }
@@ -772,17 +796,31 @@ impl ReportsOut<'_> {
             manager,
             aiding,
             monitor,
+            vector,
             span,
         } = self;
         let predict = |prn: u8, t: f64| aiding.and_then(|ff| ff.predicted_doppler_hz(prn, t));
+        let mut captured: Vec<Captured> = Vec::new();
+        let tapping = vector.is_some();
         manager
             .drain_reports(|i, e| {
                 if aiding.is_some() {
                     monitor.observe(i, e, &predict);
                 }
-                nav.on_report(i, e, aiding, sink)
+                if tapping {
+                    let mut tap = Tap {
+                        inner: &mut *sink,
+                        captured: &mut captured,
+                    };
+                    nav.on_report(i, e, aiding, &mut tap)
+                } else {
+                    nav.on_report(i, e, aiding, sink)
+                }
             })
             .map_err(ReceiverError::Sink)?;
+        if let Some(v) = vector {
+            v.take(captured, nav);
+        }
         if let (Some(ff), Some((t_first, t_done))) = (aiding, span) {
             monitor.evaluate(t_first, t_done, ff.expected_common_residual_hz(), &predict);
         }
@@ -800,6 +838,19 @@ fn gated_aid<'a>(
         port,
         permission: monitor.permission(),
     })
+}
+
+/// The aiding port of the next round: the gated INS feed-forward with `--ins`, the
+/// navigation filter's with `--tracking vector` (the two are never both on), else none.
+fn round_aid<'a>(
+    gated: Option<&'a GatedAid<'a, InsFeedForward>>,
+    vector: Option<&'a VectorTracking>,
+) -> Option<&'a dyn AidingPort> {
+    match (gated, vector) {
+        (Some(g), _) => Some(g as &dyn AidingPort),
+        (None, Some(v)) => Some(v.port() as &dyn AidingPort),
+        (None, None) => None,
+    }
 }
 
 /// Logs what an INS accelerometer bias of 1 mg per axis (up to sqrt 3 mg on a line of sight)

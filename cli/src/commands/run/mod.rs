@@ -251,6 +251,13 @@ fn print_report(out: &mut dyn Write, report: &RunReport, args: &RunArgs) -> std:
             writeln!(out)?;
         }
     }
+    if let Some(v) = &s.vector {
+        writeln!(
+            out,
+            "vector tracking: the navigation filter drove the channels for {:.1} s of {:.1} s (taken {} times, given back {} times); {} measurements admitted, {} excluded by its innovation test",
+            v.vector_s, s.duration_s, v.engagements, v.disengagements, v.admitted_rows, v.rejected_rows
+        )?;
+    }
     if let Some([g, f, d]) = report.fused_rows {
         writeln!(
             out,

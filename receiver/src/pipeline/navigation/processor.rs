@@ -287,6 +287,16 @@ impl NavigationProcessor {
         self.searched.difference(&self.locked).copied().collect()
     }
 
+    /// The ephemeris decoded from satellite `prn`'s signal, if any (vector tracking's model).
+    pub fn decoded_ephemeris(&self, prn: u8) -> Option<&gpsrx_nav::ephemeris::Ephemeris> {
+        self.decoders.get(&prn)?.ephemeris.as_ref()
+    }
+
+    /// The decoded Klobuchar parameters, if any (vector tracking's model).
+    pub fn decoded_iono(&self) -> Option<gpsrx_nav::atmosphere::KlobucharParams> {
+        self.decoders.values().find_map(|d| d.iono)
+    }
+
     /// What was decoded: ephemerides, ionosphere and UTC parameters.
     pub fn end(&self) -> NavigationEnd {
         NavigationEnd {

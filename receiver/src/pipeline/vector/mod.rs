@@ -1,0 +1,33 @@
+//! Vector wing: the navigation filter drives the channels (`--tracking vector`, issue 29, first
+//! part: a VDFLL-style carrier feed-forward).
+//!
+//! - `ekf`: [`NavFilter`], the 8-state extended Kalman filter (position, velocity, clock bias
+//!   and drift; white-noise acceleration, a TCXO clock model) with its innovation test;
+//! - `noise`: each channel's measurement noise from its C/N0 (DLL and FLL thermal noise);
+//! - `measure`: the filter's rows from an epoch of pseudoranges and Dopplers;
+//! - `feed`: the filter's Doppler prediction for every satellite through the aiding port
+//!   ([`VectorPort`]);
+//! - `dynamics`: the acceleration test that keeps the filter's feed-forward, 0.2-0.3 s ahead
+//!   of its last measurement, off the channels while the receiver accelerates hard;
+//! - `tracker`: [`VectorTracking`], the handover scalar to vector and back, fed with what the
+//!   navigation processor emits ([`Captured`], taken by [`Tap`]).
+//!
+//! Not in this part: the code NCO driven from the predicted range (the code loop stays
+//! carrier-aided), long coherent integration with data-bit wipe-off, the INS error states
+//! (`--tracking vector` with `--ins` is refused), re-acquisition from the filter's prediction.
+
+mod dynamics;
+pub mod ekf;
+pub mod feed;
+pub mod measure;
+pub mod noise;
+mod tap;
+mod tracker;
+
+pub use ekf::{ClockModel, FilterParams, NavFilter, Row, RowKind, UpdateOutcome};
+pub use feed::{Snapshot, VectorPort};
+pub use tap::Tap;
+pub use tracker::{Captured, VectorSummary, VectorTracking};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,393 @@
+//! Vector tracking over a run: when the navigation filter takes the channels and when it gives
+//! them back, and what it is fed.
+//!
+//! - **Scalar until the first valid fix.** The first least-squares fix that passes the
+//!   integrity test (RAIM, PDOP) with at least [`MIN_START_SATELLITES`] satellites and a
+//!   velocity good to [`MAX_START_VELOCITY_SIGMA_MPS`] per axis starts the filter from its
+//!   position, velocity, clock and covariance ([`NavFilter::from_solution`]); from then on the
+//!   filter's prediction is fed forward into every channel ([`VectorPort`]). (A fix of 4
+//!   satellites has a velocity good to 1-5 m/s only: 5-25 Hz of feed-forward error, enough to
+//!   throw a 20 ms loop into a false lock 25 Hz off.)
+//! - **Vector.** Every epoch of observables (the navigation rate, `[run] rate_hz`) predicts
+//!   the filter to the epoch and updates it with the pseudoranges and Dopplers of the tracked
+//!   channels (`measure`), each weighted by its C/N0 (`noise`), each tested (`ekf`).
+//! - **Not under hard dynamics** (`dynamics`): the filter takes the channels only once the
+//!   fixes' velocities have shown less than 3 m/s^2 for 1 s, and hands them back as soon as
+//!   they show more (its feed-forward is a prediction 0.2-0.3 s ahead of its last
+//!   measurement).
+//! - **Back to scalar** when the filter's health test fails [`UNHEALTHY_EPOCHS`] epochs in a
+//!   row, or when no row was admitted for [`MAX_COAST_S`] (1 s: the channels lost everything): an
+//!   epoch is unhealthy when it had measurements and none was admitted, when more rows were
+//!   excluded than admitted, or when the 3-D position sigma is above [`MAX_POSITION_SIGMA_M`].
+//!   Fewer than 4 satellites do not make it unhealthy: the filter coasts on its prediction
+//!   through a partial blockage (its covariance grows, the sigma test ends it). The next valid
+//!   fix starts the filter again.
+//!
+//! The least-squares fixes stay the receiver's output; the filter only drives the channels.
+//!
+//! # Time
+//!
+//! The observables are dated by the receiver clock; the channels ask for their aid at stream
+//! time (seconds from the first sample). Each epoch that has a fix pairs the two (the fix
+//! report carries the stream time of its epoch); an epoch without one takes the offset of the
+//! last pair (a whole-millisecond step of the receiver clock moves it by 1 ms, nothing for a
+//! Doppler prediction).
+
+use super::dynamics::AccelWatch;
+use super::ekf::{ClockModel, FilterParams, NavFilter, RowKind, BIAS};
+use super::feed::{Snapshot, VectorPort, MAX_COAST_S};
+use super::measure::{epoch_rows, RowModel};
+use super::noise::LoopNoise;
+use crate::config::{IonoModel, ReceiverConfig, TropoModel};
+use crate::pipeline::navigation::NavigationProcessor;
+use crate::pipeline::sink::{FixQuality, FixReport, ObsEpoch};
+use gpsrx_core::constants::SPEED_OF_LIGHT_MPS;
+use gpsrx_nav::atmosphere::KlobucharParams;
+use gpsrx_nav::ephemeris::{Ephemeris, HealthPolicy};
+use gpsrx_nav::pvt::{chi_square_quantile, PvtOptions, PvtSolution};
+use gpsrx_nav::rinex_nav::NavData;
+use gpsrx_nav::time::GpsTime;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Unhealthy epochs in a row that hand the channels back to their scalar loops.
+pub const UNHEALTHY_EPOCHS: u32 = 3;
+/// 3-D position sigma above which the filter is unhealthy, m.
+pub const MAX_POSITION_SIGMA_M: f64 = 100.0;
+/// Fewest satellites of a fix that starts the filter (RAIM can check it).
+pub const MIN_START_SATELLITES: usize = 5;
+/// Largest per-axis velocity sigma of a fix that starts the filter, m/s.
+pub const MAX_START_VELOCITY_SIGMA_MPS: f64 = 0.5;
+
+/// What the navigation processor emitted in a round that vector tracking takes.
+#[derive(Debug, Clone)]
+pub enum Captured {
+    /// An epoch of observables.
+    Observables(ObsEpoch),
+    /// The least-squares fix of the epoch just before.
+    Fix {
+        /// Stream time of the epoch, s.
+        t_stream_s: f64,
+        /// The solution.
+        solution: Box<PvtSolution>,
+        /// It is a valid fix (integrity and geometry passed).
+        valid: bool,
+    },
+}
+
+impl Captured {
+    /// The capture of a fix report.
+    pub fn fix(report: &FixReport) -> Self {
+        Captured::Fix {
+            t_stream_s: report.t_stream_s,
+            solution: Box::new(report.solution.clone()),
+            valid: report.fix.quality != FixQuality::None,
+        }
+    }
+}
+
+/// Whether a valid fix may start the filter (module docs).
+fn starts_the_filter(sol: &PvtSolution) -> bool {
+    let velocity_ok = sol.vel_covariance.is_some_and(|c| {
+        (0..3).all(|i| c[(i, i)].is_finite() && c[(i, i)].sqrt() <= MAX_START_VELOCITY_SIGMA_MPS)
+    });
+    sol.n_sv >= MIN_START_SATELLITES && velocity_ok && sol.vel_ecef_mps.is_some()
+}
+
+/// Vector tracking over a run.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct VectorSummary {
+    /// Seconds of signal the filter drove the channels.
+    pub vector_s: f64,
+    /// Times the filter took the channels (scalar to vector).
+    pub engagements: usize,
+    /// Times it gave them back (vector to scalar).
+    pub disengagements: usize,
+    /// Filter updates.
+    pub updates: usize,
+    /// Measurement rows excluded by the innovation test.
+    pub rejected_rows: usize,
+    /// Measurement rows admitted.
+    pub admitted_rows: usize,
+}
+
+/// The navigation filter that drives the channels, and its handover (module docs).
+#[derive(Debug)]
+pub struct VectorTracking {
+    params: FilterParams,
+    opts: PvtOptions,
+    iono_model: IonoModel,
+    track: LoopNoise,
+    weak: Option<(LoopNoise, f64)>,
+    allow_unhealthy: bool,
+    assist: Option<NavData>,
+    filter: Option<NavFilter>,
+    /// Receiver time and stream time of the last update.
+    last: Option<(GpsTime, f64)>,
+    /// Stream time of the last update that admitted a row.
+    last_admitted_s: f64,
+    /// Receiver time and stream time of the last epoch with a fix (module docs, "Time").
+    pair: Option<(GpsTime, f64)>,
+    unhealthy_in_row: u32,
+    /// The acceleration from the valid fixes' velocities.
+    dynamics: AccelWatch,
+    port: VectorPort,
+    summary: VectorSummary,
+}
+
+impl VectorTracking {
+    /// Vector tracking as `config` sets it, with the `--nav` ephemerides (used until a
+    /// satellite's own are decoded).
+    pub fn new(config: &ReceiverConfig, assist: Option<NavData>) -> Self {
+        let v = &config.vector;
+        let gate = chi_square_quantile(1.0 - v.gate_pfa, 1.0).unwrap_or(10.83);
+        let t = &config.tracking;
+        Self {
+            params: FilterParams {
+                accel_psd_m2_s3: v.accel_psd_m2_s3,
+                clock: ClockModel {
+                    h0: v.clock_h0,
+                    h_2: v.clock_h_2,
+                },
+                gate,
+            },
+            opts: PvtOptions {
+                tropo: config.run.tropo == TropoModel::Saastamoinen,
+                elevation_mask_deg: config.run.elevation_mask_deg,
+                ..PvtOptions::default()
+            },
+            iono_model: config.run.iono,
+            track: LoopNoise::of(&t.track),
+            weak: t.weak_track.map(|w| (LoopNoise::of(&w), t.weak_enter_dbhz)),
+            allow_unhealthy: config.run.allow_unhealthy,
+            assist,
+            filter: None,
+            last: None,
+            last_admitted_s: 0.0,
+            pair: None,
+            unhealthy_in_row: 0,
+            dynamics: AccelWatch::default(),
+            port: VectorPort::default(),
+            summary: VectorSummary::default(),
+        }
+    }
+
+    /// The aiding port for the channels' next round.
+    pub fn port(&self) -> &VectorPort {
+        &self.port
+    }
+
+    /// The filter, while it drives the channels.
+    pub fn filter(&self) -> Option<&NavFilter> {
+        self.filter.as_ref()
+    }
+
+    /// What vector tracking did so far.
+    pub fn summary(&self) -> VectorSummary {
+        self.summary.clone()
+    }
+
+    /// Takes what the navigation processor emitted in a round, in order, with its decoded
+    /// ephemerides and ionosphere.
+    pub fn take(&mut self, captured: Vec<Captured>, nav: &NavigationProcessor) {
+        let mut it = captured.into_iter().peekable();
+        while let Some(c) = it.next() {
+            let Captured::Observables(epoch) = c else {
+                continue;
+            };
+            let fix = match it.peek() {
+                Some(Captured::Fix { .. }) => match it.next() {
+                    Some(Captured::Fix {
+                        t_stream_s,
+                        solution,
+                        valid,
+                    }) => Some((t_stream_s, solution, valid)),
+                    _ => None,
+                },
+                _ => None,
+            };
+            if let Some((t, sol, valid)) = &fix {
+                self.pair = Some((epoch.time, *t));
+                match (valid, sol.vel_ecef_mps) {
+                    (true, Some(v)) => self.dynamics.push(*t, v),
+                    _ => self.dynamics.reset(),
+                }
+            }
+            let Some((rx0, t0)) = self.pair else {
+                continue;
+            };
+            let t_stream_s = t0 + epoch.time.diff_s(rx0);
+            if self.filter.is_some() && self.dynamics.too_high() {
+                let a = self.dynamics.accel_mps2().unwrap_or(f64::NAN);
+                self.disengage(
+                    t_stream_s,
+                    &format!("the receiver accelerates at {a:.1} m/s^2, more than its feed-forward can follow"),
+                );
+            }
+            self.on_epoch(&epoch, t_stream_s, nav);
+            if let (None, Some((_, sol, true))) = (&self.filter, &fix) {
+                if starts_the_filter(sol) && self.dynamics.calm_at(t_stream_s) {
+                    self.engage(&epoch, t_stream_s, sol, nav);
+                }
+            }
+        }
+    }
+
+    /// Starts the filter from a valid fix.
+    fn engage(
+        &mut self,
+        epoch: &ObsEpoch,
+        t_stream_s: f64,
+        sol: &PvtSolution,
+        nav: &NavigationProcessor,
+    ) {
+        let filter = NavFilter::from_solution(sol, self.params);
+        tracing::info!(
+            "{t_stream_s:.2} s: vector tracking on: the navigation filter drives the channels (started from a fix of {} satellites)",
+            sol.n_sv
+        );
+        self.filter = Some(filter);
+        self.last = Some((epoch.time, t_stream_s));
+        self.last_admitted_s = t_stream_s;
+        self.unhealthy_in_row = 0;
+        self.summary.engagements += 1;
+        self.publish(epoch, t_stream_s, nav);
+    }
+
+    /// Hands the channels back to their scalar loops.
+    fn disengage(&mut self, t_stream_s: f64, why: &str) {
+        if self.filter.take().is_some() {
+            tracing::info!("{t_stream_s:.2} s: vector tracking off ({why}): the channels track alone until the next valid fix");
+            self.summary.disengagements += 1;
+        }
+        self.port.snapshot = None;
+        self.last = None;
+        self.unhealthy_in_row = 0;
+    }
+
+    /// The ephemeris of `prn` at `t`: decoded, else from the navigation file (as the fixes).
+    fn ephemeris(&self, nav: &NavigationProcessor, prn: u8, t: GpsTime) -> Option<Ephemeris> {
+        let policy = if self.allow_unhealthy {
+            HealthPolicy::PreferHealthy
+        } else {
+            HealthPolicy::HealthyOnly
+        };
+        nav.decoded_ephemeris(prn).cloned().or_else(|| {
+            self.assist
+                .as_ref()
+                .and_then(|n| n.select_with(prn, t, policy).cloned())
+        })
+    }
+
+    /// The ionosphere of the model: decoded, assisted, else the typical set (as the fixes).
+    fn iono(&self, nav: &NavigationProcessor) -> Option<KlobucharParams> {
+        (self.iono_model == IonoModel::Klobuchar).then(|| {
+            nav.decoded_iono()
+                .or_else(|| self.assist.as_ref().and_then(|n| n.iono))
+                .unwrap_or(KlobucharParams::FALLBACK)
+        })
+    }
+
+    /// One epoch: predict, update, health, and the new snapshot for the channels.
+    fn on_epoch(&mut self, epoch: &ObsEpoch, t_stream_s: f64, nav: &NavigationProcessor) {
+        let (Some(filter), Some((rx_last, t_last))) = (self.filter.as_mut(), self.last) else {
+            return;
+        };
+        let dt = epoch.time.diff_s(rx_last);
+        if !(dt.is_finite() && dt > 0.0) {
+            return;
+        }
+        if t_stream_s - self.last_admitted_s > MAX_COAST_S {
+            self.disengage(t_stream_s, "no measurement admitted for too long");
+            return;
+        }
+        filter.predict(dt);
+        let x = *filter.state();
+        let opts = PvtOptions {
+            iono: self.iono(nav),
+            ..self.opts
+        };
+        let (track, weak) = (self.track, self.weak);
+        let loops = move |cn0: f64| match weak {
+            Some((w, enter)) if cn0 < enter => w,
+            _ => track,
+        };
+        let model = RowModel {
+            opts: &opts,
+            loops: &loops,
+            dt_s: dt,
+            allow_unhealthy: self.allow_unhealthy,
+        };
+        let eph = |prn: u8| self.ephemeris(nav, prn, epoch.time);
+        let rows = epoch_rows(epoch, &eph, &x, &model);
+        let Some(filter) = self.filter.as_mut() else {
+            return;
+        };
+        let out = filter.update(&rows);
+        self.summary.updates += 1;
+        self.summary.admitted_rows += out.admitted;
+        self.summary.rejected_rows += out.rejected.len();
+        self.summary.vector_s += t_stream_s - t_last;
+        self.last = Some((epoch.time, t_stream_s));
+        for (prn, kind, nis) in &out.rejected {
+            let what = match kind {
+                RowKind::Code => "pseudorange",
+                RowKind::Doppler => "Doppler",
+            };
+            tracing::debug!(
+                "{t_stream_s:.2} s: vector filter excluded the {what} of G{prn:02} (NIS {nis:.1})"
+            );
+        }
+        if out.admitted > 0 {
+            self.last_admitted_s = t_stream_s;
+        }
+        let v = filter.velocity_mps();
+        tracing::debug!(
+            "{t_stream_s:.2} s: vector filter: {} rows admitted ({} pseudoranges), {} excluded; velocity {:.3} {:.3} {:.3} m/s, drift {:.3} m/s, position sigma {:.2} m",
+            out.admitted,
+            out.admitted_code,
+            out.rejected.len(),
+            v.x,
+            v.y,
+            v.z,
+            filter.state()[super::ekf::DRIFT],
+            filter.position_sigma_m()
+        );
+        let healthy = (rows.is_empty() || out.admitted > 0)
+            && out.rejected.len() <= out.admitted
+            && filter.position_sigma_m() <= MAX_POSITION_SIGMA_M;
+        self.unhealthy_in_row = if healthy {
+            0
+        } else {
+            self.unhealthy_in_row + 1
+        };
+        if self.unhealthy_in_row >= UNHEALTHY_EPOCHS {
+            let why = format!(
+                "health test failed {UNHEALTHY_EPOCHS} epochs in a row: {} pseudoranges admitted, {} rows excluded, position sigma {:.1} m",
+                out.admitted_code,
+                out.rejected.len(),
+                filter.position_sigma_m()
+            );
+            self.disengage(t_stream_s, &why);
+            return;
+        }
+        self.publish(epoch, t_stream_s, nav);
+    }
+
+    /// The snapshot the channels are aided from until the next epoch.
+    fn publish(&mut self, epoch: &ObsEpoch, t_stream_s: f64, nav: &NavigationProcessor) {
+        let Some(filter) = self.filter.as_ref() else {
+            return;
+        };
+        let x = *filter.state();
+        let ephemerides: BTreeMap<u8, Ephemeris> = (1..=32u8)
+            .filter_map(|prn| Some((prn, self.ephemeris(nav, prn, epoch.time)?)))
+            .collect();
+        self.port.snapshot = Some(Snapshot {
+            t_stream_s,
+            gps_time: epoch.time.add_seconds(-x[BIAS] / SPEED_OF_LIGHT_MPS),
+            x,
+            ephemerides: Arc::new(ephemerides),
+        });
+    }
+}

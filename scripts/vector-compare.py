@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""Scalar vs vector tracking (issue 29) on simulated scenarios, scored against the simulator's truth.
+
+Usage: simulate first (VEC_WORK defaults to /tmp/vec):
+  gpsrx simulate samples/scenarios/vector-weak-23-33dbhz.toml -o $VEC_WORK/sim-vector-weak-23-33dbhz
+  gpsrx simulate samples/scenarios/vector-blockage-3s.toml   -o $VEC_WORK/sim-vector-blockage-3s
+  gpsrx simulate samples/scenarios/turn-10g-ins-perfect.toml -o $VEC_WORK/sim-turn
+then `scripts/vector-compare.py weak|block|turn`. Prints, per mode: valid fixes, mean satellites
+in the fixes, the PRNs used, horizontal RMS against truth.csv, the time back to a valid fix after
+the blockage, and the share of 20-27 s each satellite's channel was in carrier lock in the turn.
+"""
+import csv, json, math, subprocess, sys, os
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+GPSRX = os.environ.get("GPSRX", os.path.join(ROOT, "target/ci/gpsrx"))
+NAV = os.environ.get("NAV", os.path.join(ROOT, "../shared/data/brdc0010.22n"))
+
+def ecef_to_enu_err(x, y, z, tx, ty, tz, lat, lon):
+    la, lo = math.radians(lat), math.radians(lon)
+    dx, dy, dz = x - tx, y - ty, z - tz
+    e = -math.sin(lo) * dx + math.cos(lo) * dy
+    n = -math.sin(la) * math.cos(lo) * dx - math.sin(la) * math.sin(lo) * dy + math.cos(la) * dz
+    u = math.cos(la) * math.cos(lo) * dx + math.cos(la) * math.sin(lo) * dy + math.sin(la) * dz
+    return e, n, u
+
+def truth(sim):
+    rows = list(csv.DictReader(open(f"{sim}/truth.csv")))
+    return [(float(r["tow_s"]), float(r["x_m"]), float(r["y_m"]), float(r["z_m"]), float(r["lat_deg"]), float(r["lon_deg"]), float(r["t_s"])) for r in rows]
+
+def truth_at(tr, tow):
+    # linear interpolation in tow
+    lo, hi = 0, len(tr) - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if tr[mid][0] <= tow: lo = mid
+        else: hi = mid
+    a, b = tr[lo], tr[hi]
+    w = 0.0 if b[0] == a[0] else (tow - a[0]) / (b[0] - a[0])
+    return tuple(a[i] + w * (b[i] - a[i]) for i in range(7))
+
+def run(sim, mode, out, extra=()):
+    cmd = [GPSRX, "run", f"{sim}/signal.sigmf-meta", "--nav", NAV, "--tropo", "none", "--allow-unhealthy",
+           "--tracking", mode, "--out", out, "--json", "--no-plots", *extra]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        print(r.stderr[-2000:]); sys.exit(1)
+    open(out + ".err", "w").write(r.stderr)
+    return json.loads(r.stdout)
+
+def score(sim, out, t_start_tow, window=None):
+    tr = truth(sim)
+    fixes = [r for r in csv.DictReader(open(f"{out}/pvt.csv")) if r["quality"] != "none"]
+    res = []
+    for f in fixes:
+        tow = float(f["tow_s"])
+        t = truth_at(tr, tow - float(f["clock_bias_m"]) / 299792458.0)
+        e, n, u = ecef_to_enu_err(float(f["x_m"]), float(f["y_m"]), float(f["z_m"]), t[1], t[2], t[3], t[4], t[5])
+        res.append((tow - t_start_tow, math.hypot(e, n), abs(u), int(f["n_sv"]), f["used_prns"].split(), float(f["sigma_e_m"]), float(f["sigma_n_m"])))
+    return res
+
+def summary(name, summ, res, sel=lambda r: True):
+    rs = [r for r in res if sel(r)]
+    if not rs:
+        print(f"{name}: no valid fixes"); return
+    h = math.sqrt(sum(r[1] ** 2 for r in rs) / len(rs))
+    used = sorted({p for r in rs for p in r[4]}, key=int)
+    mean_n = sum(r[3] for r in rs) / len(rs)
+    print(f"{name}: first fix {summ.get('first_fix_s')}, valid fixes {len(rs)}, mean n_sv {mean_n:.2f}, PRNs used {len(used)} {used}, "
+          f"H RMS {h:.2f} m, H max {max(r[1] for r in rs):.2f} m, vector {summ.get('vector')}")
+    return rs
+
+def locks(out, t0, t1):
+    rows = [r for r in csv.DictReader(open(f"{out}/channels.csv")) if r["t_stream_s"] and t0 <= float(r["t_stream_s"]) <= t1]
+    per = {}
+    for r in rows:
+        per.setdefault(r["prn"], []).append(r["carrier_lock"] == "1" and r["state"] == "track")
+    return {p: sum(v) / len(v) for p, v in per.items()}
+
+if __name__ == "__main__":
+    which = sys.argv[1]
+    base = os.environ.get("VEC_WORK", "/tmp/vec")
+    if which == "weak":
+        sim = f"{base}/sim-vector-weak-23-33dbhz"
+        for mode in ("scalar", "vector"):
+            out = f"{base}/weak-{mode}"
+            s = run(sim, mode, out)
+            res = score(sim, out, 538194.0)
+            summary(f"weak {mode} (all)", s, res)
+            summary(f"weak {mode} (t>=20s)", s, res, lambda r: r[0] >= 20)
+            print("  lock share 20-40 s:", {p: round(v, 2) for p, v in sorted(locks(out, 20, 40).items(), key=lambda x: int(x[0]))})
+    if which == "block":
+        sim = f"{base}/sim-vector-blockage-3s"
+        for mode in ("scalar", "vector"):
+            out = f"{base}/block-{mode}"
+            s = run(sim, mode, out)
+            res = score(sim, out, 538194.0)
+            summary(f"block {mode} (before)", s, res, lambda r: r[0] < 20)
+            after = [r for r in res if r[0] >= 23]
+            if after:
+                print(f"  first valid fix after the blockage: {after[0][0] - 23:.2f} s after it ended, "
+                      f"errors of the first 10: {[round(r[1], 1) for r in after[:10]]}, n_sv {[r[3] for r in after[:10]]}")
+                summary(f"block {mode} (after)", s, res, lambda r: r[0] >= 23)
+    if which == "turn":
+        PSD1000 = f"{base}/psd1000.toml"
+        with open(PSD1000, "w") as f:
+            f.write("[vector]\naccel_psd_m2_s3 = 1000.0\n")
+        sim = f"{base}/sim-turn"
+        cfgs = [("scalar", []), ("vector", []), ("vector", ["--config", PSD1000])]
+        for i, (mode, extra) in enumerate(cfgs):
+            out = f"{base}/turn-{mode}-{i}"
+            s = run(sim, mode, out, extra)
+            res = score(sim, out, 538194.0)
+            summary(f"turn {mode} {extra} (all)", s, res)
+            summary(f"turn {mode} (20-27 s)", s, res, lambda r: 20 <= r[0] <= 27)
+            lk = locks(out, 20, 27)
+            held = [p for p, v in lk.items() if v >= 0.95]
+            print(f"  satellites held through the turn (carrier lock >= 95% of 20-27 s): {len(held)} of {len(lk)}: {sorted(lk.items(), key=lambda x: int(x[0]))}")
