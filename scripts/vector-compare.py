@@ -2,7 +2,7 @@
 """Scalar vs vector tracking (issue 29) on simulated scenarios, scored against the simulator's truth.
 
 Usage: simulate first (VEC_WORK defaults to /tmp/vec):
-  gpsrx simulate samples/scenarios/vector-weak-23-33dbhz.toml -o $VEC_WORK/sim-vector-weak-23-33dbhz
+  gpsrx simulate samples/scenarios/vector-weak-26-32dbhz.toml -o $VEC_WORK/sim-vector-weak-26-32dbhz
   gpsrx simulate samples/scenarios/vector-blockage-3s.toml   -o $VEC_WORK/sim-vector-blockage-3s
   gpsrx simulate samples/scenarios/turn-10g-ins-perfect.toml -o $VEC_WORK/sim-turn
 then `scripts/vector-compare.py weak|block|turn`. Prints, per mode: valid fixes, mean satellites
@@ -80,7 +80,7 @@ if __name__ == "__main__":
     which = sys.argv[1]
     base = os.environ.get("VEC_WORK", "/tmp/vec")
     if which == "weak":
-        sim = f"{base}/sim-vector-weak-23-33dbhz"
+        sim = f"{base}/sim-vector-weak-26-32dbhz"
         for mode in ("scalar", "vector"):
             out = f"{base}/weak-{mode}"
             s = run(sim, mode, out)
