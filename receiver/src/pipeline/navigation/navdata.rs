@@ -369,7 +369,7 @@ impl NavDecoder {
 
     /// The SV time (TOW, s) at the start of code period `ms_count` read from the bits held
     /// since the channel's bit sync, matched against the frames before
-    /// ([`FrameMemory::place`]) among the 20 ms bit edges whose time falls in
+    /// (`FrameMemory::place`) among the 20 ms bit edges whose time falls in
     /// `[lo_s, hi_s]`: `None` until they match one edge and only one. For a time kept over
     /// lost samples of unknown length (IS-GPS-200 20.3.2: subframes 1-3 repeat every 30 s).
     pub fn sv_time_from_frames(&self, ms_count: u64, lo_s: f64, hi_s: f64) -> Option<f64> {
