@@ -330,18 +330,15 @@ fn a_thirty_second_blockage_ends_in_fixes_within_two_seconds() {
 fn no_gap_is_reported_through_a_10_g_turn() {
     // Every channel's phase error moves at once when a 10 g turn starts (a 0.5 s jerk ramp at
     // 100 m/s): dynamics, not lost samples.
-    let receiver = format!(
-        r#"kind = "motion"
-start_llh_deg = [{}, {}, {}]
-heading_deg = 90.0
-speed_mps = 100.0
-transition_s = 0.5
-segments = [
-  {{ type = "cruise", duration_s = 11.0 }},
-  {{ type = "turn", duration_s = 5.0, accel_g = 10.0, direction = "left" }},
-  {{ type = "cruise", duration_s = 6.0 }},
+    let receiver = motion_receiver(
+        90.0,
+        100.0,
+        0.5,
+        r#"[
+  { type = "cruise", duration_s = 11.0 },
+  { type = "turn", duration_s = 5.0, accel_g = 10.0, direction = "left" },
+  { type = "cruise", duration_s = 6.0 },
 ]"#,
-        LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
     );
     let sim = scenario(22.0, 5, &receiver, "");
     let sink = run(&sim, Fault::None);
@@ -366,14 +363,11 @@ fn a_31_ms_cut_at_250_m_s_is_found_from_the_moved_bit_edges_and_bridged() {
     // bits of every channel now change 9 ms into the old bits: the gap is found from those.
     // Undetected, the fixes were dated 31 ms late (7.8 m along the track, more through the
     // satellites' motion) and handed out as valid.
-    let receiver = format!(
-        r#"kind = "motion"
-start_llh_deg = [{}, {}, {}]
-heading_deg = 30.0
-speed_mps = 250.0
-transition_s = 1.0
-segments = [ {{ type = "cruise", duration_s = 16.0 }} ]"#,
-        LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
+    let receiver = motion_receiver(
+        30.0,
+        250.0,
+        1.0,
+        r#"[ { type = "cruise", duration_s = 16.0 } ]"#,
     );
     let sats = "[satellites]\ncn0_zenith_dbhz = 45.0\ncn0_horizon_loss_db = 20.0";
     let sim = scenario(16.0, 4, &receiver, sats);
@@ -435,6 +429,15 @@ fn assert_moving_fixes_and_back(
     );
 }
 
+/// The `[receiver]` body of a vehicle starting at [`LLH_DEG`] with `heading_deg`,
+/// `speed_mps`, jerk-limited transitions of `transition_s` and the TOML array `segments`.
+fn motion_receiver(heading_deg: f64, speed_mps: f64, transition_s: f64, segments: &str) -> String {
+    format!(
+        "kind = \"motion\"\nstart_llh_deg = [{}, {}, {}]\nheading_deg = {heading_deg}\nspeed_mps = {speed_mps}\ntransition_s = {transition_s}\nsegments = {segments}",
+        LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
+    )
+}
+
 /// A receiver knowing the week and the broadcast ephemerides.
 fn assisted_receiver() -> Receiver {
     let mut config = gpsrx_receiver::config::ReceiverConfig::default();
@@ -456,18 +459,15 @@ fn a_31_ms_cut_inside_a_10_g_turn_is_timed_from_the_data_bits() {
     // modulo 20) all stay open; the time came back 1.2 s into the next subframe (up to 7 s).
     // The bits after the new edges, matched against the same frame positions 30 s before
     // (subframes 1-3 repeat, the HOW counts on), fix it at 31 ms within a second and a half.
-    let receiver = format!(
-        r#"kind = "motion"
-start_llh_deg = [{}, {}, {}]
-heading_deg = 30.0
-speed_mps = 250.0
-transition_s = 1.0
-segments = [
-  {{ type = "cruise", duration_s = 40.0 }},
-  {{ type = "turn", duration_s = 6.0, accel_g = 10.0, direction = "left" }},
-  {{ type = "cruise", duration_s = 2.0 }},
+    let receiver = motion_receiver(
+        30.0,
+        250.0,
+        1.0,
+        r#"[
+  { type = "cruise", duration_s = 40.0 },
+  { type = "turn", duration_s = 6.0, accel_g = 10.0, direction = "left" },
+  { type = "cruise", duration_s = 2.0 },
 ]"#,
-        LLH_DEG[0], LLH_DEG[1], LLH_DEG[2]
     );
     let sats = "[satellites]\ncn0_zenith_dbhz = 45.0\ncn0_horizon_loss_db = 20.0";
     let sim = scenario(48.0, 4, &receiver, sats);
