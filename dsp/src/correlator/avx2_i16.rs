@@ -29,9 +29,7 @@
 //! Needs 16 samples within 15 chips (`fs` above about 1.1 MHz); otherwise [`Plan16::with`]
 //! says no and the caller runs the 8-lane kernel.
 
-use super::int16_lanes::{
-    abs_shift, ci16_positions, ci8_positions, pack_position, rotator_order, w_unit, LanePlan,
-};
+use super::int16_lanes::{abs_shift, pack_position, w_unit, KernelPlan};
 use super::packed::PackedCode;
 use super::plan::{CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
 use super::scalar::Q14;
@@ -44,25 +42,12 @@ const L: usize = 16;
 const GROUP: usize = 4;
 
 /// The code plan of the 16-lane kernel and the lane order of its samples.
-pub(super) struct Plan16 {
-    code: LanePlan<L>,
-    /// The sample each rotator lane (A then B) is seeded at.
-    rotator: [usize; L],
-    /// The sample format `rotator` is for (`u8::MAX`: none yet).
-    format: u8,
-}
+pub(super) type Plan16 = KernelPlan<L>;
 
 impl Plan16 {
-    /// An all-zero plan, to be filled.
-    const ZERO: Self = Self {
-        code: LanePlan::ZERO,
-        rotator: [0; L],
-        format: u8::MAX,
-    };
-
     /// Runs `f` with the plan for the taps of `nco` (`n_taps`) on samples of format `F` (ci8
     /// or ci16), or returns `None` if some lane lies 16 or more chips past its tap's window.
-    /// The plan is written in place into one kept per thread ([`LanePlan::fill`]).
+    /// The plan is written in place into one kept per thread ([`KernelPlan::fill`]).
     pub(super) fn with<const F: u8, R>(
         nco: &CodeNco,
         n_taps: usize,
@@ -73,24 +58,10 @@ impl Plan16 {
         }
         PLAN.with(|plan| {
             let mut plan = plan.try_borrow_mut().ok()?;
-            plan.fill::<F>(nco, n_taps).then(|| f(&plan))
+            // Compare lane j (vectors A, B) lands on the position vpackssdw puts it.
+            plan.fill::<F>(nco, n_taps, pack_position::<L>, 0x8000_0000)
+                .then(|| f(&plan))
         })
-    }
-
-    /// Writes the plan in place (see [`Plan16::with`]); `false` if it cannot be made.
-    fn fill<const F: u8>(&mut self, nco: &CodeNco, n_taps: usize) -> bool {
-        let positions = if F == CI16 {
-            ci16_positions::<L>()
-        } else {
-            ci8_positions::<L>()
-        };
-        if self.format != F {
-            self.rotator = rotator_order(&positions);
-            self.format = F;
-        }
-        // Compare lane j (vectors A, B) lands on the position vpackssdw puts it.
-        self.code
-            .fill(nco, n_taps, &positions, pack_position::<L>, 0x8000_0000)
     }
 }
 

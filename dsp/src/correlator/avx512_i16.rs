@@ -23,7 +23,7 @@
 //! about 2.2 MHz); otherwise [`Plan32::with`] says no and the caller runs the 16-lane AVX2
 //! kernel.
 
-use super::int16_lanes::{ci16_positions, ci8_positions, rotator_order, w_unit, LanePlan};
+use super::int16_lanes::{w_unit, KernelPlan};
 use super::packed::PackedCode;
 use super::plan::{CarrierNco, CodeNco, CODE_LEN_FIX, RESEED_STEPS};
 use super::scalar::Q14;
@@ -36,25 +36,12 @@ const L: usize = 32;
 const GROUP: usize = 4;
 
 /// The code plan of the 32-lane kernel and the lane order of its samples.
-pub(super) struct Plan32 {
-    code: LanePlan<L>,
-    /// The sample each rotator lane (A then B) is seeded at.
-    rotator: [usize; L],
-    /// The sample format `rotator` is for (`u8::MAX`: none yet).
-    format: u8,
-}
+pub(super) type Plan32 = KernelPlan<L>;
 
 impl Plan32 {
-    /// An all-zero plan, to be filled.
-    const ZERO: Self = Self {
-        code: LanePlan::ZERO,
-        rotator: [0; L],
-        format: u8::MAX,
-    };
-
     /// Runs `f` with the plan for the taps of `nco` (`n_taps`) on samples of format `F` (ci8
     /// or ci16), or returns `None` if some lane lies 16 or more chips past its tap's window.
-    /// The plan is written in place into one kept per thread ([`LanePlan::fill`]).
+    /// The plan is written in place into one kept per thread ([`KernelPlan::fill`]).
     pub(super) fn with<const F: u8, R>(
         nco: &CodeNco,
         n_taps: usize,
@@ -65,23 +52,9 @@ impl Plan32 {
         }
         PLAN.with(|plan| {
             let mut plan = plan.try_borrow_mut().ok()?;
-            plan.fill::<F>(nco, n_taps).then(|| f(&plan))
+            // Compare lane j sets mask bit j: position j. Unsigned compares: no sign flip.
+            plan.fill::<F>(nco, n_taps, |j| j, 0).then(|| f(&plan))
         })
-    }
-
-    /// Writes the plan in place (see [`Plan32::with`]); `false` if it cannot be made.
-    fn fill<const F: u8>(&mut self, nco: &CodeNco, n_taps: usize) -> bool {
-        let positions = if F == CI16 {
-            ci16_positions::<L>()
-        } else {
-            ci8_positions::<L>()
-        };
-        if self.format != F {
-            self.rotator = rotator_order(&positions);
-            self.format = F;
-        }
-        // Compare lane j sets mask bit j: position j. Unsigned compares: no sign flip.
-        self.code.fill(nco, n_taps, &positions, |j| j, 0)
     }
 }
 

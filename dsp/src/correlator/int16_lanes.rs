@@ -35,6 +35,7 @@
 //! `|w| <= 2^14.5 (1 + 4.1e-4) + 1 < 2^15`: no lane saturates.
 
 use super::plan::{CodeNco, CODE_LEN_FIX};
+use super::simd::CI16;
 use super::MAX_TAPS;
 
 /// The largest chip offset `h` a 16-byte code window allows (the carry adds one).
@@ -153,6 +154,48 @@ fn ci16_shift(x: &[[i16; 2]]) -> u32 {
     }
     // acc <= 0x7FFF: at least one leading zero.
     (acc.leading_zeros() - 1).min(15)
+}
+
+/// The code plan of an `L`-lane int16 kernel and the lane order of its samples, kept per
+/// thread by the kernel ([`super::avx2_i16::Plan16`], [`super::avx512_i16::Plan32`]).
+pub(super) struct KernelPlan<const L: usize> {
+    pub code: LanePlan<L>,
+    /// The sample each rotator lane (A then B) is seeded at.
+    pub rotator: [usize; L],
+    /// The sample format `rotator` is for (`u8::MAX`: none yet).
+    format: u8,
+}
+
+impl<const L: usize> KernelPlan<L> {
+    /// An all-zero plan, to be filled.
+    pub(super) const ZERO: Self = Self {
+        code: LanePlan::ZERO,
+        rotator: [0; L],
+        format: u8::MAX,
+    };
+
+    /// Writes the plan in place for the taps of `nco` (`n_taps`) on samples of format `F`
+    /// (ci8 or ci16), compare lane `j` serving position `cmp_position(j)` with thresholds
+    /// XORed with `flip` ([`LanePlan::fill`]); the rotator order is recomputed only when the
+    /// format changes. `false` if the plan cannot be made.
+    pub(super) fn fill<const F: u8>(
+        &mut self,
+        nco: &CodeNco,
+        n_taps: usize,
+        cmp_position: impl Fn(usize) -> usize,
+        flip: u32,
+    ) -> bool {
+        let positions = if F == CI16 {
+            ci16_positions::<L>()
+        } else {
+            ci8_positions::<L>()
+        };
+        if self.format != F {
+            self.rotator = rotator_order(&positions);
+            self.format = F;
+        }
+        self.code.fill(nco, n_taps, &positions, cmp_position, flip)
+    }
 }
 
 /// The headroom shift of a ci16 block from the OR of its `|v|` (`vpabsw`, |-32768| read as
