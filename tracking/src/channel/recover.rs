@@ -341,6 +341,20 @@ mod tests {
         assert!(longest_unlocked_track(&eps) < 1.1);
     }
 
+    /// A steady signal at `cn0_dbhz` (noise seed `seed`) that loses 31 ms of samples at 3 s:
+    /// its data-bit edges move by 11 ms.
+    fn cut_at_3_s(cn0_dbhz: f64, seed: u64) -> Signal {
+        Signal {
+            code: CaCode::new(Prn::new(7).expect("PRN")),
+            step_s: f64::INFINITY,
+            step_hz: 0.0,
+            off_s: f64::INFINITY,
+            cut: (3.0, 0.031),
+            cn0_dbhz,
+            rng: SimRng::new(seed),
+        }
+    }
+
     /// A satellite at 34 dB-Hz, 2 dB over the weak-signal threshold: the C/N0 estimates
     /// between lost samples and their detection straddle the moved bits and fall below it, so
     /// the channel starts narrowing to its weak-signal loops (20 ms, 6 Hz) at the next old bit
@@ -350,15 +364,7 @@ mod tests {
     /// interval is 1 ms, and the C/N0 stands at the level before the gap.
     #[test]
     fn a_bit_sync_restart_ends_a_narrowing_begun_on_the_moved_bits() {
-        let mut sig = Signal {
-            code: CaCode::new(Prn::new(7).expect("PRN")),
-            step_s: f64::INFINITY,
-            step_hz: 0.0,
-            off_s: f64::INFINITY,
-            cut: (3.0, 0.031),
-            cn0_dbhz: 34.0,
-            rng: SimRng::new(5),
-        };
+        let mut sig = cut_at_3_s(34.0, 5);
         let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
         let _ = run(&mut ch, &mut sig, 2.95);
         assert!(!ch.weak_loops() && !ch.narrowing(), "weak before the gap");
@@ -387,15 +393,7 @@ mod tests {
     /// 10 g turn), and it tracks locked on its 1 ms loops after the new edges.
     #[test]
     fn a_bit_sync_restart_keeps_the_c_n0_and_the_loops() {
-        let mut sig = Signal {
-            code: CaCode::new(Prn::new(7).expect("PRN")),
-            step_s: f64::INFINITY,
-            step_hz: 0.0,
-            off_s: f64::INFINITY,
-            cut: (3.0, 0.031),
-            cn0_dbhz: 38.0,
-            rng: SimRng::new(11),
-        };
+        let mut sig = cut_at_3_s(38.0, 11);
         let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
         let eps = run(&mut ch, &mut sig, 2.95);
         assert!(eps
