@@ -21,7 +21,9 @@
 //! candidates of 3 s; a second candidate that agrees nearly as well (at most three errors: data
 //! with a period, such as a reserved field) leaves the time undecided until the stream is longer.
 
-use gpsrx_nav::lnav::{parity_check, parity_encode, solve_trailing_bits};
+use gpsrx_nav::lnav::{
+    parity_check, parity_encode, solve_trailing_bits, PREAMBLE, SUBFRAMES_PER_WEEK,
+};
 
 /// Bits in a frame (5 subframes of 300 bits: 30 s).
 pub const FRAME_BITS: u32 = 1500;
@@ -46,11 +48,6 @@ pub fn repeats(p: u32) -> bool {
 fn in_how(p: u32) -> bool {
     (p % 300) / 30 == 1
 }
-
-/// The 8-bit preamble that opens every telemetry word (IS-GPS-200 20.3.3.1).
-const PREAMBLE_BITS: [u8; 8] = [1, 0, 0, 0, 1, 0, 1, 1];
-/// Subframes (6 s) in a week: the hand-over word's time-of-week count wraps there.
-const TOW_COUNTS_PER_WEEK: u32 = 100_800;
 
 /// The last bit received at each position of the frame, with its bit number in the week.
 #[derive(Debug, Clone)]
@@ -117,20 +114,17 @@ impl FrameMemory {
         {
             return None;
         }
-        let preamble = tlm >> 22;
-        let expected: u32 = PREAMBLE_BITS
-            .iter()
-            .fold(0, |w, &b| (w << 1) | u32::from(b));
-        let invert = match preamble {
-            p if p == expected => false,
-            p if p == (!expected & 0xFF) => true,
+        // The preamble (IS-GPS-200 20.3.3.1) in either polarity.
+        let invert = match tlm >> 22 {
+            p if p == PREAMBLE => false,
+            p if p == (!PREAMBLE & 0xFF) => true,
             _ => return None,
         };
         let flip = |w: u32| if invert { w ^ 0x3FFF_FFFF } else { w };
         let tlm = flip(tlm);
         let (d29, d30) = (tlm & 0b10 != 0, tlm & 0b1 != 0);
         let data = parity_check(flip(how), d29, d30)?;
-        let tow = ((data >> 7) + 5 * (back / FRAME_BITS)) % TOW_COUNTS_PER_WEEK;
+        let tow = ((data >> 7) + 5 * (back / FRAME_BITS)) % SUBFRAMES_PER_WEEK;
         let data = solve_trailing_bits((tow << 7) | (data & 0x7F), d29, d30);
         Some(flip(parity_encode(data, d29, d30)))
     }
