@@ -397,9 +397,9 @@ fn assert_moving_fixes_and_back(
     sink: &MemorySink,
     at_s: f64,
     from_s: f64,
-) {
+) -> Vec<(f64, f64)> {
     let start_tow = 538_198.0;
-    let mut back = None;
+    let (mut back, mut after) = (None, Vec::new());
     for f in sink
         .fixes
         .iter()
@@ -419,14 +419,16 @@ fn assert_moving_fixes_and_back(
             "{name}: a valid fix at {:.2} s is {err:.1} m off (3-sigma {s3:.1} m)",
             f.t_stream_s
         );
-        if f.t_stream_s > at_s && back.is_none() {
-            back = Some(f.t_stream_s - at_s);
+        if f.t_stream_s > at_s {
+            back.get_or_insert(f.t_stream_s - at_s);
+            after.push((f.t_stream_s, err));
         }
     }
     assert!(
         back.is_some_and(|b| b <= 1.5),
         "{name}: valid fixes back {back:?} s after the cut"
     );
+    after
 }
 
 /// The `[receiver]` body of a vehicle starting at [`LLH_DEG`] with `heading_deg`,
@@ -480,7 +482,24 @@ fn a_31_ms_cut_inside_a_10_g_turn_is_timed_from_the_data_bits() {
         "{name}: measured {:?} ms",
         measured(&sink)
     );
-    assert_moving_fixes_and_back(name, &sim, &sink, at_s, 30.0);
+    // The carrier smoothing is carried over the gap (the cubic of the phase before it up to
+    // the channel's re-lock, its own carrier after), so the fixes of the 2 s after the return
+    // are not the raw code's: 7.5 m RMS (up to 11 m at PDOP 5) when the filters restarted,
+    // 3.3 m bridged (one satellite, whose lock wavered for 0.4 s, is not: its re-lock came
+    // 0.8 s after the last epoch, too far to extrapolate the turn).
+    let after = assert_moving_fixes_and_back(name, &sim, &sink, at_s, 30.0);
+    let first = after.first().map_or(f64::NAN, |f| f.0);
+    let errs: Vec<f64> = after
+        .iter()
+        .filter(|f| f.0 < first + 2.0)
+        .map(|f| f.1)
+        .collect();
+    let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len().max(1) as f64).sqrt();
+    assert!(
+        errs.len() >= 15 && rms <= 4.0,
+        "{name}: {} fixes in the 2 s after the return, {rms:.1} m RMS",
+        errs.len()
+    );
 }
 
 #[test]

@@ -15,17 +15,25 @@
 
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::navigation::navdata::NavDecoder;
-use crate::pipeline::navigation::smoothing::{Hatch, HatchEpoch};
+use crate::pipeline::navigation::smoothing::{CarrierAnchor, Hatch, HatchEpoch};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 
 /// Code periods a channel must have run before its pseudorange is used: five time constants
 /// `1 / (4 Bn)` of the 2 Hz pull-in DLL, so that the acquisition's code error (up to half a
 /// sample: 58 m at 2.6 MHz) has decayed below a metre (`e^-4.8`). It matters only when the
 /// SV time is known at once (carried over an outage); otherwise frame sync takes longer.
 pub const CODE_SETTLE_MS: u64 = 600;
+
+/// Time after lost samples before a channel's carrier phase may anchor a bridge of its
+/// smoothing, s: the gap is found 40-100 ms late and the restarted 1 ms loops (18 Hz) settle
+/// within about `3 / Bn` (0.17 s); the phase-lock indicator need not drop meanwhile.
+pub const ANCHOR_SETTLE_S: f64 = 0.3;
+/// Spacing of the kept points of a channel's locked carrier, s, and how long they are kept.
+const RUN_POINT_S: f64 = 0.05;
+const RUN_KEPT_S: f64 = 10.0;
 
 /// One satellite's observables at an epoch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,6 +101,9 @@ pub struct ObservableBuilder {
     /// Backward carrier-phase Doppler `-(L(n) - L(n-1)) / dt` per (epoch, PRN), for the central
     /// difference at emission.
     phase_rate: BTreeMap<(i64, u8), f64>,
+    /// Per PRN: `(stream time s, carrier cycles)` of the channel's reports since its lock
+    /// last broke (every [`RUN_POINT_S`], the last [`RUN_KEPT_S`]): anchors for a bridge.
+    runs: BTreeMap<u8, VecDeque<(f64, f64)>>,
     /// Hatch filter length, epochs.
     hatch_epochs: u32,
     /// Reports with a lower C/N0 estimate give no observables (see
@@ -115,6 +126,7 @@ impl ObservableBuilder {
             smoothing: BTreeMap::new(),
             gaps: Vec::new(),
             phase_rate: BTreeMap::new(),
+            runs: BTreeMap::new(),
             hatch_epochs: (rate_hz * 10.0).round().max(1.0) as u32,
             min_cn0_dbhz: f64::NEG_INFINITY,
         }
@@ -190,6 +202,42 @@ impl ObservableBuilder {
             .sum()
     }
 
+    /// Records `e` in its satellite's run of locked carrier (`usable`), or ends the run.
+    fn note_run(&mut self, e: &ChannelEpoch, usable: bool) {
+        if !usable {
+            self.runs.remove(&e.prn);
+            return;
+        }
+        let t = e.sample_index as f64 / self.fs_hz;
+        let run = self.runs.entry(e.prn).or_default();
+        if run.back().is_none_or(|p| t - p.0 >= RUN_POINT_S) {
+            run.push_back((t, -e.carrier_phase_cycles));
+        }
+        while run.front().is_some_and(|p| t - p.0 > RUN_KEPT_S) {
+            run.pop_front();
+        }
+    }
+
+    /// The anchor of a bridge of `prn`'s smoothing from stream time `from_s` to `to_s`: the
+    /// first point of its current locked run after `from_s` and [`ANCHOR_SETTLE_S`] after
+    /// the latest samples lost in between.
+    fn anchor(&self, prn: u8, from_s: f64, to_s: f64) -> Option<CarrierAnchor> {
+        let settled = self
+            .gaps
+            .iter()
+            .filter(|g| g.0 > from_s && g.0 <= to_s)
+            .map(|g| g.0 + ANCHOR_SETTLE_S)
+            .fold(from_s, f64::max);
+        self.runs
+            .get(&prn)?
+            .iter()
+            .find(|p| p.0 > settled && p.0 <= to_s)
+            .map(|&(t, cycles)| CarrierAnchor {
+                t_stream_s: t,
+                signal_cycles: cycles,
+            })
+    }
+
     /// The Hatch filter's epoch `he` of `e`'s satellite (carrier smoothing, 10 s) and its
     /// carrier Doppler: a loss of lock (`lost_flag`) is bridged when it can be
     /// ([`crate::pipeline::navigation::smoothing`]; with an INS over a manoeuvre), else the
@@ -211,6 +259,11 @@ impl ObservableBuilder {
         // defeats the quadratic); only when the INS has been told of every gap (its times are
         // then signal times).
         let total_lost: Option<f64> = self.gaps.iter().map(|g| g.1).sum();
+        let anchor = self
+            .smoothing
+            .get(&e.prn)
+            .filter(|h| h.epoch != n - 1 || lost_flag)
+            .and_then(|h| self.anchor(e.prn, h.t_stream_s, t_stream));
         match self.smoothing.get_mut(&e.prn) {
             Some(h) if h.epoch == n - 1 && !lost_flag => {
                 // A clock step is not a Doppler; over the elapsed sample time (an epoch after a
@@ -231,7 +284,14 @@ impl ObservableBuilder {
                         .map(|(cycles, _)| -cycles * SPEED_OF_LIGHT_MPS / F_L1_HZ),
                     _ => None,
                 };
-                let bridged = lost_s.is_some_and(|g| h.bridge(he, g, max_m, by_ins));
+                let bridged = lost_s.is_some_and(|g| h.bridge(he, g, max_m, by_ins, anchor));
+                tracing::debug!(
+                    "PRN {}: carrier smoothing {} over a break of {:.3} s (lost {:?} s)",
+                    e.prn,
+                    if bridged { "bridged" } else { "restarted" },
+                    t_stream - h.t_stream_s,
+                    lost_s
+                );
                 if !bridged {
                     *h = Hatch::start(he);
                 }
@@ -261,6 +321,7 @@ impl ObservableBuilder {
             && e.ms_count >= CODE_SETTLE_MS;
         let lost = self.lli.entry(e.prn).or_insert(true);
         *lost |= !usable;
+        self.note_run(e, usable);
         if !usable {
             return Vec::new();
         }

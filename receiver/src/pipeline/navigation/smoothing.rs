@@ -19,6 +19,21 @@
 //! clock falling behind by the lost samples and `c dsteps` the receiver clock steps since.
 //! A bridge whose prediction misses the new code by more than [`MAX_INNOVATION_M`] (a carried
 //! time that was wrong) restarts the filter.
+//!
+//! # Under a manoeuvre, and after a re-lock (issue 26)
+//!
+//! No quadratic follows 3 s of phase through a 10 g turn (the turning acceleration changes
+//! at 40 m/s^3), but the break to be bridged is often short: the lost samples and the 0.2-0.4
+//! s until the loops hold the signal again. From then on the channel's own carrier phase is
+//! continuous (an [`CarrierAnchor`], its first locked report after the gap settled), so only
+//! the stretch from the last epoch to the anchor is extrapolated:
+//!
+//! `lambda dL = lambda (L_fit(t_a + g - t_prev) - L_fit(0)) + lambda (L(now) - L(t_a)) - c g + c dsteps`.
+//!
+//! When the whole history does not fit a quadratic, a cubic (the jerk) through its last
+//! [`SHORT_WINDOWS_S`] is tried, and taken only when its extrapolation error, predicted from
+//! its own residuals as if they were all a snap's (`snap_error_per_rms`: a 10 g turn at 250
+//! m/s has a snap of up to 15 m/s^4, 3 cm over 0.4 s), is within [`MAX_EXTRAPOLATION_ERROR_M`].
 
 use crate::pipeline::timing::carrier_step::Quadratic;
 use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
@@ -34,6 +49,23 @@ pub const MAX_INNOVATION_M: f64 = 30.0;
 /// Largest RMS of the carrier phase about its quadratic fit that is bridged, cycles (a steady
 /// signal leaves millimetres; a 10 g manoeuvre's jerk leaves metres over the fit's 3 s).
 pub const MAX_FIT_RMS_CYCLES: f64 = 0.1;
+/// Shorter windows of the carrier history (the latest epochs, s) tried, with a cubic, when the
+/// whole history does not fit a quadratic.
+pub const SHORT_WINDOWS_S: [f64; 2] = [2.0, 1.0];
+/// Largest predicted extrapolation error of a short window's cubic, m (a restarted filter
+/// starts from the raw code: metres of noise under a manoeuvre's geometry).
+pub const MAX_EXTRAPOLATION_ERROR_M: f64 = 0.5;
+
+/// The first locked report of a satellite's channel after a break: its stream time (s) and
+/// carrier phase (cycles, RINEX sign, without the clock steps). The channel's carrier phase
+/// is continuous from it to the current epoch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CarrierAnchor {
+    /// Stream time, s.
+    pub t_stream_s: f64,
+    /// Carrier phase, cycles.
+    pub signal_cycles: f64,
+}
 
 /// One epoch's measurements of a satellite for its Hatch filter.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -163,15 +195,32 @@ impl Hatch {
     /// steps; `None` without enough history or beyond [`MAX_BRIDGE_S`].
     fn bridge_change_m(
         &self,
-        elapsed_s: f64,
+        e: &HatchEpoch,
         lost_s: f64,
-        dsteps_ms: i64,
         signal_change_m: Option<f64>,
+        anchor: Option<CarrierAnchor>,
     ) -> Option<f64> {
+        let elapsed_s = e.t_stream_s - self.t_stream_s + lost_s;
+        let dsteps_ms = e.steps_ms - self.steps_ms;
+        let clock_m = -SPEED_OF_LIGHT_MPS * lost_s + SPEED_OF_LIGHT_MPS * dsteps_ms as f64 * 1e-3;
+        // The stretch to the anchor extrapolated, the channel's own carrier after it.
+        let anchored = anchor
+            .filter(|a| a.t_stream_s > self.t_stream_s && a.t_stream_s <= e.t_stream_s)
+            .and_then(|a| {
+                let to_anchor_s = a.t_stream_s - self.t_stream_s + lost_s;
+                let now_cycles = e.carrier_cycles - e.steps_ms as f64 * 1e-3 * F_L1_HZ;
+                let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+                (0.0..=MAX_BRIDGE_S)
+                    .contains(&to_anchor_s)
+                    .then(|| self.quadratic_change_m(to_anchor_s))?
+                    .map(|c| c + lambda * (now_cycles - a.signal_cycles))
+            });
+        if let Some(change) = anchored {
+            return Some(change + clock_m);
+        }
         if !(0.0..=MAX_BRIDGE_S).contains(&elapsed_s) {
             return None;
         }
-        let clock_m = -SPEED_OF_LIGHT_MPS * lost_s + SPEED_OF_LIGHT_MPS * dsteps_ms as f64 * 1e-3;
         // The carrier's own quadratic when it follows the phase (it holds a steady
         // acceleration to millimetres), else the change given from outside (an INS).
         let given = signal_change_m.filter(|c| c.is_finite());
@@ -197,22 +246,31 @@ impl Hatch {
             .iter()
             .map(|&(t, l)| (t - t_last, l - l_last))
             .collect();
-        let q = Quadratic::fit(&pts)?;
-        // Under dynamics (a manoeuvre's jerk) no quadratic follows the phase, and none
-        // predicts it over the break.
-        let rms = (pts.iter().map(|&(t, l)| (l - q.at(t)).powi(2)).sum::<f64>() / pts.len() as f64)
-            .sqrt();
-        if rms > MAX_FIT_RMS_CYCLES {
-            return None;
-        }
         let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
-        Some(lambda * (q.at(elapsed_s) - q.at(0.0)))
+        let (q, rms) = fit_with_rms(&pts)?;
+        if rms <= MAX_FIT_RMS_CYCLES {
+            return Some(lambda * (q.at(elapsed_s) - q.at(0.0)));
+        }
+        // Under dynamics (a manoeuvre's jerk) no quadratic follows the whole history: a cubic
+        // through the latest epochs, if its predicted error over the break is small.
+        SHORT_WINDOWS_S.iter().find_map(|&w| {
+            let tail: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 >= -w).collect();
+            if tail.len() < 8 || -tail[0].0 < 0.5 * w {
+                return None;
+            }
+            let (c, rms) = poly_fit_with_rms(&tail, 3)?;
+            let error_m = lambda * rms * snap_error_per_rms(&tail, elapsed_s)?;
+            (error_m <= MAX_EXTRAPOLATION_ERROR_M)
+                .then(|| lambda * (poly_at(&c, elapsed_s) - poly_at(&c, 0.0)))
+        })
     }
 
     /// Continues the filter over a break in lock (the pseudorange being continuous) to epoch
     /// `e`, `lost_s` of samples lost since the last epoch. The range change over the break
-    /// (m, carrier sign, without the clock terms) is the extrapolated quadratic when it follows
-    /// the phase, else `signal_change_m` when given (from an INS,
+    /// (m, carrier sign, without the clock terms) is, with an `anchor` (the channel's first
+    /// settled locked report since), the extrapolation up to it plus the carrier after it;
+    /// else the extrapolated quadratic when it follows the phase, else `signal_change_m` when
+    /// given (from an INS,
     /// [`crate::pipeline::aiding::InsFeedForward::carrier_change_cycles`]: it follows a
     /// manoeuvre's jerk). Returns false (the caller restarts the
     /// filter) when the break cannot be bridged or the bridged prediction misses the new code.
@@ -222,10 +280,9 @@ impl Hatch {
         lost_s: f64,
         max_m: u32,
         signal_change_m: Option<f64>,
+        anchor: Option<CarrierAnchor>,
     ) -> bool {
-        let elapsed = e.t_stream_s - self.t_stream_s + lost_s;
-        let dsteps = e.steps_ms - self.steps_ms;
-        let Some(change) = self.bridge_change_m(elapsed, lost_s, dsteps, signal_change_m) else {
+        let Some(change) = self.bridge_change_m(e, lost_s, signal_change_m, anchor) else {
             return false;
         };
         if (self.smoothed_m + change - e.pseudorange_m).abs() > MAX_INNOVATION_M {
@@ -248,6 +305,46 @@ impl Hatch {
         self.steps_ms = e.steps_ms;
         self.t_stream_s = e.t_stream_s;
     }
+}
+
+/// The least-squares quadratic through `pts` and the RMS of its residuals.
+fn fit_with_rms(pts: &[(f64, f64)]) -> Option<(Quadratic, f64)> {
+    let q = Quadratic::fit(pts)?;
+    let ss: f64 = pts.iter().map(|&(t, l)| (l - q.at(t)).powi(2)).sum();
+    Some((q, (ss / pts.len() as f64).sqrt()))
+}
+
+/// `sum c_k t^k`.
+fn poly_at(c: &[f64], t: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, &ck| acc * t + ck)
+}
+
+/// The least-squares polynomial of `degree` through `pts` (coefficients from `t^0`; SVD of
+/// the Vandermonde matrix) and the RMS of its residuals.
+fn poly_fit_with_rms(pts: &[(f64, f64)], degree: usize) -> Option<(Vec<f64>, f64)> {
+    let a = nalgebra::DMatrix::from_fn(pts.len(), degree + 1, |i, k| pts[i].0.powi(k as i32));
+    let y = nalgebra::DVector::from_iterator(pts.len(), pts.iter().map(|p| p.1));
+    let c: Vec<f64> = a
+        .svd(true, true)
+        .solve(&y, 1e-12)
+        .ok()?
+        .iter()
+        .copied()
+        .collect();
+    let ss: f64 = pts.iter().map(|&(t, l)| (l - poly_at(&c, t)).powi(2)).sum();
+    Some((c, (ss / pts.len() as f64).sqrt()))
+}
+
+/// The error of a cubic fitted at the times of `pts` (the last at 0) and extrapolated to
+/// `t_s`, per unit of its residual RMS, when what it leaves out is a snap (a quartic `t^4`:
+/// a turning acceleration `a` seen along a line of sight has a snap of up to `a w^2`):
+/// `|(p(t_s) - p(0)) - t_s^4| / rms(t^4 - p)` for the cubic `p` through `t^4` at those times.
+/// Exact for a constant snap; noise read as snap only overstates it.
+fn snap_error_per_rms(pts: &[(f64, f64)], t_s: f64) -> Option<f64> {
+    let quartic: Vec<(f64, f64)> = pts.iter().map(|&(t, _)| (t, t.powi(4))).collect();
+    let (c, rms4) = poly_fit_with_rms(&quartic, 3)?;
+    let error = (poly_at(&c, t_s) - poly_at(&c, 0.0) - t_s.powi(4)).abs();
+    (rms4 > 0.0).then_some(error / rms4)
 }
 
 #[cfg(test)]
@@ -311,7 +408,7 @@ mod tests {
             match h.as_mut() {
                 None => h = Some(Hatch::start(&e)),
                 Some(f) if (t_stream - t_gap).abs() < 1e-9 => {
-                    assert!(f.bridge(&e, lost, 100, None), "bridged");
+                    assert!(f.bridge(&e, lost, 100, None, None), "bridged");
                 }
                 Some(f) => f.update(&e, 100),
             }
@@ -342,56 +439,99 @@ mod tests {
         }
         // A carried time 1 ms wrong: 300 km off the prediction.
         let mut wrong = h.clone();
-        assert!(!wrong.bridge(&at(20, 0.0, 20e6 - 300_000.0, 2.0), 0.0, 100, None));
+        assert!(!wrong.bridge(&at(20, 0.0, 20e6 - 300_000.0, 2.0), 0.0, 100, None, None));
         // Too long a break.
-        assert!(!h.bridge(&at(60, 0.0, 20e6 - 1000.0, 6.0), 0.0, 100, None));
+        assert!(!h.bridge(&at(60, 0.0, 20e6 - 1000.0, 6.0), 0.0, 100, None, None));
+    }
+
+    /// A 10 g turn at 250 m/s (radius 637 m, 0.385 rad/s) seen by a satellite on the
+    /// horizon: the range's acceleration turns with the aircraft (jerk up to 38 m/s^3, snap
+    /// 15 m/s^4). Epochs every 0.1 s of stream; `lost` s of samples lost at stream `t_gap`
+    /// (the receiver clock falls behind by it); code noise +-3 m. Returns the epoch and the
+    /// true pseudorange; the carrier after the gap is a new channel's (`offset` cycles off).
+    fn turn_epoch(k: i64, t_gap: f64, lost: f64, offset: f64) -> (HatchEpoch, f64) {
+        let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+        let (radius, w) = (637.0, 98.0_f64 / 250.0);
+        let range = |t: f64| 21e6 - 300.0 * t - radius * (w * t + 0.3).cos();
+        let noise = |k: i64| 3.0 * ((k as f64 * 12.9898).sin() * 43_758.545).fract();
+        let t_stream = k as f64 * 0.1;
+        let after = t_stream >= t_gap;
+        let t_true = t_stream + if after { lost } else { 0.0 };
+        let clock_m = if after {
+            -SPEED_OF_LIGHT_MPS * lost
+        } else {
+            0.0
+        };
+        let truth = range(t_true) + clock_m;
+        let e = HatchEpoch {
+            epoch: k,
+            carrier_cycles: truth / lambda + if after { offset } else { 0.0 },
+            pseudorange_m: truth + noise(k),
+            steps_ms: 0,
+            t_stream_s: t_stream,
+        };
+        (e, truth)
+    }
+
+    /// The filter after the epochs before `t_gap` (stream s) of [`turn_epoch`].
+    fn turn_filter(t_gap: f64) -> Hatch {
+        let mut h = Hatch::start(&turn_epoch(0, t_gap, 0.0, 0.0).0);
+        for k in 1..(t_gap * 10.0).round() as i64 {
+            h.update(&turn_epoch(k, t_gap, 0.0, 0.0).0, 100);
+        }
+        h
     }
 
     #[test]
-    fn under_a_jerk_only_a_range_change_from_an_ins_bridges_the_break() {
-        // A 10 g turn seen along a line of sight: 98 m/s^2 of range acceleration changing at
-        // 40 m/s^3. No quadratic follows the phase over the history, so the quadratic bridge is
-        // refused; the range change over the break given from outside (an INS) bridges it.
-        let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
-        let range = |t: f64| 21e6 - 300.0 * t + 0.5 * 98.0 * t * t + 40.0 * t * t * t / 6.0;
-        let (t_gap, lost) = (2.5, 0.031);
-        let noise = |k: i64| 3.0 * ((k as f64 * 12.9898).sin() * 43_758.545).fract();
-        let epoch = |k: i64| {
-            let t_stream = k as f64 * 0.1;
-            let t_true = t_stream + if t_stream >= t_gap { lost } else { 0.0 };
-            // The receiver clock falls behind by the lost time: the pseudorange by c g.
-            let clock_m = if t_stream >= t_gap {
-                -SPEED_OF_LIGHT_MPS * lost
-            } else {
-                0.0
-            };
-            let e = HatchEpoch {
-                epoch: k,
-                carrier_cycles: (range(t_true) + clock_m) / lambda,
-                pseudorange_m: range(t_true) + clock_m + noise(k),
-                steps_ms: 0,
-                t_stream_s: t_stream,
-            };
-            (e, range(t_true) + clock_m)
-        };
-        let mut h = Hatch::start(&epoch(0).0);
-        for k in 1..25 {
-            h.update(&epoch(k).0, 100);
-        }
-        let (e, truth) = epoch(25);
-        assert!(
-            !h.clone().bridge(&e, lost, 100, None),
-            "a quadratic bridged a jerk"
-        );
-        let signal_change = range(2.5 + lost) - range(2.4);
-        assert!(
-            h.bridge(&e, lost, 100, Some(signal_change)),
-            "the INS bridge was refused"
-        );
+    fn in_a_turn_a_short_break_is_bridged_by_the_cubic_of_the_latest_epochs() {
+        // 31 ms lost at 3.0 s, the next epoch at 3.0 s of stream: 0.131 s of signal after
+        // the last epoch. No quadratic follows the 3 s of history (the turning acceleration),
+        // the cubic through its last 2 s does.
+        let (t_gap, lost) = (3.0, 0.031);
+        let mut h = turn_filter(t_gap);
+        let (e, truth) = turn_epoch(30, t_gap, lost, 0.0);
+        assert!(h.bridge(&e, lost, 100, None, None), "refused");
         assert!(
             (h.smoothed_m - truth).abs() < 1.0,
             "{}",
             h.smoothed_m - truth
         );
+    }
+
+    #[test]
+    fn in_a_turn_a_long_break_is_bridged_from_the_carrier_after_the_re_lock() {
+        // 31 ms lost at 3.0 s; the channel holds the signal again from 3.4 s of stream (its
+        // carrier 12345.25 cycles off), the time comes back at 4.5 s. The cubic would have
+        // to carry 1.5 s of the turn: refused; from the anchor only 0.43 s is extrapolated.
+        let (t_gap, lost, offset) = (3.0, 0.031, 12_345.25);
+        let h = turn_filter(t_gap);
+        let (e, truth) = turn_epoch(45, t_gap, lost, offset);
+        let (at_anchor, _) = turn_epoch(34, t_gap, lost, offset);
+        let anchor = CarrierAnchor {
+            t_stream_s: at_anchor.t_stream_s,
+            signal_cycles: at_anchor.carrier_cycles,
+        };
+        assert!(
+            !h.clone().bridge(&e, lost, 100, None, None),
+            "a polynomial carried 1.5 s of a turn"
+        );
+        let mut anchored = h.clone();
+        assert!(
+            anchored.bridge(&e, lost, 100, None, Some(anchor)),
+            "refused"
+        );
+        assert!(
+            (anchored.smoothed_m - truth).abs() < 1.0,
+            "{}",
+            anchored.smoothed_m - truth
+        );
+        // A range change from outside (an INS) bridges it too.
+        let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+        let (last, _) = turn_epoch(29, t_gap, 0.0, 0.0);
+        let change =
+            (e.carrier_cycles - offset - last.carrier_cycles) * lambda + SPEED_OF_LIGHT_MPS * lost;
+        let mut by_ins = h;
+        assert!(by_ins.bridge(&e, lost, 100, Some(change), None), "refused");
+        assert!((by_ins.smoothed_m - truth).abs() < 1.0);
     }
 }
