@@ -131,7 +131,7 @@ section_weak() {
 section_faults() {
     local f
     f=$(seoul_file)
-    for fault in "cut 20 0.001" "cut 20 0.00125" "cut 20 0.020" "cut 20 0.031" "cut 20 0.5" "zero 20 2" \
+    for fault in "cut 20 0.001" "cut 20 0.00125" "cut 20 0.020" "cut 20 0.031" "cut 20 0.5" "zero 20 1" "zero 20 2" \
         "cut 20 5" "cut 10 20"; do
         read -r kind at len <<<"$fault"
         python3 "$TOOLS/fault.py" "$f" "$WORK/fault.ci8" --bytes-per-sample 2 --fs 2.6e6 --"$kind" "$at" "$len"

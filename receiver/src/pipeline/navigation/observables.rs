@@ -19,7 +19,7 @@ use crate::pipeline::navigation::smoothing::{CarrierAnchor, Hatch, HatchEpoch};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
 
 /// Code periods a channel must have run before its pseudorange is used: five time constants
 /// `1 / (4 Bn)` of the 2 Hz pull-in DLL, so that the acquisition's code error (up to half a
@@ -34,6 +34,8 @@ pub const ANCHOR_SETTLE_S: f64 = 0.3;
 /// Spacing of the kept points of a channel's locked carrier, s, and how long they are kept.
 const RUN_POINT_S: f64 = 0.05;
 const RUN_KEPT_S: f64 = 10.0;
+/// A data bit, s.
+const BIT_S: f64 = 0.020;
 
 /// One satellite's observables at an epoch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -90,8 +92,17 @@ pub struct ObservableBuilder {
     /// Per PRN: lock lost since the last epoch, and the carrier-phase origin (cycles) used to
     /// keep the accumulated phase small.
     lli: BTreeMap<u8, bool>,
+    /// PRNs whose loss of lock fell on an epoch not collected, to flag at the next one.
+    lli_carried: BTreeSet<u8>,
     /// Highest epoch index any channel has reached.
     newest: i64,
+    /// Receiver time (TOW, s) of the end of the newest usable report (with or without its SV
+    /// time).
+    reached_rx_s: f64,
+    /// Epochs below this index are not collected: channels reported across them before the
+    /// receiver time changed (a clock step, the time carried over lost samples), so they would
+    /// hold only the satellites reported after the change.
+    first_epoch: i64,
     /// Per PRN: the Hatch filter ([`crate::pipeline::navigation::smoothing`]), kept over losses of lock to
     /// bridge them.
     smoothing: BTreeMap<u8, Hatch>,
@@ -122,7 +133,10 @@ impl ObservableBuilder {
             total_step_ms: 0,
             pending: BTreeMap::new(),
             lli: BTreeMap::new(),
+            lli_carried: BTreeSet::new(),
             newest: i64::MIN,
+            first_epoch: i64::MIN,
+            reached_rx_s: f64::NEG_INFINITY,
             smoothing: BTreeMap::new(),
             gaps: Vec::new(),
             phase_rate: BTreeMap::new(),
@@ -154,8 +168,19 @@ impl ObservableBuilder {
             self.t0 = Some(t0.add_seconds(ms as f64 * 1e-3));
             self.pending_step_ms += ms;
             self.total_step_ms += ms;
-            // Epochs not yet emitted were measured on the old scale: drop them.
+            // Epochs not yet emitted were measured on the old scale: drop them, and those some
+            // channels have already reported across (moved onto the new scale).
             self.pending.clear();
+            self.reached_rx_s += ms as f64 * 1e-3;
+            self.skip_epochs_through(self.reached_rx_s);
+        }
+    }
+
+    /// Collects no epoch at or before receiver time `t_rx_s` (TOW, s).
+    fn skip_epochs_through(&mut self, t_rx_s: f64) {
+        if t_rx_s.is_finite() {
+            let last = (t_rx_s * self.rate_hz).floor() as i64;
+            self.first_epoch = self.first_epoch.max(last + 1);
         }
     }
 
@@ -187,6 +212,9 @@ impl ObservableBuilder {
 
     /// The samples lost at stream time `t_s` (within 50 ms) were `length_s` of signal.
     pub fn set_gap_length(&mut self, t_s: f64, length_s: f64) {
+        // The SV times are carried over the gap from now on, each satellite's at its next data
+        // bit edge: the epochs until all have theirs would hold only some satellites.
+        self.skip_epochs_through(self.reached_rx_s + BIT_S);
         if let Some(g) = self.gaps.iter_mut().find(|g| (g.0 - t_s).abs() < 0.05) {
             g.1 = Some(length_s);
         }
@@ -325,6 +353,10 @@ impl ObservableBuilder {
         if !usable {
             return Vec::new();
         }
+        if let Some(t0) = self.t0 {
+            let end_rx = t0.tow_s + e.sample_index as f64 / self.fs_hz + e.t_coh_s;
+            self.reached_rx_s = self.reached_rx_s.max(end_rx);
+        }
         let Some(sv_tow0) = dec.sv_tow_s(e.ms_count, e.code_phase_chips) else {
             return Vec::new();
         };
@@ -374,6 +406,17 @@ impl ObservableBuilder {
                 t_stream_s: t_stream,
             };
             let (smoothed, doppler_hz) = self.smooth(e, &he, lost_flag, aid);
+            if n < self.first_epoch {
+                // Not collected: its loss of lock is reported with the next epoch (the
+                // smoothing has taken the break here).
+                if lost_flag {
+                    self.lli_carried.insert(e.prn);
+                }
+                self.newest = self.newest.max(n);
+                n += 1;
+                continue;
+            }
+            let lost_flag = self.lli_carried.remove(&e.prn) || lost_flag;
             self.pending.entry(n).or_default().push(SatObservable {
                 prn: e.prn,
                 sv_tow_s: sv_tow,
