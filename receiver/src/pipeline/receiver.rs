@@ -60,6 +60,9 @@ pub enum ReceiverError {
     /// The INS input cannot be used.
     #[error("INS: {0}")]
     Ins(String),
+    /// Vector tracking was asked for with an INS, which it does not take yet.
+    #[error("vector tracking does not take an INS yet (the vector + INS coupling is a later part of issue 29): track scalar with the INS, or vector without it")]
+    VectorWithIns,
     /// Samples after the end of the stream.
     #[error("the stream has ended (finish was called): make a new Receiver for another stream")]
     Finished,
@@ -310,9 +313,7 @@ impl Receiver {
     ) -> Result<Self, ReceiverError> {
         config.validate()?;
         if config.tracking.mode == TrackingMode::Vector && assistance.ins.is_some() {
-            return Err(ReceiverError::Ins(
-                "--tracking vector does not take --ins yet (the vector + INS coupling is a later part of issue 29): run with --tracking scalar --ins, or --tracking vector without --ins".into(),
-            ));
+            return Err(ReceiverError::VectorWithIns);
         }
         let vector = (config.tracking.mode == TrackingMode::Vector)
             .then(|| VectorTracking::new(config, assistance.nav.clone()));
