@@ -9,8 +9,8 @@
 //! | 130 | a second Ctrl-C |
 
 use gpsrx_receiver::config::ConfigError;
-use gpsrx_receiver::ReceiverError;
 use gpsrx_receiver::snapshot::SnapshotError;
+use gpsrx_receiver::ReceiverError;
 use gpsrx_samples::SampleError;
 use std::io::{self, Write};
 

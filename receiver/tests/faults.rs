@@ -484,7 +484,7 @@ fn a_31_ms_cut_inside_a_10_g_turn_is_timed_from_the_data_bits() {
     );
     // The carrier smoothing is carried over the gap (the cubic of the phase before it up to
     // the channel's re-lock, its own carrier after), so the fixes of the 2 s after the return
-    // are not the raw code's: 7.5 m RMS (up to 11 m at PDOP 5) when the filters restarted,
+    // are not the raw code's: 7.1 m RMS (up to 11 m at PDOP 5) when the filters restarted,
     // 3.3 m bridged (one satellite, whose lock wavered for 0.4 s, is not: its re-lock came
     // 0.8 s after the last epoch, too far to extrapolate the turn).
     let after = assert_moving_fixes_and_back(name, &sim, &sink, at_s, 30.0);
