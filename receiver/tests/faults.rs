@@ -477,6 +477,23 @@ fn a_31_ms_cut_inside_a_10_g_turn_is_timed_from_the_data_bits() {
     let sink = run_with(assisted_receiver(), &sim, Fault::Cut { at_s, len_s });
     let name = "31 ms cut in a 10 g turn";
     describe(name, &sink, at_s);
+    // The turn's onset (40-41 s) lost G03, G16 and G22 (29-32 dB-Hz, on the 6 Hz 20 ms weak
+    // loops) eight times before the cut. The strong channels now see the dynamics (at 40.20 s,
+    // 0.1 s into the jerk) and the weak ones widen their loops (15 Hz, 10 ms): G16 holds.
+    // G03 and G22 still fall out (their C/N0 estimates sink from 40.3 s: the widening came
+    // too late for their line of sight).
+    let lost: Vec<(u8, f64)> = sink
+        .events
+        .iter()
+        .filter_map(|e| match e {
+            ReceiverEvent::Lost { prn, t_s } if (39.0..at_s).contains(t_s) => Some((*prn, *t_s)),
+            _ => None,
+        })
+        .collect();
+    assert!(
+        lost.iter().all(|l| l.0 != 16),
+        "{name}: G16 lost before the cut: {lost:?}"
+    );
     assert!(
         measured(&sink).len() == 1 && (measured(&sink)[0] - 31.0).abs() < 0.01,
         "{name}: measured {:?} ms",

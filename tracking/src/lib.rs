@@ -41,7 +41,10 @@ pub mod phase_sim;
 pub use aiding::{AidingPort, DopplerAid, TrackingMode};
 pub use bit_sync::{Bit, BitSync, BitSyncConfig, BitSyncState};
 pub use carrier_loop::{CarrierLoop, CarrierOutput};
-pub use channel::{Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState, CodeShift};
+pub use channel::{
+    dynamic_weak_config, Channel, ChannelConfig, ChannelEpoch, ChannelStart, ChannelState,
+    CodeShift, DYNAMIC_WEAK_BW_HZ, DYNAMIC_WEAK_T_COH_S,
+};
 pub use cn0::{M2m4Estimator, NwprEstimator};
 pub use code_loop::{CodeLoop, CodeOutput};
 pub use config::{ConfigError, DllDiscriminator, FllDiscriminator, LoopConfig, PllDiscriminator};

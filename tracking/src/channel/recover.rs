@@ -423,4 +423,54 @@ mod tests {
             "not locked again"
         );
     }
+
+    /// A 30 dB-Hz satellite on its weak loops (6 Hz, 20 ms): told the receiver is under
+    /// dynamics it takes the widened weak loops (15 Hz, 10 ms) at its next bit edges and keeps
+    /// its lock; told they are over, it narrows back to the weak loops. Its own rate is not
+    /// read as the receiver's (weak loops), a strong channel's is, once settled.
+    #[test]
+    fn a_weak_channel_widens_its_loops_under_dynamics_and_narrows_after() {
+        let mut sig = Signal {
+            step_s: f64::INFINITY,
+            cut: (f64::INFINITY, 0.0),
+            ..cut_at_3_s(30.0, 29)
+        };
+        let weak_start = ChannelStart {
+            cn0_dbhz: 30.0,
+            ..start()
+        };
+        let mut ch = Channel::new(&weak_start, FS, &ChannelConfig::default()).expect("channel");
+        let eps = run(&mut ch, &mut sig, 6.0);
+        assert!(
+            ch.weak_loops() && !ch.dynamic_weak_loops(),
+            "not on the weak loops"
+        );
+        assert!(eps
+            .last()
+            .is_some_and(|e| e.1 == ChannelState::Track && e.2));
+        assert_eq!(ch.los_rate_hz_s(), None, "a weak channel's rate was read");
+        ch.set_dynamics(true);
+        let eps = run(&mut ch, &mut sig, 7.0);
+        assert!(ch.dynamic_weak_loops(), "not widened");
+        assert!(eps.iter().filter(|e| e.0 > 6.1).all(|e| e.2), "lock lost");
+        ch.set_dynamics(false);
+        let _ = run(&mut ch, &mut sig, 9.0);
+        assert!(
+            ch.weak_loops() && !ch.dynamic_weak_loops(),
+            "not narrowed back"
+        );
+        // A 40 dB-Hz channel on its 1 ms loops: its rate (a static signal: near 0) is read
+        // once it has tracked for 2 s.
+        let mut strong_sig = Signal {
+            step_s: f64::INFINITY,
+            cut: (f64::INFINITY, 0.0),
+            ..cut_at_3_s(40.0, 31)
+        };
+        let mut strong = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
+        let _ = run(&mut strong, &mut strong_sig, 1.5);
+        assert_eq!(strong.los_rate_hz_s(), None, "read before it settled");
+        let _ = run(&mut strong, &mut strong_sig, 4.0);
+        let rate = strong.los_rate_hz_s().expect("rate of a strong channel");
+        assert!(rate.abs() < 2.0, "{rate} Hz/s on a static signal");
+    }
 }

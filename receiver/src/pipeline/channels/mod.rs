@@ -6,10 +6,13 @@
 //!   ([`SearchBudget`], [`Visibility`]);
 //! - `visibility`: elevation and Doppler of a satellite predicted from an ephemeris
 //!   ([`predict_satellite`]);
+//! - `dynamics`: whether the receiver is under dynamics, from its strong channels' loops (the
+//!   weak channels then widen theirs);
 //! - `ring`: the window of recent samples addressed by absolute index;
 //! - `tracker`: channels alone over a stream, without navigation ([`track`], loop studies).
 
 pub(crate) mod channel_manager;
+mod dynamics;
 pub(crate) mod ring;
 pub(crate) mod search_schedule;
 mod tracker;

@@ -19,6 +19,7 @@ pub mod realign;
 
 pub use realign::{RealignSearch, Realigned};
 
+use crate::pipeline::channels::dynamics::DynamicsWatch;
 use crate::pipeline::channels::ring::SampleView;
 use crate::pipeline::channels::search_schedule::{
     level_config, search_pfa, Batch, Liveness, Scheduler, SearchBudget, Visibility, LEVELS,
@@ -139,6 +140,8 @@ pub struct ChannelManager {
     realign_engine: Option<AcquisitionEngine>,
     /// Time spent in [`ChannelManager::work`] so far.
     times: WorkTimes,
+    /// Whether the receiver is under dynamics (the weak channels' loops widen).
+    dynamics: DynamicsWatch,
 }
 
 /// Wall time of the channels' work and of the searches beside it, summed over
@@ -185,6 +188,7 @@ impl ChannelManager {
             realign: None,
             realign_engine,
             times: WorkTimes::default(),
+            dynamics: DynamicsWatch::default(),
         })
     }
 
@@ -202,6 +206,7 @@ impl ChannelManager {
             realign: None,
             realign_engine: None,
             times: WorkTimes::default(),
+            dynamics: DynamicsWatch::default(),
         }
     }
 
@@ -362,6 +367,7 @@ impl ChannelManager {
         aid: Option<&dyn AidingPort>,
     ) -> Option<SearchOutcome> {
         self.reports.resize_with(self.channels.len(), Vec::new);
+        self.watch_dynamics(window.end());
         let channels = &mut self.channels;
         let reports = &mut self.reports;
         let mut run_all = || {
@@ -408,6 +414,25 @@ impl ChannelManager {
         };
         self.release_cross_correlations();
         outcome
+    }
+
+    /// Whether the receiver is under dynamics, from the Doppler rates the strong channels'
+    /// loops followed up to `sample` (the second largest: [`crate::pipeline::channels::dynamics`]);
+    /// told to every channel (a weak one widens its loops).
+    fn watch_dynamics(&mut self, sample: u64) {
+        let mut rates: Vec<f64> = self
+            .channels
+            .iter()
+            .filter_map(|c| c.los_rate_hz_s())
+            .map(f64::abs)
+            .collect();
+        rates.sort_by(|a, b| b.total_cmp(a));
+        // The second largest (one channel's noise or transient is not the receiver's motion).
+        let rate = rates.get(1).or(rates.first()).copied();
+        let on = self.dynamics.update(sample as f64 / self.fs_hz, rate);
+        for c in &mut self.channels {
+            c.set_dynamics(on);
+        }
     }
 
     /// Hands the reports of the last [`ChannelManager::work`] to `f` as `(channel index,
