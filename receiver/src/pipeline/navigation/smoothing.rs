@@ -36,6 +36,7 @@
 //! m/s has a snap of up to 15 m/s^4, 3 cm over 0.4 s), is within [`MAX_EXTRAPOLATION_ERROR_M`].
 
 use crate::pipeline::timing::carrier_step::Quadratic;
+use gpsrx_core::Polynomial;
 use gpsrx_dsp::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use std::collections::VecDeque;
 
@@ -258,10 +259,9 @@ impl Hatch {
             if tail.len() < 8 || -tail[0].0 < 0.5 * w {
                 return None;
             }
-            let (c, rms) = poly_fit_with_rms(&tail, 3)?;
-            let error_m = lambda * rms * snap_error_per_rms(&tail, elapsed_s)?;
-            (error_m <= MAX_EXTRAPOLATION_ERROR_M)
-                .then(|| lambda * (poly_at(&c, elapsed_s) - poly_at(&c, 0.0)))
+            let c = Polynomial::fit(&tail, 3)?;
+            let error_m = lambda * c.rms(&tail) * snap_error_per_rms(&tail, elapsed_s)?;
+            (error_m <= MAX_EXTRAPOLATION_ERROR_M).then(|| lambda * (c.at(elapsed_s) - c.at(0.0)))
         })
     }
 
@@ -314,27 +314,6 @@ fn fit_with_rms(pts: &[(f64, f64)]) -> Option<(Quadratic, f64)> {
     Some((q, (ss / pts.len() as f64).sqrt()))
 }
 
-/// `sum c_k t^k`.
-fn poly_at(c: &[f64], t: f64) -> f64 {
-    c.iter().rev().fold(0.0, |acc, &ck| acc * t + ck)
-}
-
-/// The least-squares polynomial of `degree` through `pts` (coefficients from `t^0`; SVD of
-/// the Vandermonde matrix) and the RMS of its residuals.
-fn poly_fit_with_rms(pts: &[(f64, f64)], degree: usize) -> Option<(Vec<f64>, f64)> {
-    let a = nalgebra::DMatrix::from_fn(pts.len(), degree + 1, |i, k| pts[i].0.powi(k as i32));
-    let y = nalgebra::DVector::from_iterator(pts.len(), pts.iter().map(|p| p.1));
-    let c: Vec<f64> = a
-        .svd(true, true)
-        .solve(&y, 1e-12)
-        .ok()?
-        .iter()
-        .copied()
-        .collect();
-    let ss: f64 = pts.iter().map(|&(t, l)| (l - poly_at(&c, t)).powi(2)).sum();
-    Some((c, (ss / pts.len() as f64).sqrt()))
-}
-
 /// The error of a cubic fitted at the times of `pts` (the last at 0) and extrapolated to
 /// `t_s`, per unit of its residual RMS, when what it leaves out is a snap (a quartic `t^4`:
 /// a turning acceleration `a` seen along a line of sight has a snap of up to `a w^2`):
@@ -342,8 +321,9 @@ fn poly_fit_with_rms(pts: &[(f64, f64)], degree: usize) -> Option<(Vec<f64>, f64
 /// Exact for a constant snap; noise read as snap only overstates it.
 fn snap_error_per_rms(pts: &[(f64, f64)], t_s: f64) -> Option<f64> {
     let quartic: Vec<(f64, f64)> = pts.iter().map(|&(t, _)| (t, t.powi(4))).collect();
-    let (c, rms4) = poly_fit_with_rms(&quartic, 3)?;
-    let error = (poly_at(&c, t_s) - poly_at(&c, 0.0) - t_s.powi(4)).abs();
+    let c = Polynomial::fit(&quartic, 3)?;
+    let rms4 = c.rms(&quartic);
+    let error = (c.at(t_s) - c.at(0.0) - t_s.powi(4)).abs();
     (rms4 > 0.0).then_some(error / rms4)
 }
 
