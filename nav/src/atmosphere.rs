@@ -74,6 +74,33 @@ pub fn klobuchar_delay_s(
     }
 }
 
+/// Height of the tropopause of the standard atmosphere, m: the temperature falls at 6.5 K/km
+/// up to it and is constant above ([`saastamoinen_delay_m`]).
+pub const TROPOPAUSE_M: f64 = 11_000.0;
+/// Pressure scale height of the isothermal layer above [`TROPOPAUSE_M`], m:
+/// `R T / g = 287.053 J/(kg K) x 216.66 K / 9.80665 m/s^2`.
+pub const STRATOSPHERE_SCALE_HEIGHT_M: f64 = 287.053 * 216.66 / 9.80665;
+
+/// Pressure (hPa) and temperature (K) of the standard atmosphere at height `h_m` (>= 0):
+/// `P = 1013.25 (1 - 2.2557e-5 h)^5.2568`, `T = 288.16 - 6.5e-3 h` up to [`TROPOPAUSE_M`];
+/// above, `T` stays and `P` falls by `exp(-(h - 11 km) / H)` (continuous at 11 km).
+fn standard_atmosphere(h_m: f64) -> (f64, f64) {
+    let lapse = |h: f64| {
+        (
+            1013.25 * (1.0 - 2.2557e-5 * h).powf(5.2568),
+            15.0 - 6.5e-3 * h + 273.16,
+        )
+    };
+    if h_m <= TROPOPAUSE_M {
+        return lapse(h_m);
+    }
+    let (p11, t11) = lapse(TROPOPAUSE_M);
+    (
+        p11 * (-(h_m - TROPOPAUSE_M) / STRATOSPHERE_SCALE_HEIGHT_M).exp(),
+        t11,
+    )
+}
+
 /// Relative humidity assumed by [`saastamoinen_delay_m`].
 pub const STANDARD_RELATIVE_HUMIDITY: f64 = 0.7;
 
@@ -86,15 +113,25 @@ pub const STANDARD_RELATIVE_HUMIDITY: f64 = 0.7;
 /// - dry = 0.0022768 P / (1 - 0.00266 cos(2 lat) - 0.00028 h_km) / cos(z),
 ///   wet = 0.002277 (1255 / T + 0.05) e / cos(z), z = pi/2 - el.
 ///
-/// The zenith dry delay is about 2.3 m at sea level. Returns 0 for `el_rad <= 0` and for
-/// heights outside [-100 m, 10 km], where the standard atmosphere does not apply.
+/// The zenith dry delay is about 2.3 m at sea level. Returns 0 for `el_rad <= 0` and below
+/// -100 m.
+///
+/// Above the tropopause ([`TROPOPAUSE_M`], 11 km) the standard atmosphere is taken isothermal
+/// (U.S. Standard Atmosphere 1976 up to 20 km: T = 216.66 K, P = 226.3 hPa at 11 km falling as
+/// `exp(-(h - 11 km) / H)`, `H = R T / g =` [`STRATOSPHERE_SCALE_HEIGHT_M`]; 5 % under its
+/// pressure at 30 km, where it warms again: a millimetre of delay), and the formulas
+/// above take that pressure and temperature: the dry term is the hydrostatic delay of the
+/// column above the receiver at any height (0.55 m at 11 km, 0.12 m at 20 km, zenith). RTKLIB's
+/// `tropmodel` (which this matches to 1e-9 m up to 10 km) returns 0 above 10 km instead: a
+/// step of 0.65 m at the zenith and 2-7 m at low elevations when an aircraft climbs through
+/// 10 km, which the receiver took for lost samples (every carrier phase jumped at once) and
+/// a simulated signal carried as a real jump.
 pub fn saastamoinen_delay_m(rx: &Llh, el_rad: f64) -> f64 {
-    if el_rad.is_nan() || el_rad <= 0.0 || !(-100.0..=1.0e4).contains(&rx.h_m) {
+    if el_rad.is_nan() || el_rad <= 0.0 || rx.h_m.is_nan() || rx.h_m < -100.0 {
         return 0.0;
     }
     let h_m = rx.h_m.max(0.0);
-    let pressure_hpa = 1013.25 * (1.0 - 2.2557e-5 * h_m).powf(5.2568);
-    let temp_k = 15.0 - 6.5e-3 * h_m + 273.16;
+    let (pressure_hpa, temp_k) = standard_atmosphere(h_m);
     let e_hpa =
         6.108 * STANDARD_RELATIVE_HUMIDITY * ((17.15 * temp_k - 4684.0) / (temp_k - 38.45)).exp();
     let cos_z = (std::f64::consts::FRAC_PI_2 - el_rad).cos();

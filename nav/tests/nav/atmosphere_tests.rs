@@ -113,14 +113,44 @@ fn saastamoinen_physical_properties() {
         assert!((d * el_deg.to_radians().sin() - zenith).abs() < 1e-12);
     }
     assert_eq!(saastamoinen_delay_m(&sea, 0.0), 0.0);
-    assert_eq!(
-        saastamoinen_delay_m(
-            &Llh {
-                h_m: 20_000.0,
-                ..sea
-            },
-            1.0
-        ),
-        0.0
-    );
+}
+
+/// Above 10 km the delay goes on falling smoothly (RTKLIB's `tropmodel` drops to 0 there: a
+/// step of metres at low elevations as an aircraft climbs through it), with the pressure of
+/// the U.S. Standard Atmosphere 1976 (NOAA-S/T 76-1562, table I: 226.32 hPa at 11 km,
+/// 54.749 hPa at 20 km) in the hydrostatic term; above 20 km (where that atmosphere warms again
+/// and the model stays isothermal) within 6 % of it (11.970 hPa at 30 km: 1.3 mm of 2.7 cm).
+#[test]
+fn saastamoinen_is_continuous_through_10_km_and_follows_the_standard_atmosphere_above() {
+    let zenith = std::f64::consts::FRAC_PI_2;
+    let at = |h_m: f64, el: f64| saastamoinen_delay_m(&Llh::from_degrees(37.5, 127.0, h_m), el);
+    // No step anywhere from 9 to 40 km, at the zenith or at 5 degrees.
+    for el in [zenith, 5f64.to_radians()] {
+        let mut prev = at(9_000.0, el);
+        let mut h = 9_000.0;
+        while h < 40_000.0 {
+            h += 10.0;
+            let d = at(h, el);
+            assert!(d < prev, "not decreasing at {h} m");
+            // 10 m of climb takes about 0.15 % of the delay (pressure scale height 6-8 km),
+            // never a step.
+            assert!(prev - d < 3e-3 * prev, "a step of {} m at {h} m", prev - d);
+            prev = d;
+        }
+    }
+    // The hydrostatic term against the standard atmosphere's pressure (the wet term is under
+    // a millimetre at 216.66 K).
+    let lat = 37.5f64.to_radians();
+    for (h_m, p_hpa, tol) in [
+        (11_000.0, 226.32, 0.005),
+        (20_000.0, 54.749, 0.005),
+        (30_000.0, 11.970, 0.06),
+    ] {
+        let dry = 0.0022768 * p_hpa / (1.0 - 0.00266 * (2.0 * lat).cos() - 0.00028 * h_m / 1e3);
+        let d = at(h_m, zenith);
+        assert!(
+            (d - dry).abs() < tol * dry + 1e-3,
+            "{h_m} m: {d} m against {dry} m"
+        );
+    }
 }
