@@ -106,7 +106,8 @@ mod tests {
     /// PRN 7 at `cn0_dbhz` in unit complex noise (`A^2 fs / 2 = C/N0`), 50 bit/s data
     /// alternating in pairs, the carrier Doppler stepping by `step_hz` at `step_s`
     /// (phase-continuous); no signal at all from `off_s` on; from `cut.0` s on, `cut.1` s of
-    /// signal lost (as when samples are dropped).
+    /// signal lost (as when samples are dropped); from `zeros.0` s on, `zeros.1` s of samples
+    /// that are 0 (a stalled front end).
     struct Signal {
         code: CaCode,
         step_s: f64,
@@ -115,11 +116,15 @@ mod tests {
         cn0_dbhz: f64,
         rng: SimRng,
         cut: (f64, f64),
+        zeros: (f64, f64),
     }
 
     impl Signal {
         fn sample(&mut self, k: u64) -> Complex32 {
             let t = k as f64 / FS;
+            if (self.zeros.0..self.zeros.0 + self.zeros.1).contains(&t) {
+                return Complex32::new(0.0, 0.0);
+            }
             let t = if t >= self.cut.0 { t + self.cut.1 } else { t };
             let n = Complex64::new(self.rng.gauss(), self.rng.gauss());
             if t >= self.off_s {
@@ -219,6 +224,7 @@ mod tests {
             step_hz: 5.0,
             off_s: f64::INFINITY,
             cut: (f64::INFINITY, 0.0),
+            zeros: (f64::INFINITY, 0.0),
             cn0_dbhz: 45.0,
             rng: SimRng::new(11),
         };
@@ -254,6 +260,7 @@ mod tests {
             step_hz: 5.0,
             off_s: f64::INFINITY,
             cut: (f64::INFINITY, 0.0),
+            zeros: (f64::INFINITY, 0.0),
             cn0_dbhz: 31.0,
             rng: SimRng::new(23),
         };
@@ -313,6 +320,7 @@ mod tests {
             step_hz: 0.0,
             off_s: 2.0,
             cut: (f64::INFINITY, 0.0),
+            zeros: (f64::INFINITY, 0.0),
             cn0_dbhz: 45.0,
             rng: SimRng::new(5),
         };
@@ -350,9 +358,69 @@ mod tests {
             step_hz: 0.0,
             off_s: f64::INFINITY,
             cut: (3.0, 0.031),
+            zeros: (f64::INFINITY, 0.0),
             cn0_dbhz,
             rng: SimRng::new(seed),
         }
+    }
+
+    /// One second of zeros at 3 s under a 36 dB-Hz satellite (between the weak-signal
+    /// thresholds, 32 and 35 dB-Hz, on its 1 ms loops): the C/N0 estimates sink with the power
+    /// and the channel coasts through on its weak-signal loops; `dynamics` tells it the
+    /// receiver is manoeuvring. Returns the reports of 3.95-5.0 s and the channel.
+    fn one_second_of_zeros(dynamics: bool) -> (Vec<(f64, ChannelState, bool, f64)>, Channel) {
+        let mut sig = Signal {
+            cut: (f64::INFINITY, 0.0),
+            zeros: (3.0, 1.0),
+            ..cut_at_3_s(36.0, 41)
+        };
+        let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
+        ch.set_dynamics(dynamics);
+        let _ = run(&mut ch, &mut sig, 2.95);
+        assert!(!ch.weak_loops(), "weak before the outage");
+        let _ = run(&mut ch, &mut sig, 3.95);
+        assert!(ch.weak_loops(), "not coasting on the weak loops");
+        (run(&mut ch, &mut sig, 5.0), ch)
+    }
+
+    /// When the signal comes back the channel takes back its 1 ms loops at once, not once its
+    /// C/N0 estimate, which still averages the zeros, has climbed over the weak-signal
+    /// threshold and its hysteresis (0.5-0.8 s later), and holds the phase within 0.3 s.
+    /// Under unaided dynamics it keeps its weak loops (its NCO did not follow the motion
+    /// through the outage).
+    #[test]
+    fn after_an_outage_a_channel_takes_back_the_loops_it_had() {
+        let (eps, ch) = one_second_of_zeros(false);
+        let back = eps
+            .iter()
+            .find(|e| e.0 >= 4.1)
+            .expect("reports after the outage");
+        assert!(!ch.weak_loops(), "on the weak loops at the end");
+        assert!(eps.iter().all(|e| e.1 == ChannelState::Track), "lost");
+        assert!(
+            eps.iter().filter(|e| e.0 >= 4.3).all(|e| e.2),
+            "not locked 0.3 s after the outage"
+        );
+        // Each report is one interval: 1 ms intervals from 0.1 s after the return.
+        assert!(
+            longest_interval_ms(&eps, back.0) < 1.5,
+            "longer intervals after 4.1 s"
+        );
+        // (Under dynamics the weak loops are the widened ones, 10 ms, once the signal is back.)
+        let (eps, _) = one_second_of_zeros(true);
+        assert!(
+            longest_interval_ms(&eps, 4.1) > 5.0,
+            "unaided under dynamics: taken back"
+        );
+    }
+
+    /// The longest interval between two reports from `from_s` on, ms.
+    fn longest_interval_ms(eps: &[(f64, ChannelState, bool, f64)], from_s: f64) -> f64 {
+        let after: Vec<f64> = eps.iter().filter(|e| e.0 >= from_s).map(|e| e.0).collect();
+        after
+            .windows(2)
+            .map(|w| (w[1] - w[0]) * 1e3)
+            .fold(0.0f64, f64::max)
     }
 
     /// A satellite at 34 dB-Hz, 2 dB over the weak-signal threshold: the C/N0 estimates
