@@ -8,6 +8,7 @@
 //! - [`sigmf`]: `.sigmf-meta` read/write; [`wav`]: WAV layout;
 //! - [`info`]: statistics, histogram and spectrum of a recording (`gpsrx info`).
 
+pub mod capture_gaps;
 mod chunk;
 mod codec;
 pub mod error;

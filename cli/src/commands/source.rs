@@ -12,10 +12,10 @@
 //! then stops the command at once, as there is nothing to finish.)
 
 use anyhow::Context;
+use gpsrx_samples::capture_gaps::open_filling_capture_gaps;
 use gpsrx_samples::stream_source::is_stdin_path;
 use gpsrx_samples::{
-    open_source, IntegerFormat, IntegerSamplesMut, SampleError, SampleFormat, SampleSource,
-    SourceConfig,
+    IntegerFormat, IntegerSamplesMut, SampleError, SampleFormat, SampleSource, SourceConfig,
 };
 use num_complex::Complex32;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -209,7 +209,9 @@ fn is_stream(cfg: &SourceConfig) -> bool {
 /// Opens the recording of `cfg` (`-` is standard input) so that Ctrl-C ends it cleanly, also
 /// while a stream sends nothing.
 pub fn open_interruptible(cfg: &SourceConfig) -> anyhow::Result<Box<dyn SampleSource>> {
-    let inner = open_source(cfg).with_context(|| format!("cannot read {}", cfg.path.display()))?;
+    // Samples the SigMF captures say were lost come back as zeros (the receiver's time runs on).
+    let inner = open_filling_capture_gaps(cfg)
+        .with_context(|| format!("cannot read {}", cfg.path.display()))?;
     catch_interrupt();
     let inner: Box<dyn SampleSource> = if is_stream(cfg) {
         Box::new(Threaded::new(inner))

@@ -8,7 +8,7 @@ use crate::output::{FileSink, OutputError};
 use crate::pipeline::{Assistance, AssistanceError, AssistanceFiles, Receiver, ReceiverError};
 use crate::pipeline::{RunSummary, Sink};
 use gpsrx_samples::sim::scenario::{BUILTIN_NAV, BUILTIN_NAV_TEXT};
-use gpsrx_samples::{open_source, SampleError, SampleSource, SourceConfig};
+use gpsrx_samples::{SampleError, SampleSource, SourceConfig};
 use std::path::Path;
 
 /// Why a recording could not be processed. The message names the recording's problem as
@@ -108,7 +108,9 @@ impl RecordingSpec {
     /// Opens the recording.
     pub fn open(&self) -> Result<(SourceConfig, Box<dyn SampleSource>), RecordingError> {
         let cfg = self.source_config()?;
-        let src = open_source(&cfg).map_err(|e| self.source_error(e))?;
+        // Samples the SigMF captures say were lost come back as zeros.
+        let src = gpsrx_samples::capture_gaps::open_filling_capture_gaps(&cfg)
+            .map_err(|e| self.source_error(e))?;
         Ok((cfg, src))
     }
 }
