@@ -12,7 +12,7 @@
 
 use crate::error::SampleError;
 use crate::format::SampleFormat;
-use crate::sigmf::parse_datetime_utc;
+use crate::sigmf::{parse_datetime_utc, read_meta_json};
 use crate::source::{IntegerFormat, IntegerSamplesMut, SampleSource};
 use num_complex::Complex32;
 use serde_json::Value;
@@ -45,14 +45,11 @@ pub fn capture_gaps(
     meta_path: &Path,
     fs_hz: f64,
 ) -> Result<(Vec<CaptureGap>, Vec<String>), SampleError> {
-    let text =
-        std::fs::read_to_string(meta_path).map_err(|e| SampleError::io("read", meta_path, e))?;
+    let doc = read_meta_json(meta_path)?;
     let invalid = |reason: String| SampleError::SigmfInvalid {
         path: meta_path.to_path_buf(),
         reason,
     };
-    let doc: Value =
-        serde_json::from_str(&text).map_err(|e| invalid(format!("not valid JSON ({e})")))?;
     let captures = doc
         .get("captures")
         .and_then(Value::as_array)
@@ -238,6 +235,8 @@ impl SampleSource for GapFilled {
         self.inner.format()
     }
 
+    /// The inner source's samples and every gap's zeros (more than are delivered when a skip
+    /// or a duration leaves gaps out: for progress only).
     fn total_samples(&self) -> Option<u64> {
         let filled: u64 = self.gaps.iter().map(|g| g.missing).sum();
         self.inner.total_samples().map(|n| n + filled)

@@ -341,15 +341,20 @@ pub fn write_sigmf_meta(data_path: &Path, meta: &SigmfMeta) -> Result<PathBuf, S
     Ok(meta_path)
 }
 
+/// The JSON document of a `.sigmf-meta` file (an unreadable file or invalid JSON: an error
+/// naming it).
+pub(crate) fn read_meta_json(path: &Path) -> Result<Value, SampleError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SampleError::io("read", path, e))?;
+    serde_json::from_str(&text).map_err(|e| SampleError::SigmfInvalid {
+        path: path.to_path_buf(),
+        reason: format!("not valid JSON ({e})"),
+    })
+}
+
 /// The data file a `.sigmf-meta` file names in `global.core:dataset` (a "non-conforming
 /// dataset", beside the metadata), if it names one.
 pub fn dataset_path(meta_path: &Path) -> Result<Option<PathBuf>, SampleError> {
-    let text =
-        std::fs::read_to_string(meta_path).map_err(|e| SampleError::io("read", meta_path, e))?;
-    let doc: Value = serde_json::from_str(&text).map_err(|e| SampleError::SigmfInvalid {
-        path: meta_path.to_path_buf(),
-        reason: format!("not valid JSON ({e})"),
-    })?;
+    let doc = read_meta_json(meta_path)?;
     let name = doc
         .get("global")
         .and_then(|g| g.get("core:dataset"))
@@ -359,13 +364,11 @@ pub fn dataset_path(meta_path: &Path) -> Result<Option<PathBuf>, SampleError> {
 
 /// Reads a `.sigmf-meta` file. Requires `global.core:datatype`; everything else is optional.
 pub fn read_sigmf_meta(path: &Path) -> Result<SigmfMeta, SampleError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SampleError::io("read", path, e))?;
+    let doc = read_meta_json(path)?;
     let invalid = |reason: String| SampleError::SigmfInvalid {
         path: path.to_path_buf(),
         reason,
     };
-    let doc: Value =
-        serde_json::from_str(&text).map_err(|e| invalid(format!("not valid JSON ({e})")))?;
     let global = doc
         .get("global")
         .and_then(Value::as_object)
