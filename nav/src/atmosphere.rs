@@ -74,6 +74,9 @@ pub fn klobuchar_delay_s(
     }
 }
 
+/// Height above which [`saastamoinen_delay_m`] is 0, m (the stratopause: 1 mm of delay at
+/// the zenith left, 1 cm at 5 degrees).
+pub const TROPO_TOP_M: f64 = 50_000.0;
 /// Height of the tropopause of the standard atmosphere, m: the temperature falls at 6.5 K/km
 /// up to it and is constant above ([`saastamoinen_delay_m`]).
 pub const TROPOPAUSE_M: f64 = 11_000.0;
@@ -113,8 +116,9 @@ pub const STANDARD_RELATIVE_HUMIDITY: f64 = 0.7;
 /// - dry = 0.0022768 P / (1 - 0.00266 cos(2 lat) - 0.00028 h_km) / cos(z),
 ///   wet = 0.002277 (1255 / T + 0.05) e / cos(z), z = pi/2 - el.
 ///
-/// The zenith dry delay is about 2.3 m at sea level. Returns 0 for `el_rad <= 0` and below
-/// -100 m.
+/// The zenith dry delay is about 2.3 m at sea level. Returns 0 for `el_rad <= 0`, below
+/// -100 m and above [`TROPO_TOP_M`] (50 km: a millimetre at the zenith is left there, and
+/// the formula's height term would divide by zero at 3570 km).
 ///
 /// Above the tropopause ([`TROPOPAUSE_M`], 11 km) the standard atmosphere is taken isothermal
 /// (U.S. Standard Atmosphere 1976 up to 20 km: T = 216.66 K, P = 226.3 hPa at 11 km falling as
@@ -127,7 +131,7 @@ pub const STANDARD_RELATIVE_HUMIDITY: f64 = 0.7;
 /// 10 km, which the receiver took for lost samples (every carrier phase jumped at once) and
 /// a simulated signal carried as a real jump.
 pub fn saastamoinen_delay_m(rx: &Llh, el_rad: f64) -> f64 {
-    if el_rad.is_nan() || el_rad <= 0.0 || rx.h_m.is_nan() || rx.h_m < -100.0 {
+    if el_rad.is_nan() || el_rad <= 0.0 || !(-100.0..=TROPO_TOP_M).contains(&rx.h_m) {
         return 0.0;
     }
     let h_m = rx.h_m.max(0.0);

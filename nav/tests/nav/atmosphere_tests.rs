@@ -138,6 +138,12 @@ fn saastamoinen_is_continuous_through_10_km_and_follows_the_standard_atmosphere_
             prev = d;
         }
     }
+    // Above 50 km nothing (a spacecraft; the height term of the dry delay would divide by
+    // zero at 3570 km), and the step there is a millimetre at the zenith.
+    for h_m in [50_001.0, 1e5, 3.57e6, 2e7] {
+        assert_eq!(at(h_m, zenith), 0.0, "{h_m} m");
+    }
+    assert!(at(50_000.0, zenith) < 2e-3);
     // The hydrostatic term against the standard atmosphere's pressure (the wet term is under
     // a millimetre at 216.66 K).
     let lat = 37.5f64.to_radians();
