@@ -12,10 +12,9 @@
 
 use crate::error::SampleError;
 use crate::format::SampleFormat;
-use crate::sigmf::{parse_datetime_utc, read_meta_json};
+use crate::sigmf::{parse_datetime_utc, read_captures};
 use crate::source::{IntegerFormat, IntegerSamplesMut, SampleSource};
 use num_complex::Complex32;
-use serde_json::Value;
 use std::path::Path;
 
 /// Longest gap filled with zeros, s: a longer one would make the receiver track zeros for
@@ -45,25 +44,15 @@ pub fn capture_gaps(
     meta_path: &Path,
     fs_hz: f64,
 ) -> Result<(Vec<CaptureGap>, Vec<String>), SampleError> {
-    let doc = read_meta_json(meta_path)?;
     let invalid = |reason: String| SampleError::SigmfInvalid {
         path: meta_path.to_path_buf(),
         reason,
     };
-    let captures = doc
-        .get("captures")
-        .and_then(Value::as_array)
-        .map(Vec::as_slice)
-        .unwrap_or_default();
     let mut timed = Vec::new();
-    for c in captures {
-        let start = c
-            .get("core:sample_start")
-            .and_then(Value::as_u64)
-            .unwrap_or(0);
-        if let Some(when) = c.get("core:datetime").and_then(Value::as_str) {
-            let t = parse_datetime_utc(when).map_err(|why| invalid(format!("captures: {why}")))?;
-            timed.push((start, t, when.to_string()));
+    for c in read_captures(meta_path)? {
+        if let Some(when) = c.datetime {
+            let t = parse_datetime_utc(&when).map_err(|why| invalid(format!("captures: {why}")))?;
+            timed.push((c.sample_start, t, when));
         }
     }
     let (mut gaps, mut warnings) = (Vec::new(), Vec::new());
@@ -297,6 +286,7 @@ pub fn open_filling_capture_gaps(
 mod tests {
     use super::*;
     use crate::source::SourceConfig;
+    use serde_json::Value;
 
     const FS: f64 = 2.048e6;
 

@@ -351,6 +351,39 @@ pub(crate) fn read_meta_json(path: &Path) -> Result<Value, SampleError> {
     })
 }
 
+/// One capture of a SigMF recording: its first sample in the data file and its
+/// `core:datetime`, as written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Capture {
+    /// `core:sample_start` (0 when absent).
+    pub sample_start: u64,
+    /// `core:datetime` (ISO 8601 UTC), if given.
+    pub datetime: Option<String>,
+}
+
+/// The captures of a `.sigmf-meta` file, in sample order (none when it has no `captures`).
+pub fn read_captures(meta_path: &Path) -> Result<Vec<Capture>, SampleError> {
+    let doc = read_meta_json(meta_path)?;
+    let mut out: Vec<Capture> = doc
+        .get("captures")
+        .and_then(Value::as_array)
+        .map_or(&[][..], Vec::as_slice)
+        .iter()
+        .map(|c| Capture {
+            sample_start: c
+                .get("core:sample_start")
+                .and_then(Value::as_u64)
+                .unwrap_or(0),
+            datetime: c
+                .get("core:datetime")
+                .and_then(Value::as_str)
+                .map(str::to_string),
+        })
+        .collect();
+    out.sort_by_key(|c| c.sample_start);
+    Ok(out)
+}
+
 /// The data file a `.sigmf-meta` file names in `global.core:dataset` (a "non-conforming
 /// dataset", beside the metadata), if it names one.
 pub fn dataset_path(meta_path: &Path) -> Result<Option<PathBuf>, SampleError> {

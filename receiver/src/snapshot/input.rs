@@ -95,41 +95,12 @@ fn sigmf_meta_of(path: &Path) -> Option<std::path::PathBuf> {
     meta.is_file().then_some(meta)
 }
 
-/// One capture of a SigMF recording: its first sample and its `core:datetime`.
-#[derive(Debug, Clone, PartialEq)]
-struct Capture {
-    sample_start: u64,
-    datetime: Option<String>,
-}
-
 /// The captures of a SigMF metadata file, in sample order.
-fn captures(meta: &Path) -> Result<Vec<Capture>, SnapshotError> {
-    let bad = |reason: String| SnapshotError::Input {
+fn captures(meta: &Path) -> Result<Vec<gpsrx_samples::sigmf::Capture>, SnapshotError> {
+    gpsrx_samples::sigmf::read_captures(meta).map_err(|e| SnapshotError::Input {
         path: meta.to_path_buf(),
-        reason,
-    };
-    let text = std::fs::read_to_string(meta).map_err(|e| bad(e.to_string()))?;
-    let doc: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| bad(format!("not valid JSON ({e})")))?;
-    let list = doc
-        .get("captures")
-        .and_then(serde_json::Value::as_array)
-        .map_or(&[][..], Vec::as_slice);
-    let mut out: Vec<Capture> = list
-        .iter()
-        .map(|c| Capture {
-            sample_start: c
-                .get("core:sample_start")
-                .and_then(serde_json::Value::as_u64)
-                .unwrap_or(0),
-            datetime: c
-                .get("core:datetime")
-                .and_then(serde_json::Value::as_str)
-                .map(str::to_string),
-        })
-        .collect();
-    out.sort_by_key(|c| c.sample_start);
-    Ok(out)
+        reason: e.to_string(),
+    })
 }
 
 /// The snapshots of a SigMF recording with more than one capture: capture `k` holds the
