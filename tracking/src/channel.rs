@@ -372,6 +372,9 @@ pub struct Channel {
     /// [`ChannelConfig::weak_enter_dbhz`] does not make the channel weak
     /// ([`FADE_RECOVERY_HOLD_MS`]).
     fade_hold_ms: u32,
+    /// Milliseconds left after a fade coasted with a feed-forward during which low C/N0
+    /// estimates do not release the channel ([`Channel::on_cn0_estimate`]).
+    aided_fade_hold_ms: u32,
     cn0_window_blocks: u32,
     bit_sync: BitSync,
     /// Next integration's first sample (absolute index).
@@ -486,6 +489,7 @@ impl Channel {
             costas_hold_ms: None,
             weak_before_fade: None,
             fade_hold_ms: 0,
+            aided_fade_hold_ms: 0,
             cn0_window_blocks,
             cn0: SmoothedNwpr::new(
                 1e-3,
@@ -894,7 +898,9 @@ impl Channel {
     /// (set below [`ChannelConfig::weak_enter_dbhz`], cleared above
     /// [`ChannelConfig::weak_leave_dbhz`]), and once per estimation window the code lock
     /// decided: [`ChannelConfig::lost_estimates`] consecutive estimates below
-    /// [`ChannelConfig::cn0_lost_dbhz`] with the code lock detector out release the channel.
+    /// [`ChannelConfig::cn0_lost_dbhz`] with the code lock detector out release the channel
+    /// (not counting, with a feed-forward applied, the estimates of an outage: while the fade
+    /// detector says the power is gone, and up to [`FADE_RECOVERY_HOLD_MS`] after it).
     fn on_cn0_estimate(&mut self, c: f64) {
         self.cn0_dbhz = c;
         // The level the signal had: the highest estimate, forgotten at 0.05 dB per estimate
@@ -916,7 +922,11 @@ impl Channel {
         // Lock decisions once per estimation window.
         if self.cn0.blocks().is_multiple_of(self.cn0_window_blocks) {
             let ok = self.code_lock.update(c);
-            self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz {
+            // An outage with a feed-forward: the NCO follows the motion through it, and the
+            // estimates that average it are not the signal's (a search could do no better).
+            let coasting =
+                self.ff_applied_hz.is_some() && (self.fade.faded() || self.aided_fade_hold_ms > 0);
+            self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz && !coasting {
                 self.low_cn0_count + 1
             } else {
                 0
@@ -939,10 +949,14 @@ impl Channel {
     #[inline]
     fn watch_fade(&mut self) {
         self.fade_hold_ms = self.fade_hold_ms.saturating_sub(1);
+        self.aided_fade_hold_ms = self.aided_fade_hold_ms.saturating_sub(1);
         match (self.weak_before_fade, self.fade.faded()) {
             (None, true) => self.weak_before_fade = Some(self.weak),
             (Some(before), false) => {
                 self.weak_before_fade = None;
+                if self.ff_applied_hz.is_some() {
+                    self.aided_fade_hold_ms = FADE_RECOVERY_HOLD_MS;
+                }
                 // Only where the NCO followed the signal through the outage: with a
                 // feed-forward, or without dynamics. Unaided in a manoeuvre it coasted tens
                 // of hertz off (a 10 g turn's jerk over 1 s: 100 Hz), and the normal loops

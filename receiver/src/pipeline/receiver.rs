@@ -10,7 +10,7 @@
 use crate::config::ReceiverConfig;
 use crate::landmarks::LandmarkObservation;
 use crate::pipeline::aiding::InsFeedForward;
-use crate::pipeline::aiding::{AidMonitor, AidingStats, GatedAid};
+use crate::pipeline::aiding::{AidMonitor, AidingStats, GatedAid, OutageBridge};
 use crate::pipeline::channels::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
 use crate::pipeline::channels::ring::{block_samples, SampleWindow};
 use crate::pipeline::channels::search_schedule::SearchBudget;
@@ -261,6 +261,9 @@ pub struct Receiver {
     monitor: AidMonitor,
     /// Vector tracking (`[tracking] mode = "vector"`).
     vector: Option<VectorTracking>,
+    /// Without an INS: the bridge over the outage under way, and the signal lost before it
+    /// was armed, s ([`OutageBridge`]).
+    bridge: Option<(OutageBridge, f64)>,
     /// Samples up to this index have been processed by the channels.
     processed_to: Option<u64>,
     /// Index of the first sample of the stream.
@@ -371,6 +374,7 @@ impl Receiver {
             aiding,
             monitor: AidMonitor::new(),
             vector,
+            bridge: None,
             processed_to: None,
             first_sample: None,
             started: std::time::Instant::now(),
@@ -473,7 +477,8 @@ impl Receiver {
                 .manager
                 .due_search(view, &|p| nav.visibility(p.get(), t_s));
             let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
-            let aid = round_aid(gated.as_ref(), self.vector.as_ref());
+            let bridge = self.bridge.as_ref().map(|(b, _)| b);
+            let aid = round_aid(gated.as_ref(), self.vector.as_ref(), bridge);
             let manager = &mut self.manager;
             let end = view.end();
             let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
@@ -621,7 +626,8 @@ impl Receiver {
             .manager
             .due_search(view, &|p| nav.visibility(p.get(), t_s));
         let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
-        let aid = round_aid(gated.as_ref(), self.vector.as_ref());
+        let bridge = self.bridge.as_ref().map(|(b, _)| b);
+        let aid = round_aid(gated.as_ref(), self.vector.as_ref(), bridge);
         let manager = &mut self.manager;
         let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
         self.processed_to = Some(limit);
@@ -706,9 +712,13 @@ impl Receiver {
     ) -> Result<(), ReceiverError> {
         match self.nav.end_block(end, sink).map_err(ReceiverError::Sink)? {
             Some(BlockEvent::PhaseJump(_)) => self.manager.restart_bit_sync(),
-            Some(BlockEvent::Collapse(c)) => self.manager.request_realignment(&c),
+            Some(BlockEvent::Collapse(c)) => {
+                self.manager.request_realignment(&c);
+                self.arm_bridge(c.sample as f64 / self.fs_hz);
+            }
             None => {}
         }
+        self.follow_bridge(end as f64 / self.fs_hz);
         match found {
             Some(outcome) if outcome.is_realignment() => {
                 // The channels report the code shifts; timing decides what they show.
@@ -738,6 +748,37 @@ impl Receiver {
         let keep_from = self.manager.oldest_needed(end);
         self.window.discard_before(keep_from);
         Ok(())
+    }
+
+    /// Without an INS: arms the bridge over the outage whose collapse was at stream time
+    /// `collapse_s`, unless one is under way ([`NavigationProcessor::outage_bridge`]).
+    fn arm_bridge(&mut self, collapse_s: f64) {
+        if self.aiding.is_none() && self.bridge.is_none() {
+            let lost_s = self.nav.lost_total_s();
+            self.bridge = self.nav.outage_bridge(collapse_s).map(|b| (b, lost_s));
+        }
+    }
+
+    /// The bridge under way after the round ending at stream time `t_s`: the signal lost
+    /// since it was armed (measured gaps), its end at the first valid fix more than
+    /// [`BRIDGE_RETURN_S`] after the collapse, and gone once over.
+    fn follow_bridge(&mut self, t_s: f64) {
+        let Some((bridge, lost_before_s)) = self.bridge.as_mut() else {
+            return;
+        };
+        bridge.set_lost_s(self.nav.lost_total_s() - *lost_before_s);
+        if let Some(t_fix) = self.nav.last_valid_fix_s() {
+            if t_fix > bridge.from_s() + BRIDGE_RETURN_S {
+                bridge.end_at(t_fix);
+            }
+        }
+        if bridge.over_at(t_s) {
+            tracing::info!(
+                "{t_s:.3} s: the outage bridge from {:.3} s ends (a valid fix after the return, or its longest)",
+                bridge.from_s()
+            );
+            self.bridge = None;
+        }
     }
 
     /// Tells the sink about the channels just started.
@@ -842,17 +883,25 @@ fn gated_aid<'a>(
 }
 
 /// The aiding port of the next round: the gated INS feed-forward with `--ins`, the
-/// navigation filter's with `--tracking vector` (the two are never both on), else none.
+/// navigation filter's with `--tracking vector` while it drives the channels (the two are
+/// never both on), else the bridge over an outage under way, else none.
 fn round_aid<'a>(
     gated: Option<&'a GatedAid<'a, InsFeedForward>>,
     vector: Option<&'a VectorTracking>,
+    bridge: Option<&'a OutageBridge>,
 ) -> Option<&'a dyn AidingPort> {
-    match (gated, vector) {
-        (Some(g), _) => Some(g as &dyn AidingPort),
-        (None, Some(v)) => Some(v.port() as &dyn AidingPort),
-        (None, None) => None,
+    let vector = vector.filter(|v| v.port().snapshot.is_some());
+    match (gated, vector, bridge) {
+        (Some(g), _, _) => Some(g as &dyn AidingPort),
+        (None, Some(v), _) => Some(v.port() as &dyn AidingPort),
+        (None, None, Some(b)) => Some(b as &dyn AidingPort),
+        (None, None, None) => None,
     }
 }
+
+/// A valid fix this long after the collapse ends the outage bridge, s (the fixes of the
+/// reports from before the collapse still come in for a round or two).
+const BRIDGE_RETURN_S: f64 = 0.2;
 
 /// Logs what an INS accelerometer bias of 1 mg per axis (up to sqrt 3 mg on a line of sight)
 /// does to the aided carrier loops: the static phase offset of a 2nd-order loop (seed 004

@@ -414,6 +414,53 @@ mod tests {
         );
     }
 
+    /// A satellite at 30 dB-Hz under 1.2 s of zeros: its C/N0 estimates sink for as long
+    /// (5 of them below 25 dB-Hz, with the code lock out, release a channel). Unaided it is
+    /// released in the outage; with a feed-forward that holds its Doppler (an INS, or the
+    /// receiver's outage bridge) it coasts through, is not released for the estimates that
+    /// still average the zeros after the return, and tracks locked again.
+    #[test]
+    fn a_channel_coasting_on_a_feed_forward_is_not_released_for_the_outage() {
+        let run_aided = |aided: bool| {
+            let mut sig = Signal {
+                cut: (f64::INFINITY, 0.0),
+                zeros: (3.0, 1.2),
+                ..cut_at_3_s(30.0, 7)
+            };
+            let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
+            let mut last = None;
+            while ch.state() != ChannelState::Lost {
+                let (first, n) = ch.next_span();
+                let t = first as f64 / FS;
+                if t > 7.0 {
+                    break;
+                }
+                let aid = crate::DopplerAid {
+                    doppler_hz: DOPPLER_HZ,
+                    doppler_rate_hz_s: 0.0,
+                };
+                ch.set_aid((aided && t > 2.9).then_some(aid), t);
+                let x: Vec<Complex32> = (first..first + n as u64).map(|k| sig.sample(k)).collect();
+                if let Some(e) = ch.process_code_period(&x) {
+                    last = Some((e.t_rx_s, e.state, e.pll_lock));
+                }
+            }
+            last.expect("reports")
+        };
+        let (t, state, _) = run_aided(false);
+        assert_eq!(
+            state,
+            ChannelState::Lost,
+            "unaided: still tracking at {t:.2} s"
+        );
+        assert!(t < 5.0, "unaided: released only at {t:.2} s");
+        let (t, state, locked) = run_aided(true);
+        assert!(
+            state == ChannelState::Track && locked && t > 6.9,
+            "aided: {state:?}, lock {locked} at {t:.2} s"
+        );
+    }
+
     /// The longest interval between two reports from `from_s` on, ms.
     fn longest_interval_ms(eps: &[(f64, ChannelState, bool, f64)], from_s: f64) -> f64 {
         let after: Vec<f64> = eps.iter().filter(|e| e.0 >= from_s).map(|e| e.0).collect();

@@ -78,6 +78,26 @@ pub struct ObservableEpoch {
     pub sats: Vec<SatObservable>,
 }
 
+/// Longest stretch without a feed-forward in a break that a channel's own carrier still
+/// bridges, s: an outage bridge comes on a round or two after the collapse
+/// (`crate::pipeline::aiding::OutageBridge`); until then the loops coast on their memories.
+const MAX_UNAIDED_COAST_S: f64 = 0.2;
+
+/// How a satellite's channel coasted over its last break in lock.
+#[derive(Debug, Clone, Copy, Default)]
+struct Coast {
+    /// `ms_count` of its latest report.
+    last_ms: Option<u64>,
+    /// In a break (its latest report was not usable).
+    in_break: bool,
+    /// Some report of the break held a feed-forward.
+    aided: bool,
+    /// Integration time of the break's reports without one, s (infinite: another channel).
+    unaided_s: f64,
+    /// The last break was coasted with a feed-forward (decided at its end).
+    coasted: bool,
+}
+
 /// Builds observable epochs from channel reports.
 #[derive(Debug)]
 pub struct ObservableBuilder {
@@ -115,6 +135,9 @@ pub struct ObservableBuilder {
     /// Per PRN: `(stream time s, carrier cycles)` of the channel's reports since its lock
     /// last broke (every [`RUN_POINT_S`], the last [`RUN_KEPT_S`]): anchors for a bridge.
     runs: BTreeMap<u8, VecDeque<(f64, f64)>>,
+    /// Per PRN, since its last usable report: how its channel coasted
+    /// ([`ObservableBuilder::note_coast`]).
+    coasts: BTreeMap<u8, Coast>,
     /// Hatch filter length, epochs.
     hatch_epochs: u32,
     /// Reports with a lower C/N0 estimate give no observables (see
@@ -133,6 +156,7 @@ impl ObservableBuilder {
             total_step_ms: 0,
             pending: BTreeMap::new(),
             lli: BTreeMap::new(),
+            coasts: BTreeMap::new(),
             lli_carried: BTreeSet::new(),
             newest: i64::MIN,
             first_epoch: i64::MIN,
@@ -246,6 +270,40 @@ impl ObservableBuilder {
         }
     }
 
+    /// Follows whether `e`'s satellite coasted with a feed-forward over its last break in
+    /// lock: every report in it was of the same channel (its `ms_count` grew), some held a
+    /// feed-forward, and those without one (before an outage bridge came on) span at most
+    /// [`MAX_UNAIDED_COAST_S`]. Returns that, from the first usable report after the break
+    /// until the next break.
+    fn note_coast(&mut self, e: &ChannelEpoch, usable: bool) -> bool {
+        let aided = e.feedforward_hz.is_some_and(f64::is_finite);
+        let c = self.coasts.entry(e.prn).or_default();
+        let same = c.last_ms.is_none_or(|m| e.ms_count > m);
+        c.last_ms = Some(e.ms_count);
+        if usable {
+            if c.in_break {
+                c.coasted = same && c.aided && c.unaided_s <= MAX_UNAIDED_COAST_S;
+                c.in_break = false;
+            }
+            return c.coasted;
+        }
+        if !c.in_break {
+            *c = Coast {
+                last_ms: Some(e.ms_count),
+                in_break: true,
+                ..Coast::default()
+            };
+        }
+        c.aided |= aided;
+        if !aided {
+            c.unaided_s += e.t_coh_s;
+        }
+        if !same {
+            c.unaided_s = f64::INFINITY;
+        }
+        false
+    }
+
     /// The anchor of a bridge of `prn`'s smoothing from stream time `from_s` to `to_s`: the
     /// first point of its current locked run after `from_s` and [`ANCHOR_SETTLE_S`] after
     /// the latest samples lost in between.
@@ -276,6 +334,7 @@ impl ObservableBuilder {
         he: &HatchEpoch,
         lost_flag: bool,
         aid: Option<&InsFeedForward>,
+        coasted: bool,
     ) -> (f64, f64) {
         let (n, t_stream, steps) = (he.epoch, he.t_stream_s, he.steps_ms);
         let max_m = self.hatch_epochs;
@@ -312,13 +371,24 @@ impl ObservableBuilder {
                         .map(|(cycles, _)| -cycles * SPEED_OF_LIGHT_MPS / F_L1_HZ),
                     _ => None,
                 };
-                let bridged = lost_s.is_some_and(|g| h.bridge(he, g, max_m, by_ins, anchor));
+                // A channel that coasted with a feed-forward (an INS, the outage bridge) moved
+                // its NCO with the motion: its own carrier is the range change (no samples lost).
+                let by_own = (coasted && lost_s.is_some_and(|g| g.abs() < 1e-9)).then(|| {
+                    let cycles = |c: f64, steps: i64| c - steps as f64 * 1e-3 * F_L1_HZ;
+                    SPEED_OF_LIGHT_MPS / F_L1_HZ
+                        * (cycles(he.carrier_cycles, he.steps_ms)
+                            - cycles(h.carrier_cycles, h.steps_ms))
+                });
+                let given = by_ins.or(by_own);
+                let break_s = t_stream - h.t_stream_s;
+                let bridged = lost_s.is_some_and(|g| h.bridge(he, g, max_m, given, anchor));
                 tracing::debug!(
-                    "PRN {}: carrier smoothing {} over a break of {:.3} s (lost {:?} s)",
+                    "PRN {}: carrier smoothing {} over a break of {:.3} s (lost {:?} s; coasted with a feed-forward: {:?} m)",
                     e.prn,
                     if bridged { "bridged" } else { "restarted" },
-                    t_stream - h.t_stream_s,
-                    lost_s
+                    break_s,
+                    lost_s,
+                    by_own
                 );
                 if !bridged {
                     *h = Hatch::start(he);
@@ -350,6 +420,7 @@ impl ObservableBuilder {
         let lost = self.lli.entry(e.prn).or_insert(true);
         *lost |= !usable;
         self.note_run(e, usable);
+        let coasted = self.note_coast(e, usable);
         if !usable {
             return Vec::new();
         }
@@ -405,7 +476,7 @@ impl ObservableBuilder {
                 steps_ms: self.total_step_ms,
                 t_stream_s: t_stream,
             };
-            let (smoothed, doppler_hz) = self.smooth(e, &he, lost_flag, aid);
+            let (smoothed, doppler_hz) = self.smooth(e, &he, lost_flag, aid, coasted);
             if n < self.first_epoch {
                 // Not collected: its loss of lock is reported with the next epoch (the
                 // smoothing has taken the break here).

@@ -8,6 +8,7 @@
 
 mod decode;
 mod predict;
+mod settle;
 mod solve;
 mod time_recovery;
 
@@ -48,6 +49,13 @@ pub struct NavigationProcessor {
     prior: Option<PvtSolution>,
     /// The last valid fix for the acquisition scheduler's predictions (kept across gaps).
     anchor: Option<predict::PredictionAnchor>,
+    /// The valid fixes with a velocity of the last `predict::RECENT_FIXES_S`, for the outage
+    /// bridge.
+    recent_fixes: std::collections::VecDeque<crate::pipeline::aiding::FixPoint>,
+    /// Signal lost in all the gaps measured so far, s.
+    lost_total_s: f64,
+    /// The first fixes after an outage ([`settle`]).
+    settle: settle::OutageSettle,
     iono_fallback_said: bool,
     /// The RAIM outcome last logged (transitions are logged).
     last_raim: Option<RaimStatus>,
@@ -144,6 +152,9 @@ impl NavigationProcessor {
             builder,
             prior: None,
             anchor: None,
+            recent_fixes: std::collections::VecDeque::new(),
+            lost_total_s: 0.0,
+            settle: settle::OutageSettle::default(),
             iono_fallback_said: false,
             last_raim: None,
             poor_geometry_logged: false,
@@ -217,6 +228,7 @@ impl NavigationProcessor {
         let d = match self.time.end_block(end) {
             None => return Ok(None),
             Some(BlockEvent::Collapse(c)) => {
+                self.settle.collapse(c.sample as f64 / self.fs_hz);
                 tracing::info!(
                 "{:.3} s: the prompt power of {} of {} satellites collapsed at once (samples lost, or a blockage): searching their code again",
                 c.sample as f64 / self.fs_hz,
@@ -379,6 +391,7 @@ impl NavigationProcessor {
             if let Some(ff) = aiding {
                 ff.note_samples_lost(self.lost_for_aid_ms * 1e-3);
             }
+            self.lost_total_s += self.lost_for_aid_ms * 1e-3;
             self.lost_for_aid_ms = 0.0;
         }
         let s = e.sample_index;

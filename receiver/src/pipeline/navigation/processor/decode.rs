@@ -278,6 +278,7 @@ impl NavigationProcessor {
         self.prior = None;
         // The coarse time was wrong, and so were the fixes from it.
         self.anchor = None;
+        self.recent_fixes.clear();
         sink.event(&ReceiverEvent::CoarseTimeDropped { t_s })
     }
 }

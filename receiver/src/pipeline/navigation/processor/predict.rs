@@ -5,11 +5,15 @@ use super::{
     NavigationProcessor, APPROX_DOPPLER_HZ, BELOW_HORIZON_DEG, PENDING_FOR_S, PREDICTED_DOPPLER_HZ,
     PREDICTED_DOPPLER_RATE_HZ_S,
 };
+use crate::pipeline::aiding::{FixPoint, OutageBridge};
 use crate::pipeline::channels::search_schedule::Visibility;
 use gpsrx_core::constants::{F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::ephemeris::HealthPolicy;
 use gpsrx_nav::pvt::PvtSolution;
 use gpsrx_nav::Vector3;
+
+/// How long the valid fixes are kept for the outage bridge, s.
+pub(super) const RECENT_FIXES_S: f64 = 1.0;
 
 impl NavigationProcessor {
     /// What is predicted of `prn` at stream time `t_stream_s` for the acquisition scheduler:
@@ -68,6 +72,66 @@ impl NavigationProcessor {
             vel_mps: gpsrx_nav::Vector3::zeros(),
         };
         Some((rx, t0.add_seconds(t_stream_s), 0.0, APPROX_DOPPLER_HZ))
+    }
+}
+
+impl NavigationProcessor {
+    /// Keeps the valid fix `sol` at stream time `t_stream_s` for the outage bridge (with its
+    /// velocity; the last [`RECENT_FIXES_S`] of them).
+    pub(super) fn remember_fix(&mut self, sol: &PvtSolution, t_stream_s: f64) {
+        let Some(vel_mps) = sol.vel_ecef_mps else {
+            return;
+        };
+        self.recent_fixes.push_back(FixPoint {
+            t_stream_s,
+            time: sol.time,
+            pos_m: sol.pos_ecef_m,
+            vel_mps,
+            drift_s_s: sol.clock_drift_mps.unwrap_or(0.0) / SPEED_OF_LIGHT_MPS,
+        });
+        while self
+            .recent_fixes
+            .front()
+            .is_some_and(|f| t_stream_s - f.t_stream_s > RECENT_FIXES_S)
+        {
+            self.recent_fixes.pop_front();
+        }
+    }
+
+    /// The bridge over an outage whose common collapse of the prompt power was at stream time
+    /// `collapse_s` ([`OutageBridge::arm`]): the recent valid fixes and every satellite's
+    /// ephemeris (decoded, else from `--nav`, as the fixes take them). None when it is not
+    /// armed.
+    pub fn outage_bridge(&self, collapse_s: f64) -> Option<OutageBridge> {
+        let t = self.recent_fixes.back()?.time;
+        let policy = if self.settings.allow_unhealthy {
+            HealthPolicy::PreferHealthy
+        } else {
+            HealthPolicy::HealthyOnly
+        };
+        let ephemerides = (1..=32u8)
+            .filter_map(|prn| {
+                let decoded = self.decoders.get(&prn).and_then(|d| d.ephemeris.as_ref());
+                let eph = decoded.or_else(|| {
+                    self.nav_assist
+                        .as_ref()
+                        .and_then(|n| n.select_with(prn, t, policy))
+                })?;
+                Some((prn, eph.clone()))
+            })
+            .collect();
+        let fixes: Vec<FixPoint> = self.recent_fixes.iter().copied().collect();
+        OutageBridge::arm(collapse_s, &fixes, ephemerides)
+    }
+
+    /// Stream time of the last valid fix, s.
+    pub fn last_valid_fix_s(&self) -> Option<f64> {
+        self.recent_fixes.back().map(|f| f.t_stream_s)
+    }
+
+    /// Signal lost in all the gaps measured so far, s.
+    pub fn lost_total_s(&self) -> f64 {
+        self.lost_total_s
     }
 }
 

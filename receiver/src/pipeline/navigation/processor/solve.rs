@@ -179,7 +179,15 @@ impl NavigationProcessor {
         let solution = self.solution(&epoch, &ephs);
         let max_pdop = self.settings.max_pdop;
         let integrity_ok = solution.as_ref().is_some_and(passes_integrity);
-        let valid = integrity_ok && solution.as_ref().is_some_and(|s| s.dop.pdop <= max_pdop);
+        let mut valid = integrity_ok && solution.as_ref().is_some_and(|s| s.dop.pdop <= max_pdop);
+        if let Some(s) = solution.as_ref().filter(|_| valid) {
+            let checked = !matches!(s.raim, RaimStatus::Unavailable);
+            let t_s = epoch.sample / self.fs_hz;
+            if !self.settle.admit(t_s, checked, 1.0 / self.settings.rate_hz) {
+                tracing::debug!("{t_s:.2} s: a fix of 4 satellites just after an outage is not valid (waiting for one RAIM can check)");
+                valid = false;
+            }
+        }
         if let Some(s) = solution.as_ref().filter(|s| s.dop.pdop > max_pdop) {
             self.log_poor_geometry(epoch.sample / self.fs_hz, s.dop.pdop, s.n_sv);
         } else {
@@ -291,6 +299,7 @@ impl NavigationProcessor {
         if passes_integrity(&sol) {
             let anchor = PredictionAnchor::new(&sol, t_stream_s, self.anchor.as_ref());
             self.anchor = Some(anchor);
+            self.remember_fix(&sol, t_stream_s);
         }
         self.prior = Some(sol);
         Ok(())
