@@ -87,8 +87,9 @@ pub struct FixPoint {
 
 impl TurnMotion {
     /// The least-squares line through the velocities of `fixes` (in time order): velocity
-    /// `v_c` (the mean) and acceleration `a = sum (t - t_c)(v - v_c) / sum (t - t_c)^2` at
-    /// their mean time `t_c`, the mean position. None with fewer than [`MIN_FIT_FIXES`] or
+    /// `v_c` (the mean's direction with the mean speed) and acceleration
+    /// `a = sum (t - t_c)(v - v_mean) / sum (t - t_c)^2` at their mean time `t_c`, the mean
+    /// position. None with fewer than [`MIN_FIT_FIXES`] or
     /// spanning less than 0.1 s.
     pub fn fit(fixes: &[FixPoint]) -> Option<Self> {
         let n = fixes.len();
@@ -98,12 +99,16 @@ impl TurnMotion {
         }
         let nf = n as f64;
         let t_c = fixes.iter().map(|f| f.t_stream_s).sum::<f64>() / nf;
-        let v_c = fixes.iter().map(|f| f.vel_mps).sum::<Vector3<f64>>() / nf;
+        // The mean velocity is shorter than the velocities on a turn's arc (a chord): its
+        // direction, with their mean speed.
+        let v_mean = fixes.iter().map(|f| f.vel_mps).sum::<Vector3<f64>>() / nf;
+        let speed = fixes.iter().map(|f| f.vel_mps.norm()).sum::<f64>() / nf;
+        let v_c = v_mean.try_normalize(1e-9).map_or(v_mean, |d| d * speed);
         let p_c = fixes.iter().map(|f| f.pos_m).sum::<Vector3<f64>>() / nf;
         let stt: f64 = fixes.iter().map(|f| (f.t_stream_s - t_c).powi(2)).sum();
         let stv: Vector3<f64> = fixes
             .iter()
-            .map(|f| (f.vel_mps - v_c) * (f.t_stream_s - t_c))
+            .map(|f| (f.vel_mps - v_mean) * (f.t_stream_s - t_c))
             .sum();
         let a = stv / stt;
         let m = Self {
