@@ -67,6 +67,10 @@ pub struct RunSettings {
     pub search_budget_s: f64,
     /// Use satellites whose ephemeris says they are unhealthy.
     pub allow_unhealthy: bool,
+    /// Without an INS: when every signal is gone at once under dynamics, feed the motion of
+    /// the last fixes forward into the channels until a fix after the return
+    /// ([`crate::pipeline::aiding::OutageBridge`]). Off: the loops coast alone.
+    pub outage_bridge: bool,
     /// Full GPS week of the recording: labels times until subframe 1 gives the week, and
     /// resolves the broadcast 10-bit week (default: the recording's date, else the navigation
     /// file's week; else unknown, see [`crate::pipeline::WeekReference`]).
@@ -101,6 +105,7 @@ impl Default for RunSettings {
             acq_pfa: 1e-5,
             search_budget_s: crate::pipeline::channels::DEFAULT_PER_SIGNAL_S,
             allow_unhealthy: false,
+            outage_bridge: true,
             week: None,
             prns: Vec::new(),
             approx_time: None,

@@ -102,6 +102,7 @@ pub fn default_toml() -> anyhow::Result<String> {
          acq_noncoherent = 10      # acquisition non-coherent blocks (--acq-noncoherent)\n\
          # (weak signals, below about 35 dB-Hz: acq_coherent_ms = 10, acq_noncoherent = 10 or more)\n\
          allow_unhealthy = false   # use satellites flagged unhealthy (--allow-unhealthy)\n\
+         outage_bridge = true      # without --ins, carry the channels through an outage under dynamics on the motion of the last fixes\n\
          plots = true              # draw track.png, skyplot.png, cn0.png, dop.png (dr.png with --dr) (--no-plots)\n\
          # approx_time = {{ week = 2190, tow_s = 538200.0 }}  # approximate GPS time of the first sample (--time)\n\
          # approx_llh = [37.5665, 126.978, 40.0]           # approximate position, deg, deg, m (--approx-llh)\n\

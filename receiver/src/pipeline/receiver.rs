@@ -264,6 +264,8 @@ pub struct Receiver {
     /// Without an INS: the bridge over the outage under way, and the signal lost before it
     /// was armed, s ([`OutageBridge`]).
     bridge: Option<(OutageBridge, f64)>,
+    /// `[run] outage_bridge`.
+    outage_bridge: bool,
     /// Samples up to this index have been processed by the channels.
     processed_to: Option<u64>,
     /// Index of the first sample of the stream.
@@ -375,6 +377,7 @@ impl Receiver {
             monitor: AidMonitor::new(),
             vector,
             bridge: None,
+            outage_bridge: config.run.outage_bridge,
             processed_to: None,
             first_sample: None,
             started: std::time::Instant::now(),
@@ -753,7 +756,7 @@ impl Receiver {
     /// Without an INS: arms the bridge over the outage whose collapse was at stream time
     /// `collapse_s`, unless one is under way ([`NavigationProcessor::outage_bridge`]).
     fn arm_bridge(&mut self, collapse_s: f64) {
-        if self.aiding.is_none() && self.bridge.is_none() {
+        if self.outage_bridge && self.aiding.is_none() && self.bridge.is_none() {
             let lost_s = self.nav.lost_total_s();
             self.bridge = self.nav.outage_bridge(collapse_s).map(|b| (b, lost_s));
         }
