@@ -48,7 +48,7 @@ pub const ARM_ACCEL_MPS2: f64 = 1.5;
 /// dynamics themselves.
 pub const MAX_BRIDGE_S: f64 = 3.0;
 /// Below this speed the turn rate is not defined: constant acceleration, m/s.
-const MIN_TURN_SPEED_MPS: f64 = 5.0;
+pub const MIN_TURN_SPEED_MPS: f64 = 5.0;
 /// Step of the Doppler rate, s.
 const RATE_STEP_S: f64 = 0.01;
 

@@ -13,6 +13,9 @@ mod bridge;
 mod feed_forward;
 mod monitor;
 
-pub use bridge::{FixPoint, OutageBridge, TurnMotion};
+pub use bridge::{
+    FixPoint, OutageBridge, TurnMotion, ARM_ACCEL_MPS2, FIT_WINDOW_S, MAX_BRIDGE_S, MAX_FIX_AGE_S,
+    MIN_FIT_FIXES, MIN_TURN_SPEED_MPS,
+};
 pub use feed_forward::{InsFeedForward, DRIFT_SMOOTHING_S};
 pub use monitor::{AidMonitor, AidPermission, AidingStats, GatedAid};
