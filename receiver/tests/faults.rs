@@ -440,6 +440,26 @@ fn motion_receiver(heading_deg: f64, speed_mps: f64, transition_s: f64, segments
     )
 }
 
+/// The aircraft of `samples/scenarios/gaps-turn-10g.toml`: 250 m/s, heading 30 deg, `cruise_s`
+/// of straight flight, a 6 s left turn at 10 g (jerk-limited over 1 s), `after_s` of straight
+/// flight; satellites at 30-45 dB-Hz by elevation.
+fn ten_g_turn(cruise_s: f64, after_s: f64) -> Simulator {
+    let receiver = motion_receiver(
+        30.0,
+        250.0,
+        1.0,
+        &format!(
+            r#"[
+  {{ type = "cruise", duration_s = {cruise_s:.1} }},
+  {{ type = "turn", duration_s = 6.0, accel_g = 10.0, direction = "left" }},
+  {{ type = "cruise", duration_s = {after_s:.1} }},
+]"#
+        ),
+    );
+    let sats = "[satellites]\ncn0_zenith_dbhz = 45.0\ncn0_horizon_loss_db = 20.0";
+    scenario(cruise_s + 6.0 + after_s, 4, &receiver, sats)
+}
+
 /// A receiver knowing the week and the broadcast ephemerides.
 fn assisted_receiver() -> Receiver {
     let mut config = gpsrx_receiver::config::ReceiverConfig::default();
@@ -461,18 +481,7 @@ fn a_31_ms_cut_inside_a_10_g_turn_is_timed_from_the_data_bits() {
     // modulo 20) all stay open; the time came back 1.2 s into the next subframe (up to 7 s).
     // The bits after the new edges, matched against the same frame positions 30 s before
     // (subframes 1-3 repeat, the HOW counts on), fix it at 31 ms within a second and a half.
-    let receiver = motion_receiver(
-        30.0,
-        250.0,
-        1.0,
-        r#"[
-  { type = "cruise", duration_s = 40.0 },
-  { type = "turn", duration_s = 6.0, accel_g = 10.0, direction = "left" },
-  { type = "cruise", duration_s = 2.0 },
-]"#,
-    );
-    let sats = "[satellites]\ncn0_zenith_dbhz = 45.0\ncn0_horizon_loss_db = 20.0";
-    let sim = scenario(48.0, 4, &receiver, sats);
+    let sim = ten_g_turn(40.0, 2.0);
     let (at_s, len_s) = (44.0, 0.031);
     let sink = run_with(assisted_receiver(), &sim, Fault::Cut { at_s, len_s });
     let name = "31 ms cut in a 10 g turn";
@@ -528,18 +537,7 @@ fn one_second_of_zeros_inside_a_10_g_turn_is_bridged_by_the_motion_of_the_fixes(
     // motion of the fixes before the zeros on as a turn and feeds it forward: the channels
     // hold, the carrier smoothing is carried over, and the fixes come back within 1.5 s,
     // each within 5 m of the truth.
-    let receiver = motion_receiver(
-        30.0,
-        250.0,
-        1.0,
-        r#"[
-  { type = "cruise", duration_s = 14.0 },
-  { type = "turn", duration_s = 6.0, accel_g = 10.0, direction = "left" },
-  { type = "cruise", duration_s = 1.0 },
-]"#,
-    );
-    let sats = "[satellites]\ncn0_zenith_dbhz = 45.0\ncn0_horizon_loss_db = 20.0";
-    let sim = scenario(21.0, 4, &receiver, sats);
+    let sim = ten_g_turn(14.0, 1.0);
     let (at_s, len_s) = (17.0, 1.0);
     let sink = run_with(assisted_receiver(), &sim, Fault::Zeros { at_s, len_s });
     let name = "1 s of zeros in a 10 g turn";
