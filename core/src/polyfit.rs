@@ -35,6 +35,17 @@ impl Polynomial {
         self.coeffs.iter().rev().fold(0.0, |acc, &c| acc * x + c)
     }
 
+    /// Its derivative at `t`: `sum_k k c_k (t - t_center)^(k - 1)`.
+    pub fn slope_at(&self, t: f64) -> f64 {
+        let x = t - self.t_center;
+        self.coeffs
+            .iter()
+            .enumerate()
+            .skip(1)
+            .rev()
+            .fold(0.0, |acc, (k, &c)| acc * x + k as f64 * c)
+    }
+
     /// The RMS of its residuals at `pts`.
     pub fn rms(&self, pts: &[(f64, f64)]) -> f64 {
         let ss: f64 = pts.iter().map(|&(t, y)| (y - self.at(t)).powi(2)).sum();
@@ -74,5 +85,27 @@ mod tests {
             "{}",
             c.rms(&sq)
         );
+    }
+
+    #[test]
+    fn the_slope_is_the_derivative() {
+        // y = 2 - 3 t + 0.5 t^2 + 0.25 t^3: y' = -3 + t + 0.75 t^2.
+        let pts: Vec<(f64, f64)> = (0..9)
+            .map(|i| {
+                let t = 10.0 + 0.1 * i as f64;
+                (t, 2.0 - 3.0 * t + 0.5 * t * t + 0.25 * t * t * t)
+            })
+            .collect();
+        let p = Polynomial::fit(&pts, 3).expect("fit");
+        for t in [10.0, 10.4, 11.3] {
+            let want = -3.0 + t + 0.75 * t * t;
+            assert!(
+                (p.slope_at(t) - want).abs() < 1e-6,
+                "{t}: {} vs {want}",
+                p.slope_at(t)
+            );
+        }
+        let line = Polynomial::fit(&[(0.0, 1.0), (1.0, 3.0)], 1).expect("line");
+        assert!((line.slope_at(5.0) - 2.0).abs() < 1e-12);
     }
 }

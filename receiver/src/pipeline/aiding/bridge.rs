@@ -22,12 +22,13 @@
 //! goes (`gpsrx_tracking::Channel::set_aid`), so only the predicted *change* of each Doppler
 //! reaches the NCO, and the receiver clock drift (constant over seconds) drops out.
 //!
-//! It is armed only when the fixes show an acceleration of at least [`ARM_ACCEL_MPS2`]: a
+//! It is armed only when the fixes show an acceleration of at least [`ARM_ACCEL_MPS2`] (a
 //! receiver without one coasts as well on its loops' memories, and its results stay those of
-//! the loops alone.
+//! the loops alone) that is steady ([`MAX_ACCEL_CHANGE`]: not the onset or the end of a
+//! manoeuvre, which the model cannot foresee).
 
 use crate::pipeline::channels::visibility::predict;
-use gpsrx_core::PosVel;
+use gpsrx_core::{Polynomial, PosVel};
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::DopplerAid;
@@ -38,11 +39,19 @@ use std::collections::BTreeMap;
 pub const FIT_WINDOW_S: f64 = 0.5;
 /// Fewest fixes with a velocity in the window.
 pub const MIN_FIT_FIXES: usize = 3;
+/// Fewest fixes for a quadratic through the velocities (else a line), [`TurnMotion::fit`].
+pub const QUADRATIC_FIT_FIXES: usize = 5;
 /// The last fix must be at most this long before the collapse, s.
 pub const MAX_FIX_AGE_S: f64 = 0.5;
 /// Acceleration from which the bridge is armed, m/s^2 (a Doppler rate of 8 Hz/s: where the
 /// receiver counts as under dynamics, `crate::pipeline::channels::dynamics`).
 pub const ARM_ACCEL_MPS2: f64 = 1.5;
+/// Largest change of the acceleration's magnitude from the fit window's middle to its end, as
+/// a fraction of it, for which the bridge is armed: the turn model holds a steady manoeuvre;
+/// at the onset or the end of one (the simulator's 1 s ramp to 10 g changes it by 30 % over
+/// the last 0.25 s) the loops' own memories are fresher than fixes 0.1-0.2 s old (measured:
+/// 1 s of zeros at the end of a 10 g onset, bridged: worst fix 14.8 m; coasting: 9.0 m).
+pub const MAX_ACCEL_CHANGE: f64 = 0.2;
 /// Longest bridge from the collapse, s: a turn does not last for ever, and after the
 /// signal's return the loops hold the residual of a wrong prediction no worse than the
 /// dynamics themselves.
@@ -56,7 +65,7 @@ const RATE_STEP_S: f64 = 0.01;
 /// with a constant change of speed (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TurnMotion {
-    /// GPS time and stream time (s) of the fit's reference epoch (the fixes' mean time).
+    /// GPS time of the fit's reference epoch (the fixes' mean time).
     pub time: GpsTime,
     /// Stream time of the reference epoch, s.
     pub t_stream_s: f64,
@@ -68,6 +77,10 @@ pub struct TurnMotion {
     pub accel_mps2: Vector3<f64>,
     /// Receiver clock drift, s/s.
     pub drift_s_s: f64,
+    /// The change of the acceleration's magnitude over the fit window's second half, as a
+    /// fraction of its magnitude at the end (0 with too few fixes to tell): how steady the
+    /// manoeuvre was ([`MAX_ACCEL_CHANGE`]).
+    pub accel_change: f64,
 }
 
 /// One valid fix as the fit takes it.
@@ -87,10 +100,15 @@ pub struct FixPoint {
 
 impl TurnMotion {
     /// The least-squares line through the velocities of `fixes` (in time order): velocity
-    /// `v_c` (the mean's direction with the mean speed) and acceleration
-    /// `a = sum (t - t_c)(v - v_mean) / sum (t - t_c)^2` at their mean time `t_c`, the mean
-    /// position. None with fewer than [`MIN_FIT_FIXES`] or
-    /// spanning less than 0.1 s.
+    /// `v_c` (the mean's direction with the mean speed: the mean velocity on a turn's arc is a
+    /// chord) and acceleration `a = sum (t - t_c)(v - v_mean) / sum (t - t_c)^2` at their mean
+    /// time `t_c`, the mean position; and how steady the manoeuvre was: per axis the
+    /// least-squares quadratic through the velocities (`gpsrx_core::Polynomial`, with at least
+    /// [`QUADRATIC_FIT_FIXES`]), whose slopes at the window's middle and end give the change of
+    /// the acceleration's magnitude over its second half. (The line at the mean time, not the
+    /// quadratic at the end, carries the turn: on a steady 10 g turn it is 0.16 m/s off after
+    /// 1 s, the quadratic's slope at the end 0.35 m/s, and 1 s of zeros in the turn left a fix
+    /// 5.2 m off with it.) None with fewer than [`MIN_FIT_FIXES`] or spanning less than 0.1 s.
     pub fn fit(fixes: &[FixPoint]) -> Option<Self> {
         let n = fixes.len();
         let (first, last) = (fixes.first()?, fixes.last()?);
@@ -99,8 +117,6 @@ impl TurnMotion {
         }
         let nf = n as f64;
         let t_c = fixes.iter().map(|f| f.t_stream_s).sum::<f64>() / nf;
-        // The mean velocity is shorter than the velocities on a turn's arc (a chord): its
-        // direction, with their mean speed.
         let v_mean = fixes.iter().map(|f| f.vel_mps).sum::<Vector3<f64>>() / nf;
         let speed = fixes.iter().map(|f| f.vel_mps.norm()).sum::<f64>() / nf;
         let v_c = v_mean.try_normalize(1e-9).map_or(v_mean, |d| d * speed);
@@ -110,14 +126,14 @@ impl TurnMotion {
             .iter()
             .map(|f| (f.vel_mps - v_mean) * (f.t_stream_s - t_c))
             .sum();
-        let a = stv / stt;
         let m = Self {
             time: last.time.add_seconds(t_c - last.t_stream_s),
             t_stream_s: t_c,
             pos_m: p_c,
             vel_mps: v_c,
-            accel_mps2: a,
+            accel_mps2: stv / stt,
             drift_s_s: last.drift_s_s,
+            accel_change: accel_change(fixes)?,
         };
         (m.vel_mps
             .iter()
@@ -199,6 +215,14 @@ impl OutageBridge {
         if accel < ARM_ACCEL_MPS2 || ephemerides.is_empty() {
             return None;
         }
+        if motion.accel_change.abs() > MAX_ACCEL_CHANGE {
+            tracing::info!(
+                "{collapse_s:.3} s: every signal gone while the acceleration ({accel:.1} m/s^2) changes by {:.0} % over {:.2} s: no steady manoeuvre to carry on, the channels coast on their loops",
+                100.0 * motion.accel_change,
+                0.5 * FIT_WINDOW_S
+            );
+            return None;
+        }
         tracing::info!(
             "{collapse_s:.3} s: every signal gone under {accel:.1} m/s^2 ({:.0} m/s): the channels are aided by the motion of the last fixes (a turn at {:.2} rad/s) until a fix after the return, at most {MAX_BRIDGE_S} s",
             motion.vel_mps.norm(),
@@ -260,6 +284,29 @@ impl gpsrx_tracking::AidingPort for OutageBridge {
     }
 }
 
+/// `(|a(t_end)| - |a(t_mid)|) / |a(t_end)|` from per-axis quadratics through the velocities
+/// of `fixes` ([`TurnMotion::accel_change`]); 0 with fewer than [`QUADRATIC_FIT_FIXES`]. None
+/// when a fit fails.
+fn accel_change(fixes: &[FixPoint]) -> Option<f64> {
+    let (first, last) = (fixes.first()?, fixes.last()?);
+    if fixes.len() < QUADRATIC_FIT_FIXES {
+        return Some(0.0);
+    }
+    let t_mid = 0.5 * (first.t_stream_s + last.t_stream_s);
+    let (mut end, mut mid) = (Vector3::zeros(), Vector3::<f64>::zeros());
+    for axis in 0..3 {
+        let pts: Vec<(f64, f64)> = fixes
+            .iter()
+            .map(|f| (f.t_stream_s, f.vel_mps[axis]))
+            .collect();
+        let p = Polynomial::fit(&pts, 2)?;
+        end[axis] = p.slope_at(last.t_stream_s);
+        mid[axis] = p.slope_at(t_mid);
+    }
+    let e = end.norm();
+    Some(if e > 0.0 { (e - mid.norm()) / e } else { 0.0 })
+}
+
 /// The turn rate of the fitted motion, rad/s (0 below [`MIN_TURN_SPEED_MPS`]).
 fn turn_rate_rad_s(m: &TurnMotion) -> f64 {
     let speed = m.vel_mps.norm();
@@ -305,7 +352,7 @@ mod tests {
     }
 
     /// The 10 g turn at 250 m/s fitted from 0.5 s of fixes at 10 Hz and carried 1 s past the
-    /// last: the velocity within 0.3 m/s of the circle's (1.6 Hz of Doppler at most), where
+    /// last: the velocity within 0.3 m/s of the circle's (0.16 m/s, 0.8 Hz), where
     /// constant acceleration from the same fit is 25 m/s off and the velocity held 98 m/s.
     #[test]
     fn a_turn_is_carried_round_its_circle() {
@@ -329,6 +376,55 @@ mod tests {
             (straight - v_true).norm()
         );
         assert!((turn_rate_rad_s(&m) - 10.0 * g / 250.0).abs() < 1e-3);
+        assert!(
+            m.accel_change.abs() < 0.01,
+            "a steady turn: {}",
+            m.accel_change
+        );
+    }
+
+    /// The onset of a turn: the normal acceleration ramps from 0 to 10 g over 1 s (the
+    /// simulator's jerk-limited transition), the fixes of its last 0.5 s fitted. The turn
+    /// carried on from the window's middle (three quarters of the final rate) would be 25 m/s
+    /// off after a second of the full turn; the fit sees the acceleration grow by a quarter
+    /// over the window's second half, and the bridge is not armed.
+    #[test]
+    fn a_turn_fitted_in_its_onset_is_not_bridged() {
+        let (s, w_max) = (250.0, 10.0 * 9.80665 / 250.0);
+        // Heading: w(t) = w_max t for t in [0, 1], then w_max.
+        let heading = |t: f64| {
+            if t <= 1.0 {
+                0.5 * w_max * t * t
+            } else {
+                0.5 * w_max + w_max * (t - 1.0)
+            }
+        };
+        let (e, n) = (Vector3::new(0.0, 1.0, 0.0), Vector3::new(-0.6, 0.0, 0.8));
+        let vel = |t: f64| (e * heading(t).cos() + n * heading(t).sin()) * s;
+        let t0 = GpsTime::new(2190, 538_000.0);
+        let fixes: Vec<FixPoint> = (0..=5)
+            .map(|i| {
+                let t = 0.5 + 0.1 * i as f64;
+                FixPoint {
+                    t_stream_s: t,
+                    time: t0.add_seconds(t),
+                    pos_m: Vector3::new(3.822e6, 0.0, 5.096e6),
+                    vel_mps: vel(t),
+                    drift_s_s: 0.0,
+                }
+            })
+            .collect();
+        let m = TurnMotion::fit(&fixes).expect("fit");
+        let off = (m.at(2.0 - m.t_stream_s).vel_mps - vel(2.0)).norm();
+        assert!(off > 20.0, "{off:.2} m/s off after 1 s");
+        assert!((m.accel_change - 0.25).abs() < 0.05, "{}", m.accel_change);
+        let nav = gpsrx_nav::rinex_nav::parse_rinex_nav(include_str!(
+            "../../../../samples/data/brdc0010.22n"
+        ))
+        .expect("nav");
+        let ephs: BTreeMap<u8, Ephemeris> =
+            nav.ephemerides.iter().map(|e| (e.prn, e.clone())).collect();
+        assert!(OutageBridge::arm(1.05, &fixes, ephs).is_none());
     }
 
     /// Speeding up along a straight line: the speed grows by `a_t dt`, the direction holds.

@@ -14,8 +14,8 @@ mod feed_forward;
 mod monitor;
 
 pub use bridge::{
-    FixPoint, OutageBridge, TurnMotion, ARM_ACCEL_MPS2, FIT_WINDOW_S, MAX_BRIDGE_S, MAX_FIX_AGE_S,
-    MIN_FIT_FIXES, MIN_TURN_SPEED_MPS,
+    FixPoint, OutageBridge, TurnMotion, ARM_ACCEL_MPS2, FIT_WINDOW_S, MAX_ACCEL_CHANGE,
+    MAX_BRIDGE_S, MAX_FIX_AGE_S, MIN_FIT_FIXES, MIN_TURN_SPEED_MPS, QUADRATIC_FIT_FIXES,
 };
 pub use feed_forward::{InsFeedForward, DRIFT_SMOOTHING_S};
 pub use monitor::{AidMonitor, AidPermission, AidingStats, GatedAid};

@@ -90,13 +90,21 @@ struct Coast {
     last_ms: Option<u64>,
     /// In a break (its latest report was not usable).
     in_break: bool,
-    /// Some report of the break held a feed-forward.
-    aided: bool,
+    /// Stream time of the break's first report, s.
+    start_s: f64,
+    /// The loop's share of the NCO frequency (`doppler - feed-forward`) at the break's first
+    /// report with a feed-forward, Hz (None: none had one).
+    loop_share_hz: Option<f64>,
     /// Integration time of the break's reports without one, s (infinite: another channel).
     unaided_s: f64,
-    /// The last break was coasted with a feed-forward (decided at its end).
+    /// The last break was coasted with a feed-forward that held the signal (decided at its
+    /// end).
     coasted: bool,
 }
+
+/// Largest error of the range change a coasted channel's carrier may carry into the carrier
+/// smoothing, m (as the extrapolations of `crate::pipeline::navigation::smoothing`).
+const MAX_COAST_ERROR_M: f64 = 1.5;
 
 /// Builds observable epochs from channel reports.
 #[derive(Debug)]
@@ -272,17 +280,30 @@ impl ObservableBuilder {
 
     /// Follows whether `e`'s satellite coasted with a feed-forward over its last break in
     /// lock: every report in it was of the same channel (its `ms_count` grew), some held a
-    /// feed-forward, and those without one (before an outage bridge came on) span at most
-    /// [`MAX_UNAIDED_COAST_S`]. Returns that, from the first usable report after the break
-    /// until the next break.
+    /// feed-forward, those without one (before an outage bridge came on) span at most
+    /// [`MAX_UNAIDED_COAST_S`], and the feed-forward held the signal: the loop's share of the
+    /// NCO frequency (`doppler - feed-forward`) changed by `d` Hz from the break's first aided
+    /// report to the re-lock, which is what the feed-forward missed; a miss growing
+    /// linearly over the break of `T` s leaves `|d| T / 2` cycles in the carrier's range
+    /// change, which must be within [`MAX_COAST_ERROR_M`]. Returns that, from the first usable
+    /// report after the break (it must hold a feed-forward too) until the next break.
     fn note_coast(&mut self, e: &ChannelEpoch, usable: bool) -> bool {
-        let aided = e.feedforward_hz.is_some_and(f64::is_finite);
+        let ff = e.feedforward_hz.filter(|f| f.is_finite());
+        let t_s = e.sample_index as f64 / self.fs_hz;
         let c = self.coasts.entry(e.prn).or_default();
         let same = c.last_ms.is_none_or(|m| e.ms_count > m);
         c.last_ms = Some(e.ms_count);
         if usable {
             if c.in_break {
-                c.coasted = same && c.aided && c.unaided_s <= MAX_UNAIDED_COAST_S;
+                let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
+                let held = match (ff, c.loop_share_hz) {
+                    (Some(f), Some(start)) => {
+                        let missed_hz = (e.doppler_hz - f) - start;
+                        (missed_hz * (t_s - c.start_s) / 2.0).abs() * lambda <= MAX_COAST_ERROR_M
+                    }
+                    _ => false,
+                };
+                c.coasted = same && held && c.unaided_s <= MAX_UNAIDED_COAST_S;
                 c.in_break = false;
             }
             return c.coasted;
@@ -291,12 +312,15 @@ impl ObservableBuilder {
             *c = Coast {
                 last_ms: Some(e.ms_count),
                 in_break: true,
+                start_s: t_s,
                 ..Coast::default()
             };
         }
-        c.aided |= aided;
-        if !aided {
-            c.unaided_s += e.t_coh_s;
+        match ff {
+            Some(f) => {
+                c.loop_share_hz.get_or_insert(e.doppler_hz - f);
+            }
+            None => c.unaided_s += e.t_coh_s,
         }
         if !same {
             c.unaided_s = f64::INFINITY;
