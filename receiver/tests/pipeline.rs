@@ -881,3 +881,91 @@ fn cu8_recordings_held_as_ci16_give_the_fixes_of_the_f32_path() {
         );
     }
 }
+
+/// The simulator's samples with `[from, to)` zeroed: every signal gone at once.
+struct Zeroed<'a> {
+    inner: SimSource<'a>,
+    from: u64,
+    to: u64,
+}
+
+impl SampleSource for Zeroed<'_> {
+    fn fs_hz(&self) -> f64 {
+        self.inner.fs_hz()
+    }
+    fn format(&self) -> &SampleFormat {
+        self.inner.format()
+    }
+    fn total_samples(&self) -> Option<u64> {
+        self.inner.total_samples()
+    }
+    fn read(&mut self, out: &mut [Complex32]) -> Result<(u64, usize), SampleError> {
+        let (first, n) = self.inner.read(out)?;
+        for (i, s) in out[..n].iter_mut().enumerate() {
+            if (self.from..self.to).contains(&(first + i as u64)) {
+                *s = Complex32::new(0.0, 0.0);
+            }
+        }
+        Ok((first, n))
+    }
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+/// `Receiver::run` works a round of the channels while the navigation processor takes the
+/// reports of the round before, and works it again when the end of block asks for something
+/// (here the collapse of 2 s of zeros, the channels lost and the searches after it): the
+/// fixes, observables and events are those of the same run whose rounds wait for the
+/// navigation.
+#[test]
+fn a_run_whose_rounds_overlap_the_navigation_gives_what_waiting_rounds_give_through_an_outage() {
+    let sim = simulator(14.0);
+    // Outages starting at several phases of the 40 ms rounds and 0.1 s search ticks: the
+    // channels are lost, and searched again, in different rounds.
+    for start_s in [8.0, 8.025, 8.05, 8.075] {
+        overlapped_run_matches_waiting_run(&sim, start_s);
+    }
+}
+
+/// [`a_run_whose_rounds_overlap_the_navigation_gives_what_waiting_rounds_give_through_an_outage`]
+/// with 2 s of zeros from `start_s`.
+fn overlapped_run_matches_waiting_run(sim: &Simulator, start_s: f64) {
+    let fs = 2.048e6;
+    let run = |overlap: bool| {
+        let mut src = Zeroed {
+            inner: SimSource::new(sim),
+            from: (start_s * fs) as u64,
+            to: ((start_s + 2.0) * fs) as u64,
+        };
+        let mut rx = receiver(fs);
+        rx.set_overlap(overlap);
+        let mut sink = MemorySink::new();
+        let summary = rx
+            .run(&mut src, &mut sink)
+            .unwrap_or_else(|e| panic!("{e}"));
+        (summary, sink)
+    };
+    let (summary, by_run) = run(true);
+    let p = summary.profile;
+    assert!(p.overlapped_rounds > 200, "{p:?}");
+    assert!(p.redone_rounds >= 1, "no round worked again: {p:?}");
+    let (s, waiting) = run(false);
+    assert_eq!(s.profile.overlapped_rounds, 0);
+    let fixes = |s: &gpsrx_receiver::RunSummary| (s.fixes, s.invalid_fixes);
+    assert_eq!(fixes(&s), fixes(&summary), "outage from {start_s} s");
+    assert!(summary.fixes > 10, "{} fixes", summary.fixes);
+    for (a, b) in waiting.fixes.iter().zip(&by_run.fixes) {
+        let at = |f: &gpsrx_receiver::pipeline::FixReport| (f.fix.ecef_m, f.fix.time);
+        assert_eq!(at(a), at(b), "outage from {start_s} s");
+    }
+    assert_eq!(waiting.observables.len(), by_run.observables.len());
+    assert_eq!(waiting.events, by_run.events, "outage from {start_s} s");
+    // The outage was seen: channels lost and found again after it.
+    let acquired_after = by_run
+        .events
+        .iter()
+        .filter(|e| matches!(e, ReceiverEvent::Acquired { t_s, .. } if *t_s > start_s))
+        .count();
+    assert!(acquired_after > 0, "{:?}", by_run.events);
+}

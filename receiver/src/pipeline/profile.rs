@@ -4,12 +4,16 @@
 //! --profile` prints them).
 //!
 //! The stages follow the receiver's loop. Serial, on the calling thread, one after the other:
-//! the cold start's search, the parallel rounds, the navigation between rounds and the
-//! completion of the outputs at the end. Within a round the channels and a due search run side
-//! by side on the rayon pool ([`crate::pipeline::channels::channel_manager::ChannelManager::work`]);
-//! the next block of the source is read on the pool while the navigation runs
-//! ([`crate::pipeline::channels::ring::SampleWindow::read_during`]; before the cold start, and when the
-//! receiver is pushed samples, there is no such overlap). Each part is timed from its start to
+//! the cold start's search, the parallel rounds, the navigation and the completion of the
+//! outputs at the end. Within a round the channels and a due search run side by side on the
+//! rayon pool ([`crate::pipeline::channels::channel_manager::ChannelManager::work`]). Without
+//! an INS or vector tracking, the navigation of a round runs on the calling thread while the
+//! pool works the next round and reads the block after it (`Receiver::run`: a round is worked
+//! again when the navigation's end of block asks for something else); its time then counts as
+//! navigation and the rest of the round's as the round. Otherwise the navigation runs between
+//! the rounds, the next block read beside it
+//! ([`crate::pipeline::channels::ring::SampleWindow::read_during`]). Before the cold start, and
+//! when the receiver is pushed samples, nothing overlaps. Each part is timed from its start to
 //! its end on its own, so parts that overlap can add up to more than their stage, and each
 //! includes the time its own parallel parts waited for a thread.
 
@@ -32,10 +36,15 @@ pub struct StageTimes {
     pub searches: usize,
     /// Reading the source (and converting it): beside the navigation, s.
     pub read_s: f64,
-    /// Between the rounds: the channels' reports to the navigation processor (observables,
-    /// fixes, rows written to the sink) while the next block is read, the channels started
-    /// by a search, the samples dropped, s.
+    /// The channels' reports to the navigation processor (observables, fixes, rows written to
+    /// the sink), beside the next round or, between the rounds, while the next block is read;
+    /// the channels started by a search, the samples dropped, s.
     pub navigation_s: f64,
+    /// Rounds worked while the navigation processor took the reports of the round before.
+    pub overlapped_rounds: usize,
+    /// Of those, rounds worked again because the navigation's end of block asked for
+    /// something else (an event, another search).
+    pub redone_rounds: usize,
     /// At the end: the sink completing its outputs (plots, files), s.
     pub finish_s: f64,
 }

@@ -5,13 +5,18 @@
 //! the code periods the window holds while a due re-acquisition search runs beside them, and
 //! each report goes to the [`NavigationProcessor`], which hands observables, fixes and events to
 //! the [`Sink`]. The processing is cut into the same 40 ms blocks whatever the caller's block
-//! size, so [`Receiver::push`] in any chunking gives what [`Receiver::run`] gives.
+//! size, so [`Receiver::push`] in any chunking gives what [`Receiver::run`] gives. (`run`,
+//! without an INS or vector tracking, also works a round of the channels while the navigation
+//! takes the reports of the round before, and works it again when the navigation's end of
+//! block asks for something else: [`overlap`].)
 
 use crate::config::ReceiverConfig;
 use crate::landmarks::LandmarkObservation;
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::aiding::{AidMonitor, AidingStats, GatedAid, OutageBridge};
-use crate::pipeline::channels::channel_manager::{ChannelManager, ColdStartError, SearchSettings};
+use crate::pipeline::channels::channel_manager::{
+    drain_in_stream_order, ChannelManager, ColdStartError, SearchSettings,
+};
 use crate::pipeline::channels::ring::{block_samples, SampleWindow};
 use crate::pipeline::channels::search_schedule::SearchBudget;
 use crate::pipeline::navigation::NavigationProcessor;
@@ -27,9 +32,11 @@ use gpsrx_ins_aiding::InsTrack;
 use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_samples::sigmf::RecordingStart;
 use gpsrx_samples::{SampleError, SampleSource};
-use gpsrx_tracking::{AidingPort, TrackingMode};
+use gpsrx_tracking::{AidingPort, ChannelEpoch, TrackingMode};
 use num_complex::Complex32;
 use std::path::Path;
+
+mod overlap;
 
 /// Why the receiver stopped.
 #[derive(Debug, thiserror::Error)]
@@ -274,6 +281,11 @@ pub struct Receiver {
     /// The serial stages' wall time so far (the rounds' parts come from the window and the
     /// channel manager).
     stages: StageTimes,
+    /// Per channel, the reports of a round the navigation processor takes while the channels
+    /// work on the next ([`overlap`]).
+    spare_reports: Vec<Vec<ChannelEpoch>>,
+    /// [`Receiver::run`] may work a round beside the navigation of the round before.
+    overlap: bool,
     finished: bool,
     non_finite_said: bool,
 }
@@ -382,6 +394,8 @@ impl Receiver {
             first_sample: None,
             started: std::time::Instant::now(),
             stages: StageTimes::default(),
+            spare_reports: Vec::new(),
+            overlap: true,
             finished: false,
             non_finite_said: false,
         })
@@ -416,6 +430,13 @@ impl Receiver {
     /// The integrity monitor of the INS aiding (idle without an INS).
     pub fn aid_monitor(&self) -> &AidMonitor {
         &self.monitor
+    }
+
+    /// Whether [`Receiver::run`] may work a round of the channels while the navigation
+    /// processor takes the reports of the round before (default: yes; the outputs are the
+    /// same either way, only the wall time differs: see [`overlap`]).
+    pub fn set_overlap(&mut self, overlap: bool) {
+        self.overlap = overlap;
     }
 
     /// The INS feed-forward, when the receiver is aided.
@@ -467,6 +488,12 @@ impl Receiver {
                 let end = self.window.end();
                 self.catch_up(end.saturating_sub(1), sink)?;
             }
+        }
+        // Without an INS or vector tracking nothing of a round waits for the navigation of
+        // the round before, unless that asks for something: the two run side by side.
+        if self.overlap && self.aiding.is_none() && self.vector.is_none() {
+            self.run_rounds_overlapped(source, sink)?;
+            return self.finish(sink);
         }
         // Every block: the channels (and a due search) work on the samples held, on the pool;
         // then their reports go to the navigation processor while the next block is read
@@ -676,7 +703,7 @@ impl Receiver {
         let t0 = std::time::Instant::now();
         let reports = ReportsOut {
             nav: &mut self.nav,
-            manager: &mut self.manager,
+            reports: self.manager.reports_mut(),
             aiding: self.aiding.as_ref(),
             monitor: &mut self.monitor,
             vector: self.vector.as_mut(),
@@ -696,7 +723,7 @@ impl Receiver {
     fn reports_out(&mut self) -> ReportsOut<'_> {
         ReportsOut {
             nav: &mut self.nav,
-            manager: &mut self.manager,
+            reports: self.manager.reports_mut(),
             aiding: self.aiding.as_ref(),
             monitor: &mut self.monitor,
             vector: self.vector.as_mut(),
@@ -713,7 +740,20 @@ impl Receiver {
         end: u64,
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
-        match self.nav.end_block(end, sink).map_err(ReceiverError::Sink)? {
+        let event = self.nav.end_block(end, sink).map_err(ReceiverError::Sink)?;
+        self.after_end_block(event, found, end, sink)
+    }
+
+    /// [`Receiver::end_round`] after the navigation processor's end of block, which gave
+    /// `event`.
+    fn after_end_block(
+        &mut self,
+        event: Option<BlockEvent>,
+        found: Option<crate::pipeline::channels::channel_manager::SearchOutcome>,
+        end: u64,
+        sink: &mut dyn Sink,
+    ) -> Result<(), ReceiverError> {
+        match event {
             Some(BlockEvent::PhaseJump(_)) => self.manager.restart_bit_sync(),
             Some(BlockEvent::Collapse(c)) => {
                 self.manager.request_realignment(&c);
@@ -823,7 +863,8 @@ fn done_span(
 /// (with an INS) and the channel manager that holds them.
 struct ReportsOut<'a> {
     nav: &'a mut NavigationProcessor,
-    manager: &'a mut ChannelManager,
+    /// The round's reports, per channel (cleared once passed).
+    reports: &'a mut [Vec<ChannelEpoch>],
     aiding: Option<&'a InsFeedForward>,
     monitor: &'a mut AidMonitor,
     /// Vector tracking, which takes the round's observables and fixes.
@@ -838,7 +879,7 @@ impl ReportsOut<'_> {
     fn pass(self, sink: &mut dyn Sink) -> Result<(), ReceiverError> {
         let Self {
             nav,
-            manager,
+            reports,
             aiding,
             monitor,
             vector,
@@ -847,22 +888,21 @@ impl ReportsOut<'_> {
         let predict = |prn: u8, t: f64| aiding.and_then(|ff| ff.predicted_doppler_hz(prn, t));
         let mut captured: Vec<Captured> = Vec::new();
         let tapping = vector.is_some();
-        manager
-            .drain_reports(|i, e| {
-                if aiding.is_some() {
-                    monitor.observe(i, e, &predict);
-                }
-                if tapping {
-                    let mut tap = Tap {
-                        inner: &mut *sink,
-                        captured: &mut captured,
-                    };
-                    nav.on_report(i, e, aiding, &mut tap)
-                } else {
-                    nav.on_report(i, e, aiding, sink)
-                }
-            })
-            .map_err(ReceiverError::Sink)?;
+        drain_in_stream_order(reports, |i, e| {
+            if aiding.is_some() {
+                monitor.observe(i, e, &predict);
+            }
+            if tapping {
+                let mut tap = Tap {
+                    inner: &mut *sink,
+                    captured: &mut captured,
+                };
+                nav.on_report(i, e, aiding, &mut tap)
+            } else {
+                nav.on_report(i, e, aiding, sink)
+            }
+        })
+        .map_err(ReceiverError::Sink)?;
         if let Some(v) = vector {
             v.take(captured, nav);
         }

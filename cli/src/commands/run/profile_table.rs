@@ -65,10 +65,11 @@ pub fn write_profile(
         &format!("  - background search ({} searches)", p.searches),
         p.search_s,
     )?;
-    row(
+    row(out, "navigation (observables, fixes, rows)", p.navigation_s)?;
+    writeln!(
         out,
-        "navigation between rounds (observables, fixes, rows)",
-        p.navigation_s,
+        "    - beside the next round in {} rounds ({} worked again)",
+        p.overlapped_rounds, p.redone_rounds
     )?;
     row(out, "  - reading the next block, beside it", p.read_s)?;
     row(out, "outputs at the end (plots, files)", p.finish_s)?;
@@ -98,6 +99,8 @@ mod tests {
             read_s: 0.1,
             navigation_s: 0.3,
             finish_s: 0.05,
+            overlapped_rounds: 1490,
+            redone_rounds: 3,
         };
         let mut out = Vec::new();
         write_profile(&mut out, &p, 60.0, 2.0, Some((3.0, 44.5))).unwrap_or_else(|e| panic!("{e}"));
@@ -115,6 +118,10 @@ mod tests {
         );
         assert!(line("4 searches").ends_with("0.600      30.0 %"), "{text}");
         assert!(line("navigation").ends_with("0.300      15.0 %"), "{text}");
+        assert!(
+            line("beside the next round").ends_with("in 1490 rounds (3 worked again)"),
+            "{text}"
+        );
         // 2.0 - (0.05 + 1.5 + 0.3 + 0.05) s of setup.
         assert!(line("other").ends_with("0.100       5.0 %"), "{text}");
     }

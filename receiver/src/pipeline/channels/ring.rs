@@ -413,15 +413,21 @@ impl SampleWindow {
         let (read, r) = match &mut self.store {
             Store::Cf32(b) => {
                 let room = b.split(n).1;
-                beside(|| src.read(room), f)
+                beside(|| timed(|| src.read(room)), f)
             }
             Store::Ci8(b) => {
                 let room = b.split(n).1;
-                beside(|| src.read_integer(IntegerSamplesMut::Ci8(room)), f)
+                beside(
+                    || timed(|| src.read_integer(IntegerSamplesMut::Ci8(room))),
+                    f,
+                )
             }
             Store::Ci16(b) => {
                 let room = b.split(n).1;
-                beside(|| src.read_integer(IntegerSamplesMut::Ci16(room)), f)
+                beside(
+                    || timed(|| src.read_integer(IntegerSamplesMut::Ci16(room))),
+                    f,
+                )
             }
         };
         Ok((self.take_read(read)?, r))
@@ -453,20 +459,20 @@ impl SampleWindow {
     }
 }
 
-/// Runs `read` on the rayon pool (timed) while `f` runs on the calling thread; returns both
-/// results when both are done.
-fn beside<T: Send, R>(
-    read: impl FnOnce() -> T + Send,
-    f: impl FnOnce() -> R,
-) -> ((T, Duration), R) {
+/// Runs `pool` on the rayon pool while `here` runs on the calling thread (which need not be
+/// `Send`); returns both results when both are done.
+pub(crate) fn beside<T: Send, R>(
+    pool: impl FnOnce() -> T + Send,
+    here: impl FnOnce() -> R,
+) -> (T, R) {
     let mut out = None;
     let r = rayon::in_place_scope(|scope| {
-        scope.spawn(|_| out = Some(timed(read)));
-        f()
+        scope.spawn(|_| out = Some(pool()));
+        here()
     });
-    // The scope returns once the spawned read has run (a panic in it is resumed here).
-    let read = out.expect("the scope waits for its spawned read");
-    (read, r)
+    // The scope returns once the spawned job has run (a panic in it is resumed here).
+    let pooled = out.expect("the scope waits for its spawned job");
+    (pooled, r)
 }
 
 #[cfg(test)]

@@ -181,7 +181,7 @@ pub enum Visibility {
 }
 
 /// A search the channel manager is to run: the level's engine, its samples and targets.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Batch {
     /// Index of the engine (0: the configured search, then [`LEVELS`]).
     pub level: usize,

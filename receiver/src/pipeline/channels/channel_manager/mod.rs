@@ -15,6 +15,7 @@
 //! - Work: every channel processes the code periods the sample window holds, in parallel
 //!   (rayon), concurrently with a due search (rayon `join`).
 
+mod overlap;
 pub mod realign;
 
 pub use realign::{RealignSearch, Realigned};
@@ -89,7 +90,7 @@ pub struct SearchSettings {
 
 /// A search due in this block: its first sample and its targets, and what it is for (a
 /// scheduled batch, or a code realignment).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct DueSearch {
     first: u64,
     /// Samples read from `first`.
@@ -332,22 +333,33 @@ impl ChannelManager {
             return Some(due);
         }
         let mut schedule = self.schedule.take()?;
-        let span = window.end() - window.start();
-        let batch = schedule.due(
+        let due = self.scheduled(
+            &mut schedule,
             window.end(),
-            span,
-            &self.engines,
-            &|p| self.liveness(p),
+            window.end() - window.start(),
             visibility,
         );
         self.schedule = Some(schedule);
-        let batch = batch?;
+        let due = due?;
         tracing::debug!(
             "search at sample {}: level {}, {} PRN(s)",
             window.end(),
-            batch.level,
-            batch.targets.len()
+            due.batch.as_ref().map_or(0, |b| b.level),
+            due.targets.len()
         );
+        Some(due)
+    }
+
+    /// The background search's next batch from `schedule`, with the window ending at sample
+    /// `end` and holding `span` samples.
+    fn scheduled(
+        &self,
+        schedule: &mut Scheduler,
+        end: u64,
+        span: u64,
+        visibility: &dyn Fn(Prn) -> Visibility,
+    ) -> Option<DueSearch> {
+        let batch = schedule.due(end, span, &self.engines, &|p| self.liveness(p), visibility)?;
         Some(DueSearch {
             first: batch.first,
             len: batch.len,
@@ -444,25 +456,9 @@ impl ChannelManager {
     /// when `f` fails (its error is returned).
     pub fn drain_reports<E>(
         &mut self,
-        mut f: impl FnMut(usize, &ChannelEpoch) -> Result<(), E>,
+        f: impl FnMut(usize, &ChannelEpoch) -> Result<(), E>,
     ) -> Result<(), E> {
-        let mut order: Vec<(u64, usize, usize)> = self
-            .reports
-            .iter()
-            .enumerate()
-            .flat_map(|(i, r)| {
-                r.iter()
-                    .enumerate()
-                    .map(move |(j, e)| (e.sample_index, i, j))
-            })
-            .collect();
-        order.sort_unstable();
-        let reports = &self.reports;
-        let result = order.iter().try_for_each(|&(_, i, j)| f(i, &reports[i][j]));
-        for r in &mut self.reports {
-            r.clear();
-        }
-        result
+        drain_in_stream_order(&mut self.reports, f)
     }
 
     /// Whether detection `d` sits at the Doppler of a much stronger live channel modulo 1 kHz
@@ -691,4 +687,28 @@ fn run_channel(
             None => break,
         }
     }
+}
+
+/// Hands `reports` (per channel, as [`ChannelManager::work`] leaves them) to `f` as `(channel
+/// index, report)` in stream order (see [`ChannelManager::drain_reports`]) and clears them,
+/// also when `f` fails (its error is returned).
+pub fn drain_in_stream_order<E>(
+    reports: &mut [Vec<ChannelEpoch>],
+    mut f: impl FnMut(usize, &ChannelEpoch) -> Result<(), E>,
+) -> Result<(), E> {
+    let mut order: Vec<(u64, usize, usize)> = reports
+        .iter()
+        .enumerate()
+        .flat_map(|(i, r)| {
+            r.iter()
+                .enumerate()
+                .map(move |(j, e)| (e.sample_index, i, j))
+        })
+        .collect();
+    order.sort_unstable();
+    let result = order.iter().try_for_each(|&(_, i, j)| f(i, &reports[i][j]));
+    for r in reports.iter_mut() {
+        r.clear();
+    }
+    result
 }
