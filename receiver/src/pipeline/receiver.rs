@@ -8,7 +8,7 @@
 //! size, so [`Receiver::push`] in any chunking gives what [`Receiver::run`] gives. (`run`,
 //! without an INS or vector tracking, also works a round of the channels while the navigation
 //! takes the reports of the round before, and works it again when the navigation's end of
-//! block asks for something else: [`overlap`].)
+//! block asks for something else: `receiver::overlap`.)
 
 use crate::config::ReceiverConfig;
 use crate::landmarks::LandmarkObservation;
@@ -282,7 +282,7 @@ pub struct Receiver {
     /// channel manager).
     stages: StageTimes,
     /// Per channel, the reports of a round the navigation processor takes while the channels
-    /// work on the next ([`overlap`]).
+    /// work on the next (`receiver::overlap`).
     spare_reports: Vec<Vec<ChannelEpoch>>,
     /// [`Receiver::run`] may work a round beside the navigation of the round before.
     overlap: bool,
@@ -434,7 +434,7 @@ impl Receiver {
 
     /// Whether [`Receiver::run`] may work a round of the channels while the navigation
     /// processor takes the reports of the round before (default: yes; the outputs are the
-    /// same either way, only the wall time differs: see [`overlap`]).
+    /// same either way, only the wall time differs: see `receiver::overlap`).
     pub fn set_overlap(&mut self, overlap: bool) {
         self.overlap = overlap;
     }
