@@ -12,6 +12,11 @@ use std::path::Path;
 
 /// A static receiver near Daejeon, 2.048 MHz, the built-in broadcast ephemerides.
 pub(crate) fn simulator(duration_s: f64) -> Simulator {
+    simulator_with(duration_s, "")
+}
+
+/// [`simulator`] with more of the scenario (`extra`: TOML tables such as `[[outages]]`).
+pub(crate) fn simulator_with(duration_s: f64, extra: &str) -> Simulator {
     let text = format!(
         r#"
 duration_s = {duration_s}
@@ -29,6 +34,7 @@ llh_deg = [36.3721, 127.3604, 80.0]
 [clock]
 bias_s = 3.0e-4
 drift_s_s = 4.0e-8
+{extra}
 "#
     );
     let sc = Scenario::from_toml(&text).unwrap_or_else(|e| panic!("{e}"));
@@ -882,37 +888,6 @@ fn cu8_recordings_held_as_ci16_give_the_fixes_of_the_f32_path() {
     }
 }
 
-/// The simulator's samples with `[from, to)` zeroed: every signal gone at once.
-struct Zeroed<'a> {
-    inner: SimSource<'a>,
-    from: u64,
-    to: u64,
-}
-
-impl SampleSource for Zeroed<'_> {
-    fn fs_hz(&self) -> f64 {
-        self.inner.fs_hz()
-    }
-    fn format(&self) -> &SampleFormat {
-        self.inner.format()
-    }
-    fn total_samples(&self) -> Option<u64> {
-        self.inner.total_samples()
-    }
-    fn read(&mut self, out: &mut [Complex32]) -> Result<(u64, usize), SampleError> {
-        let (first, n) = self.inner.read(out)?;
-        for (i, s) in out[..n].iter_mut().enumerate() {
-            if (self.from..self.to).contains(&(first + i as u64)) {
-                *s = Complex32::new(0.0, 0.0);
-            }
-        }
-        Ok((first, n))
-    }
-    fn warnings(&self) -> Vec<String> {
-        Vec::new()
-    }
-}
-
 /// `Receiver::run` works a round of the channels while the navigation processor takes the
 /// reports of the round before, and works it again when the end of block asks for something
 /// (here the collapse of 2 s of zeros, the channels lost and the searches after it): the
@@ -920,29 +895,28 @@ impl SampleSource for Zeroed<'_> {
 /// navigation.
 #[test]
 fn a_run_whose_rounds_overlap_the_navigation_gives_what_waiting_rounds_give_through_an_outage() {
-    let sim = simulator(14.0);
     // Outages starting at several phases of the 40 ms rounds and 0.1 s search ticks: the
     // channels are lost, and searched again, in different rounds.
     for start_s in [8.0, 8.025, 8.05, 8.075] {
-        overlapped_run_matches_waiting_run(&sim, start_s);
+        overlapped_run_matches_waiting_run(start_s);
     }
 }
 
 /// [`a_run_whose_rounds_overlap_the_navigation_gives_what_waiting_rounds_give_through_an_outage`]
-/// with 2 s of zeros from `start_s`.
-fn overlapped_run_matches_waiting_run(sim: &Simulator, start_s: f64) {
+/// with every signal blocked for 2 s from `start_s`.
+fn overlapped_run_matches_waiting_run(start_s: f64) {
     let fs = 2.048e6;
+    let outage = format!(
+        "[[outages]]\nstart_s = {start_s}\nend_s = {}\n",
+        start_s + 2.0
+    );
+    let sim = simulator_with(14.0, &outage);
     let run = |overlap: bool| {
-        let mut src = Zeroed {
-            inner: SimSource::new(sim),
-            from: (start_s * fs) as u64,
-            to: ((start_s + 2.0) * fs) as u64,
-        };
         let mut rx = receiver(fs);
         rx.set_overlap(overlap);
         let mut sink = MemorySink::new();
         let summary = rx
-            .run(&mut src, &mut sink)
+            .run(&mut SimSource::new(&sim), &mut sink)
             .unwrap_or_else(|e| panic!("{e}"));
         (summary, sink)
     };
