@@ -5,10 +5,14 @@
 //! the code periods the window holds while a due re-acquisition search runs beside them, and
 //! each report goes to the [`NavigationProcessor`], which hands observables, fixes and events to
 //! the [`Sink`]. The processing is cut into the same 40 ms blocks whatever the caller's block
-//! size, so [`Receiver::push`] in any chunking gives what [`Receiver::run`] gives. (`run`,
-//! without an INS or vector tracking, also works a round of the channels while the navigation
-//! takes the reports of the round before, and works it again when the navigation's end of
-//! block asks for something else: `receiver::overlap`.)
+//! size, so [`Receiver::push`] in any chunking gives what [`Receiver::run`] gives on a stream
+//! the signal never leaves (`receiver/tests/pipeline.rs`). Through an outage they can differ
+//! slightly: `run` hands the navigation's end of block the end of the samples read (one block
+//! ahead of the channels), `push` the end of the block processed, so a collapse may be acted
+//! on one block apart (a fix 4 cm apart after 2 s of blocked signal in that test's scenario).
+//! (`run`, without an INS or vector tracking, also works a round of the channels while the
+//! navigation takes the reports of the round before, and works it again when the
+//! navigation's end of block asks for something else: `receiver::overlap`.)
 
 use crate::config::ReceiverConfig;
 use crate::landmarks::LandmarkObservation;
