@@ -505,19 +505,7 @@ impl Receiver {
         // behind them (the channels have two threads; the read hides behind the navigation,
         // which runs on this thread alone).
         loop {
-            let view = self.window.view();
-            let (nav, fs) = (&self.nav, self.fs_hz);
-            let t_s = view.end() as f64 / fs;
-            let due = self
-                .manager
-                .due_search(view, &|p| nav.visibility(p.get(), t_s));
-            let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
-            let bridge = self.bridge.as_ref().map(|(b, _)| b);
-            let aid = round_aid(gated.as_ref(), self.vector.as_ref(), bridge);
-            let manager = &mut self.manager;
-            let end = view.end();
-            let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
-            self.processed_to = Some(end);
+            let found = self.work_until(self.window.end());
             if self.deliver_while_reading(found, source, sink)? == 0 {
                 break;
             }
@@ -655,6 +643,16 @@ impl Receiver {
 
     /// One block: the channels process the samples before `limit`, with a due search beside.
     fn step(&mut self, limit: u64, sink: &mut dyn Sink) -> Result<(), ReceiverError> {
+        let found = self.work_until(limit);
+        self.timed_deliver(found, limit, sink)
+    }
+
+    /// The channels (and the search due now) on the samples held before `limit`, with the
+    /// aid of this round; returns what the search found.
+    fn work_until(
+        &mut self,
+        limit: u64,
+    ) -> Option<crate::pipeline::channels::channel_manager::SearchOutcome> {
         let view = self.window.view().until(limit);
         let (nav, t_s) = (&self.nav, limit as f64 / self.fs_hz);
         let due = self
@@ -666,7 +664,7 @@ impl Receiver {
         let manager = &mut self.manager;
         let found = add_timed(&mut self.stages.rounds_s, || manager.work(view, due, aid));
         self.processed_to = Some(limit);
-        self.timed_deliver(found, limit, sink)
+        found
     }
 
     /// [`Receiver::deliver`], its wall time added to the navigation stage.

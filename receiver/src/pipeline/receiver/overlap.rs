@@ -141,13 +141,6 @@ impl Receiver {
         self.stages.redone_rounds += 1;
         self.manager.restore(kept);
         self.after_end_block(event, None, end, sink)?;
-        let (nav, view) = (&self.nav, self.window.view().until(end));
-        let due = self
-            .manager
-            .due_search(view, &|p| nav.visibility(p.get(), t_s));
-        let aid = round_aid(None, None, self.bridge.as_ref().map(|(b, _)| b));
-        let found = self.manager.work(view, due, aid);
-        self.processed_to = Some(end);
-        Ok((got, found))
+        Ok((got, self.work_until(end)))
     }
 }
