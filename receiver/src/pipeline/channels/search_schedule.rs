@@ -103,17 +103,22 @@ pub const PENDING_WAIT_S: f64 = 1.0;
 pub const TICK_S: f64 = 0.1;
 /// Modelled CPU time of a search per sample, Doppler bin and pass, s, for 1 ms coherent
 /// blocks, and divided by the coherent milliseconds for longer ones: the inverse FFTs, one per
-/// block, bin and PRN. Measured as process CPU time (every thread of the pool) per PRN over
-/// +-5 kHz on the 2-core AMD EPYC development machine, on 8-bit noise held as ci8
-/// (`cargo bench -p gpsrx-benches --bench search_cost`): 1 ms x 10 1.7 ms at 4 MHz, 10 ms x 13
-/// 13 ms at 2.6 and 21 ms at 4 MHz, 10 ms x 50 45 ms and 72 ms.
-pub const COST_S_PER_SAMPLE_BIN: f64 = 1.9e-9;
+/// block, bin and PRN. Fitted with [`COST_S_PER_SAMPLE_FFT`] to the process CPU time (every
+/// thread of the pool) of batches of 1 and 8 PRNs over +-5 kHz at every level at 2.6 and
+/// 4 MHz, on 8-bit noise held as ci8 (`cargo bench -p gpsrx-benches --bench search_cost`), on
+/// the 2-core Intel Xeon (AVX-512) the project is measured on: within 14 % on all 12 (1 ms x 10
+/// 2.1 ms per PRN at 4 MHz, 10 ms x 13 17 ms at 2.6 and 26 ms at 4 MHz, 10 ms x 50 65 ms and
+/// 100 ms). It was fitted to PRNs searched alone on the AMD EPYC of earlier sessions (1.9e-9),
+/// which made a batch of 8 on the Xeon 1.2-1.3 times its model.
+pub const COST_S_PER_SAMPLE_BIN: f64 = 2.5e-9;
 /// Modelled CPU time of the block spectra of a search (the forward FFTs every search makes
 /// whatever its targets, with the allocation of the spectra), s per sample and pass (10 ms x
-/// 50: about 34 ms at 2.6 MHz, 56 ms at 4 MHz; see [`COST_S_PER_SAMPLE_BIN`]).
-pub const COST_S_PER_SAMPLE_FFT: f64 = 2.7e-8;
-/// Largest modelled cost of one batch, s (a block waits for its search).
-pub const MAX_BATCH_S: f64 = 0.5;
+/// 50: about 26 ms at 2.6 MHz, 40 ms at 4 MHz; see [`COST_S_PER_SAMPLE_BIN`]; 2.7e-8 on the
+/// AMD).
+pub const COST_S_PER_SAMPLE_FFT: f64 = 2.0e-8;
+/// Largest modelled cost of one batch, s (a block waits for its search; 0.5 s under the
+/// model fitted on the AMD, the same batches).
+pub const MAX_BATCH_S: f64 = 0.65;
 /// A charged batch waits until the budget can pay for this many of its level's due PRNs
 /// (or all of them when fewer are due), so the block spectra every batch computes are
 /// shared: the forward FFTs re-used across PRNs.
@@ -121,8 +126,26 @@ pub const MIN_BATCH_PRNS: usize = 4;
 
 /// Capacity of the bucket, CPU s: a first round of searches at the start (every PRN up to
 /// 10 ms x 13, most of them 10 ms x 50, at 2.6-4 MHz). It was 2 s with the two-pass levels,
-/// whose searches cost 1/0.62 as much: the same round at the same sensitivity.
-pub const BURST_S: f64 = 1.25;
+/// whose searches cost 1/0.62 as much: the same round at the same sensitivity; then 1.25 s
+/// under the cost model fitted on the AMD, which the Xeon's costs (the model now) make 1.6 s.
+pub const BURST_S: f64 = 1.6;
+
+/// Satellites tracked from which the first most sensitive search of a PRN nothing is
+/// predicted of waits [`DEEP_WAIT_S`], as its later ones do, instead of following its
+/// 10 ms x 13 search at once (the cheap search goes on every [`UNKNOWN_WAIT_S`]).
+///
+/// That search (10 ms x 50) costs about four times the one before it (10 ms x 13, about
+/// 31 dB-Hz), and a first round of it over the 20-odd PRNs that are not above the horizon is
+/// most of a default run's CPU (a 60 s recording at 4 MHz with 12 satellites: 1.1 of the
+/// 1.55 CPU s its searches were modelled to spend). With eight satellites tracked the
+/// receiver fixes with margin for fault exclusion (which needs six) and a PDOP that a ninth
+/// improves little; meanwhile the almanac the satellites send (a PRN per 30 s frame) and the
+/// ephemerides predict which PRNs are up ([`Visibility`]): those are searched in their
+/// predicted window at every level at once, the others not at all. The cost: a satellite at
+/// 25-31 dB-Hz beside eight stronger ones, and not yet predicted, is found minutes later
+/// instead of in the first second. A receiver tracking fewer (weak signals everywhere:
+/// foliage, indoors), `--nav`, and satellites just lost are not affected.
+pub const DEFER_DEEP_FROM_TRACKED: usize = 8;
 
 /// The default refill, CPU s per second of signal: half a percent of a core. Once the first
 /// round is done it pays for the cheap search of about 20 absent PRNs every
@@ -447,13 +470,15 @@ impl Scheduler {
     }
 
     /// Takes the results of `batch`, searched at sample `now`, with `visibility` as in
-    /// [`Scheduler::due`]: a PRN not found searches harder next time, or waits once the
-    /// hardest search failed.
+    /// [`Scheduler::due`] and `tracked` satellites tracked (those found by the batch
+    /// included): a PRN not found searches harder next time, or waits once the hardest search
+    /// failed (or before its first one, see [`DEFER_DEEP_FROM_TRACKED`]).
     pub fn record(
         &mut self,
         batch: &Batch,
         results: &[AcqResult],
         now: u64,
+        tracked: usize,
         visibility: &dyn Fn(Prn) -> Visibility,
     ) {
         let max_level = LEVELS.len();
@@ -466,6 +491,15 @@ impl Scheduler {
             }
             let hot = batch.hot.get(i).copied().unwrap_or(false);
             let predicted = matches!(visibility(t.prn), Visibility::Visible { .. });
+            if !hot
+                && !predicted
+                && batch.level + 1 == max_level
+                && s.deep_not_before == 0
+                && tracked >= DEFER_DEEP_FROM_TRACKED
+            {
+                // Its first deepest search waits, as its later ones do.
+                s.deep_not_before = now + (DEEP_WAIT_S * self.fs_hz) as u64;
+            }
             let wait_s = if hot {
                 hot_interval_s(batch.level)
             } else if batch.level < max_level && (predicted || now >= s.deep_not_before) {
@@ -579,6 +613,17 @@ mod tests {
         budget: SearchBudget,
         wanted: &[Prn],
     ) -> Vec<Vec<(usize, u64)>> {
+        run_tracking(seconds, vis, budget, wanted, 0)
+    }
+
+    /// [`run_for`] with `tracked` satellites tracked (PRNs not wanted).
+    fn run_tracking(
+        seconds: f64,
+        vis: &dyn Fn(Prn) -> Visibility,
+        budget: SearchBudget,
+        wanted: &[Prn],
+        tracked: usize,
+    ) -> Vec<Vec<(usize, u64)>> {
         let engines = engines();
         let mut s = Scheduler::new(FS, budget, 1e-3, wanted, 0);
         let mut log = vec![Vec::new(); 32];
@@ -594,11 +639,53 @@ mod tests {
                 }
                 let results: Vec<AcqResult> =
                     b.targets.iter().map(|t| result(t.prn, false)).collect();
-                s.record(&b, &results, now, vis);
+                s.record(&b, &results, now, tracked, vis);
             }
             now += block;
         }
         log
+    }
+
+    #[test]
+    fn beside_eight_tracked_satellites_the_first_deep_search_of_an_unknown_prn_waits() {
+        // PRNs 9-12 nothing is known of, 13 predicted visible; 8 (then 7) satellites tracked.
+        let wanted: Vec<Prn> = (9..=13).filter_map(|p| Prn::new(p).ok()).collect();
+        let vis = |p: Prn| {
+            if p.get() == 13 {
+                Visibility::Visible {
+                    doppler_hz: 1000.0,
+                    half_width_hz: 300.0,
+                }
+            } else {
+                Visibility::Unknown
+            }
+        };
+        let seconds = 1.2 * DEEP_WAIT_S;
+        let budget = SearchBudget::per_signal(1.0);
+        let log = run_tracking(seconds, &vis, budget, &wanted, DEFER_DEEP_FROM_TRACKED);
+        for (i, l) in log.iter().enumerate().skip(8).take(4) {
+            let levels: Vec<usize> = l.iter().map(|x| x.0).collect();
+            assert_eq!(&levels[..3], &[0, 1, 0], "PRN {}: {levels:?}", i + 1);
+            // The cheap search every UNKNOWN_WAIT_S, the deep one once DEEP_WAIT_S is over.
+            let first_deep = l.iter().find(|x| x.0 == 2).map(|x| x.1 as f64 / FS);
+            let after_s = first_deep.expect("a deep search after the wait") - l[1].1 as f64 / FS;
+            assert!(
+                (DEEP_WAIT_S..DEEP_WAIT_S + UNKNOWN_WAIT_S + 1.0).contains(&after_s),
+                "PRN {}: {after_s} s",
+                i + 1
+            );
+            let cheap = l.iter().filter(|x| x.0 == 0).count() as f64;
+            assert!(cheap + 2.0 >= DEEP_WAIT_S / UNKNOWN_WAIT_S, "PRN {}", i + 1);
+        }
+        // The predicted one goes on to the deep search at once.
+        let predicted: Vec<usize> = log[12].iter().map(|x| x.0).collect();
+        assert_eq!(&predicted[..3], &[0, 1, 2], "{predicted:?}");
+        // One satellite fewer: the round as before.
+        let fewer = run_tracking(5.0, &vis, budget, &wanted, DEFER_DEEP_FROM_TRACKED - 1);
+        for l in fewer.iter().skip(8).take(5) {
+            let levels: Vec<usize> = l.iter().map(|x| x.0).collect();
+            assert_eq!(&levels[..3], &[0, 1, 2], "{levels:?}");
+        }
     }
 
     #[test]
@@ -623,7 +710,7 @@ mod tests {
                 searched.extend(b.targets.iter().map(|t| (b.level, t.prn.get(), now)));
                 let results: Vec<AcqResult> =
                     b.targets.iter().map(|t| result(t.prn, false)).collect();
-                s.record(&b, &results, now, &vis);
+                s.record(&b, &results, now, 0, &vis);
             }
             now += block;
         }
@@ -781,7 +868,7 @@ mod tests {
                 assert!(lo < -1234.0 && hi > -1234.0 && hi - lo < 700.0, "{lo} {hi}");
                 times.push(now);
                 let r = vec![result(prn, false)];
-                s.record(&b, &r, now, &|_| Visibility::Unknown);
+                s.record(&b, &r, now, 0, &|_| Visibility::Unknown);
             }
             now += block;
         }
@@ -841,7 +928,7 @@ mod tests {
             if let Some(b) = s.due(now, now, &engines, &live, &vis) {
                 assert_eq!((b.level, b.targets.len()), (level_for_cn0(33.0), 1));
                 times.push(now);
-                s.record(&b, &[result(prn, false)], now, &vis);
+                s.record(&b, &[result(prn, false)], now, 0, &vis);
             }
             now += block;
         }

@@ -543,6 +543,8 @@ impl ChannelManager {
             }
         }
         let end = outcome.first + outcome.batch.as_ref().map_or(0, |b| b.len as u64);
+        let tracked = Prn::all().filter(|&p| self.live(p).is_some()).count()
+            + outcome.results.iter().filter(|d| d.detected).count();
         if let (Some(s), Some(b)) = (self.schedule.as_mut(), outcome.batch.as_ref()) {
             for (t, r) in b.targets.iter().zip(&outcome.results) {
                 tracing::trace!(
@@ -555,7 +557,7 @@ impl ChannelManager {
                     r.threshold
                 );
             }
-            s.record(b, &outcome.results, end, visibility);
+            s.record(b, &outcome.results, end, tracked, visibility);
         }
         let mut started = Vec::new();
         for d in outcome.results.into_iter().filter(|d| d.detected) {
