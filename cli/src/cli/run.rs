@@ -107,7 +107,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "P")]
     pub acq_pfa: Option<f64>,
     /// CPU time the background search for missing satellites may spend per second of signal,
-    /// s [default: 0.005; 1.25 s may go at once, at the start]: raise it to find weak
+    /// s [default: 0.005; 1.6 s may go at once, at the start]: raise it to find weak
     /// satellites sooner, lower it for speed; 0 searches only for satellites just lost.
     #[arg(long, value_name = "S")]
     pub search_budget: Option<f64>,
