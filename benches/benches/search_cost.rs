@@ -75,7 +75,7 @@ fn main() {
     let mut worst: f64 = 0.0;
     for fs in [2.6e6, 4.0e6] {
         for level in 0..=LEVELS.len() {
-            let cfg = level_config(&base, level);
+            let cfg = level_config(&base, level, fs);
             let name = format!("{} ms x {}", cfg.coherent_ms, cfg.noncoherent);
             let engine = match AcquisitionEngine::new(fs, cfg) {
                 Ok(e) => e,

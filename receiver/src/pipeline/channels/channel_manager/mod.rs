@@ -170,7 +170,7 @@ impl ChannelManager {
         let mut engines = Vec::new();
         if settings.weak_fallback {
             for level in 1..=LEVELS.len() {
-                let cfg = level_config(&settings.acq, level);
+                let cfg = level_config(&settings.acq, level, fs_hz);
                 engines.push(AcquisitionEngine::new(fs_hz, cfg)?.sharing_replicas_with(&first));
             }
         }
