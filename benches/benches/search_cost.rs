@@ -5,7 +5,7 @@
 //! at 2.6 and 4 MHz, batches of 1 and 8 absent PRNs on 8-bit noise held as the receiver
 //! holds it (ci8, converted block by block): the process CPU time of one search on the whole
 //! rayon pool (`CLOCK_PROCESS_CPUTIME_ID`: every thread, the pool's spinning included, the
-//! allocation and release of the search's memory included), the least of a few repetitions,
+//! allocation and release of the search's memory included), the least of a few repetitions in each of 3 rounds over all rows,
 //! next to the modelled cost. Issue 28 asks the two to agree within 20 %; the table says
 //! for each row whether they do, and the run fails when one does not.
 //!
@@ -19,6 +19,45 @@ use std::hint::black_box;
 
 /// Agreement asked for: measured within this fraction of the model.
 const TOLERANCE: f64 = 0.20;
+
+/// Rounds over all rows; each row keeps its least time.
+const ROUNDS: usize = 3;
+
+/// One row of the table: a level's engine at one rate with a batch of PRNs.
+struct Row {
+    fs: f64,
+    name: String,
+    engine: std::sync::Arc<AcquisitionEngine>,
+    samples: std::sync::Arc<Vec<[i8; 2]>>,
+    targets: Vec<SearchTarget>,
+    model_s: f64,
+    /// Least process CPU time of one search so far, s.
+    measured_s: f64,
+}
+
+impl Row {
+    /// One warm-up search, then the least CPU time of the repetitions (about 0.3 s of
+    /// modelled work, 3 to 50 searches), kept when less than before.
+    fn measure(&mut self) {
+        let run = || match self
+            .engine
+            .search_slice(SampleSlice::Ci8(&self.samples), &self.targets)
+        {
+            Ok(r) => black_box(r),
+            Err(e) => panic!("{e}"),
+        };
+        run();
+        let reps = ((0.3 / self.model_s).ceil() as usize).clamp(3, 50);
+        let least = (0..reps)
+            .map(|_| {
+                let t0 = process_cpu_s();
+                run();
+                process_cpu_s() - t0
+            })
+            .fold(f64::INFINITY, f64::min);
+        self.measured_s = self.measured_s.min(least);
+    }
+}
 
 /// CPU time of the whole process so far, s.
 fn process_cpu_s() -> f64 {
@@ -72,7 +111,9 @@ fn main() {
         "ratio",
         TOLERANCE * 100.0
     );
-    let mut worst: f64 = 0.0;
+    // Every row is measured in each of ROUNDS rounds and keeps its least time: a slow
+    // stretch of a shared or virtual machine (minutes long) then spoils at most one round.
+    let mut rows = Vec::new();
     for fs in [2.6e6, 4.0e6] {
         for level in 0..=LEVELS.len() {
             let cfg = level_config(&base, level, fs);
@@ -81,7 +122,8 @@ fn main() {
                 Ok(e) => e,
                 Err(e) => panic!("{e}"),
             };
-            let x = ci8_noise(engine.samples_wanted(), 7);
+            let x = std::sync::Arc::new(ci8_noise(engine.samples_wanted(), 7));
+            let engine = std::sync::Arc::new(engine);
             for n_prn in [1usize, 8] {
                 let targets: Vec<SearchTarget> = (25u8..25 + n_prn as u8)
                     .filter_map(|p| Prn::new(p).ok())
@@ -89,38 +131,41 @@ fn main() {
                     .collect();
                 let model_s =
                     fixed_cost_s(&engine) + targets.iter().map(|t| cost_s(&engine, t)).sum::<f64>();
-                // Warm up, then the least CPU time of the repetitions.
-                let run = || match engine.search_slice(SampleSlice::Ci8(&x), &targets) {
-                    Ok(r) => black_box(r),
-                    Err(e) => panic!("{e}"),
-                };
-                run();
-                let reps = ((0.3 / model_s).ceil() as usize).clamp(3, 50);
-                let measured_s = (0..reps)
-                    .map(|_| {
-                        let t0 = process_cpu_s();
-                        run();
-                        process_cpu_s() - t0
-                    })
-                    .fold(f64::INFINITY, f64::min);
-                let ratio = measured_s / model_s;
-                worst = worst.max((ratio - 1.0).abs());
-                println!(
-                    "{:>7.1} {:>12} {:>5} {:>11.2} {:>11.2} {:>9.2}  {}",
-                    fs / 1e6,
-                    name,
-                    n_prn,
-                    model_s * 1e3,
-                    measured_s * 1e3,
-                    ratio,
-                    if (ratio - 1.0).abs() <= TOLERANCE {
-                        "yes"
-                    } else {
-                        "NO"
-                    }
-                );
+                rows.push(Row {
+                    fs,
+                    name: name.clone(),
+                    engine: std::sync::Arc::clone(&engine),
+                    samples: std::sync::Arc::clone(&x),
+                    targets,
+                    model_s,
+                    measured_s: f64::INFINITY,
+                });
             }
         }
+    }
+    for _ in 0..ROUNDS {
+        for row in &mut rows {
+            row.measure();
+        }
+    }
+    let mut worst: f64 = 0.0;
+    for row in &rows {
+        let ratio = row.measured_s / row.model_s;
+        worst = worst.max((ratio - 1.0).abs());
+        println!(
+            "{:>7.1} {:>12} {:>5} {:>11.2} {:>11.2} {:>9.2}  {}",
+            row.fs / 1e6,
+            row.name,
+            row.targets.len(),
+            row.model_s * 1e3,
+            row.measured_s * 1e3,
+            ratio,
+            if (ratio - 1.0).abs() <= TOLERANCE {
+                "yes"
+            } else {
+                "NO"
+            }
+        );
     }
     println!("largest deviation from the model: {:.0} %", worst * 100.0);
     if worst > TOLERANCE {

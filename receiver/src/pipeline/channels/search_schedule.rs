@@ -594,9 +594,15 @@ pub fn cost_s(engine: &AcquisitionEngine, target: &SearchTarget) -> f64 {
     let bins = ((b.min(hi) - a.max(lo)) / step).max(0.0) + 1.0;
     let coherent_ms = engine.config().coherent_ms.max(1);
     // The spectrum bins each inverse FFT reads per code period: the samples of a period, or
-    // fewer when the search keeps only the lowest frequencies.
+    // fewer when the search keeps only the lowest frequencies, with an FFT's n log n per
+    // point counted from the 4096 points the constant was fitted at (2048: 11/12).
     let per_ms = engine.fs_hz() * 1e-3;
-    let kept = (engine.search_lags() as f64).min(per_ms) / per_ms;
+    let lags = engine.search_lags() as f64;
+    let kept = if lags < per_ms {
+        lags / per_ms * lags.log2() / 12.0
+    } else {
+        1.0
+    };
     engine.samples_needed() as f64 * kept * bins * passes(engine) * COST_S_PER_SAMPLE_BIN
         / f64::from(coherent_ms)
 }
@@ -705,8 +711,8 @@ mod tests {
         };
         assert_eq!(level_config(&few, 1, 4e6).search_lags_per_ms, 1024);
         assert_eq!(level_config(&few, 1, 4e6).noncoherent, 13);
-        // The model charges the inverse FFTs' length: 16 blocks of 2048 lags cost 0.63 of
-        // 13 blocks of 4000 samples per period at 4 MHz.
+        // The model charges the inverse FFTs' length: 16 blocks of 2048 lags cost 0.58 of
+        // 13 blocks of 4000 samples per period at 4 MHz (0.63 in points, 11/12 per point).
         let at = |c: AcqConfig| {
             let e = AcquisitionEngine::new(4e6, c).expect("engine");
             cost_s(&e, &SearchTarget::full(Prn::new(1).expect("prn")))
