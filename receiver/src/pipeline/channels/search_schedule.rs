@@ -138,7 +138,7 @@ pub const TICK_S: f64 = 0.1;
 /// block, bin and PRN. Fitted with [`COST_S_PER_SAMPLE_FFT`] to the process CPU time (every
 /// thread of the pool) of batches of 1 and 8 PRNs over +-5 kHz at every level at 2.6 and
 /// 4 MHz, on 8-bit noise held as ci8 (`cargo bench -p gpsrx-benches --bench search_cost`), on
-/// the 2-core Intel Xeon (AVX-512) the project is measured on: within 14 % on all 12 (1 ms x 10
+/// the 2-core Intel Xeon (AVX-512) the project is measured on: within 17 % on all 12 (1 ms x 10
 /// 2.1 ms per PRN at 4 MHz, 10 ms x 13 17 ms at 2.6 and 26 ms at 4 MHz, 10 ms x 50 65 ms and
 /// 100 ms). It was fitted to PRNs searched alone on the AMD EPYC of earlier sessions (1.9e-9),
 /// which made a batch of 8 on the Xeon 1.2-1.3 times its model.
