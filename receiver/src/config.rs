@@ -65,6 +65,12 @@ pub struct RunSettings {
     /// [`crate::pipeline::channels::BURST_S`] at once. 0: no background search, only
     /// the re-acquisition of lost satellites.
     pub search_budget_s: f64,
+    /// Satellites tracked from which the first most sensitive background search (10 ms x 50)
+    /// of a PRN nothing is predicted of waits 5 minutes instead of following its 10 ms x 13
+    /// one at once ([`crate::pipeline::channels::DEFER_DEEP_FROM_TRACKED`], 8); 33: never
+    /// (a weak satellite beside strong ones found in the first second, at the CPU cost of a
+    /// deep round over every absent PRN).
+    pub defer_deep_search_from: usize,
     /// Use satellites whose ephemeris says they are unhealthy.
     pub allow_unhealthy: bool,
     /// Without an INS: when every signal is gone at once under dynamics, feed the motion of
@@ -104,6 +110,7 @@ impl Default for RunSettings {
             acq_noncoherent: 10,
             acq_pfa: 1e-5,
             search_budget_s: crate::pipeline::channels::DEFAULT_PER_SIGNAL_S,
+            defer_deep_search_from: crate::pipeline::channels::DEFER_DEEP_FROM_TRACKED,
             allow_unhealthy: false,
             outage_bridge: true,
             week: None,
@@ -409,6 +416,12 @@ impl RunSettings {
             return bad(format!(
                 "search budget {} CPU s per second of signal: use 0 to 2",
                 self.search_budget_s
+            ));
+        }
+        if self.defer_deep_search_from > 33 {
+            return bad(format!(
+                "deep search deferred from {} satellites tracked: use 0 to 33 (33: never)",
+                self.defer_deep_search_from
             ));
         }
         if let Some(p) = self.prns.iter().find(|p| !(1..=32).contains(*p)) {

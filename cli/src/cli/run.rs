@@ -111,6 +111,11 @@ pub struct RunArgs {
     /// satellites sooner, lower it for speed; 0 searches only for satellites just lost.
     #[arg(long, value_name = "S")]
     pub search_budget: Option<f64>,
+    /// Satellites tracked from which the first 10 ms x 50 search of a PRN nothing is
+    /// predicted of waits 5 minutes [default: 8]; 33: never (weak satellites beside strong
+    /// ones found at once, for the CPU of a deep round over every absent PRN).
+    #[arg(long, value_name = "N")]
+    pub defer_deep_search: Option<usize>,
     /// RAIM false-alarm probability [default: 0.001].
     #[arg(long, value_name = "P")]
     pub raim_pfa: Option<f64>,
@@ -206,6 +211,9 @@ impl RunArgs {
         set(&mut r.max_pdop, self.max_pdop);
         set(&mut r.acq_pfa, self.acq_pfa);
         set(&mut r.search_budget_s, self.search_budget);
+        if let Some(v) = self.defer_deep_search {
+            r.defer_deep_search_from = v;
+        }
         set(&mut r.doppler_max_hz, self.doppler_max);
         set(&mut r.doppler_center_hz, self.doppler_center);
         if let Some(v) = self.acq_coherent_ms {

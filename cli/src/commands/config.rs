@@ -101,6 +101,9 @@ pub fn default_toml() -> anyhow::Result<String> {
          acq_coherent_ms = 1       # acquisition coherent integration, 1 .. 10 ms (--acq-coherent-ms)\n\
          acq_noncoherent = 10      # acquisition non-coherent blocks (--acq-noncoherent)\n\
          # (weak signals, below about 35 dB-Hz: acq_coherent_ms = 10, acq_noncoherent = 10 or more)\n\
+         acq_pfa = 1e-5            # probability that an absent PRN is reported, over the whole run (--acq-pfa)\n\
+         search_budget_s = 0.005   # CPU s the background search may spend per s of signal; 0: off (--search-budget)\n\
+         defer_deep_search_from = 8  # satellites tracked from which an unpredicted PRN's first 10 ms x 50 search waits 5 min; 33: never (--defer-deep-search)\n\
          allow_unhealthy = false   # use satellites flagged unhealthy (--allow-unhealthy)\n\
          outage_bridge = true      # without --ins, carry the channels through an outage under dynamics on the motion of the last fixes\n\
          plots = true              # draw track.png, skyplot.png, cn0.png, dop.png (dr.png with --dr) (--no-plots)\n\

@@ -71,6 +71,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<Completion> {
         max_pdop: None,
         acq_pfa: None,
         search_budget: None,
+        defer_deep_search: None,
         allow_unhealthy: false,
         landmarks: None,
         ins: None,

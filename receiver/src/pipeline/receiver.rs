@@ -319,7 +319,10 @@ impl Receiver {
                 ..AcqConfig::default()
             },
             weak_fallback: true,
-            background: Some(SearchBudget::per_signal(run.search_budget_s)),
+            background: Some(SearchBudget {
+                defer_deep_from_tracked: run.defer_deep_search_from,
+                ..SearchBudget::per_signal(run.search_budget_s)
+            }),
             prns: run.prns.iter().filter_map(|&p| Prn::new(p).ok()).collect(),
             cold_targets: None,
         }

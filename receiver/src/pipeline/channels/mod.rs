@@ -21,7 +21,7 @@ pub(crate) mod visibility;
 pub use channel_manager::{ChannelManager, RealignSearch, Realigned, SearchSettings};
 pub use search_schedule::{
     cost_s, fixed_cost_s, level_config, SearchBudget, Visibility, BURST_S, DEFAULT_PER_SIGNAL_S,
-    LEVELS,
+    DEFER_DEEP_FROM_TRACKED, LEVELS,
 };
 pub use tracker::{track, AidSource};
 pub use visibility::{predict as predict_satellite, SatPrediction};

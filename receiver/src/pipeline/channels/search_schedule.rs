@@ -13,8 +13,8 @@
 //! 2. predicted visible ([`Visibility::Visible`]: from `--nav` or decoded ephemerides and a
 //!    position), in their predicted Doppler window, never left more than [`PREDICTED_WAIT_S`];
 //! 3. the others over the whole Doppler range, the least recently searched first; once the
-//!    most sensitive search has failed, only the cheap one (level 0) every [`UNKNOWN_WAIT_S`],
-//!    and the escalation again after [`DEEP_WAIT_S`]. Satellites predicted below
+//!    most sensitive search has failed, only the cheap one (level 0) every `UNKNOWN_WAIT_S`,
+//!    and the escalation again after `DEEP_WAIT_S`. Satellites predicted below
 //!    the horizon are not searched, and while a prediction is about to come
 //!    ([`Visibility::Pending`]: ephemerides at hand, no fix yet) the most sensitive search
 //!    waits for it (most of the 32 PRNs are below the horizon).
@@ -48,10 +48,10 @@ use gpsrx_dsp::Prn;
 pub const LEVELS: [(u32, u32); 2] = [(10, 13), (10, 50)];
 
 /// Search lags per code period of the 10 ms x 13 level where a code period holds at least
-/// [`HALF_CHIP_FROM_SAMPLES_PER_MS`] samples: half a chip between lags and +-1.024 MHz of the
-/// spectrum kept (`AcqConfig::search_lags_per_ms`), with [`HALF_CHIP_BLOCKS`] times the blocks.
+/// `HALF_CHIP_FROM_SAMPLES_PER_MS` samples: half a chip between lags and +-1.024 MHz of the
+/// spectrum kept (`AcqConfig::search_lags_per_ms`), with `HALF_CHIP_BLOCKS` times the blocks.
 pub const HALF_CHIP_LAGS_PER_MS: usize = 2048;
-/// Samples per code period from which the 10 ms x 13 level searches [`HALF_CHIP_LAGS_PER_MS`]
+/// Samples per code period from which the 10 ms x 13 level searches `HALF_CHIP_LAGS_PER_MS`
 /// lags (3.072 MHz): its inverse FFTs, nearly all of its work, are then at least 1.5 times
 /// shorter (4 MHz: 4096 -> 2048 points, 2.2 times less work per block), which more than pays
 /// for the blocks added (0.61 of the work at 4 MHz, measured 0.6); below it (2.6 MHz:
@@ -67,8 +67,8 @@ pub const HALF_CHIP_BLOCKS: f64 = 1.22;
 
 /// The engine settings of background level `level` (1 or 2; 0 is `base` itself) at `fs_hz`:
 /// `base` with the coherent integration and blocks of [`LEVELS`], in one pass (no bit-edge
-/// pass); level 1 from [`HALF_CHIP_FROM_SAMPLES_PER_MS`] on at [`HALF_CHIP_LAGS_PER_MS`] lags
-/// with [`HALF_CHIP_BLOCKS`] times the blocks (unless `base` asks for fewer lags still).
+/// pass); level 1 from `HALF_CHIP_FROM_SAMPLES_PER_MS` on at `HALF_CHIP_LAGS_PER_MS` lags
+/// with `HALF_CHIP_BLOCKS` times the blocks (unless `base` asks for fewer lags still).
 pub fn level_config(base: &AcqConfig, level: usize, fs_hz: f64) -> AcqConfig {
     match level.checked_sub(1).and_then(|i| LEVELS.get(i)) {
         Some(&(coherent_ms, noncoherent)) => {
@@ -125,7 +125,7 @@ pub const PREDICTED_WAIT_S: f64 = 2.0;
 pub const UNKNOWN_WAIT_S: f64 = 15.0;
 /// Wait before a satellite nothing is predicted of is searched up to the most sensitive level
 /// again, once that search failed, s. Between, it gets only the cheap search every
-/// [`UNKNOWN_WAIT_S`]: at 4 MHz one most sensitive search of one PRN costs as much as about
+/// `UNKNOWN_WAIT_S`: at 4 MHz one most sensitive search of one PRN costs as much as about
 /// 50 cheap ones, and most of the 32 PRNs are below the horizon.
 pub const DEEP_WAIT_S: f64 = 300.0;
 /// Wait of a satellite whose most sensitive search awaits a prediction
@@ -163,8 +163,8 @@ pub const MIN_BATCH_PRNS: usize = 4;
 pub const BURST_S: f64 = 1.6;
 
 /// Satellites tracked from which the first most sensitive search of a PRN nothing is
-/// predicted of waits [`DEEP_WAIT_S`], as its later ones do, instead of following its
-/// 10 ms x 13 search at once (the cheap search goes on every [`UNKNOWN_WAIT_S`]).
+/// predicted of waits `DEEP_WAIT_S`, as its later ones do, instead of following its
+/// 10 ms x 13 search at once (the cheap search goes on every `UNKNOWN_WAIT_S`).
 ///
 /// That search (10 ms x 50) costs about four times the one before it (10 ms x 13, about
 /// 31 dB-Hz), and a first round of it over the 20-odd PRNs that are not above the horizon is
@@ -196,6 +196,9 @@ pub struct SearchBudget {
     pub per_signal_s: f64,
     /// Capacity of the bucket, CPU s (spent at once at the start: a first full round).
     pub burst_s: f64,
+    /// Satellites tracked from which the first most sensitive search of a PRN nothing is
+    /// predicted of waits `DEEP_WAIT_S` ([`DEFER_DEEP_FROM_TRACKED`]; more than 32: never).
+    pub defer_deep_from_tracked: usize,
 }
 
 impl SearchBudget {
@@ -205,6 +208,7 @@ impl SearchBudget {
         Self {
             per_signal_s,
             burst_s: if per_signal_s > 0.0 { BURST_S } else { 0.0 },
+            defer_deep_from_tracked: DEFER_DEEP_FROM_TRACKED,
         }
     }
 }
@@ -269,7 +273,7 @@ struct PrnState {
     /// Sample index before which it is not searched.
     not_before: u64,
     /// Sample index before which, unpredicted, it is not searched past level 0 again
-    /// ([`DEEP_WAIT_S`]; 0: its first escalation is still to come).
+    /// (`DEEP_WAIT_S`; 0: its first escalation is still to come).
     deep_not_before: u64,
 }
 
@@ -424,7 +428,7 @@ impl Scheduler {
     }
 
     /// The candidate search of `p` at sample `now`, or `None` when it is not to be searched
-    /// (predicted below the horizon: looked at again in [`UNKNOWN_WAIT_S`]).
+    /// (predicted below the horizon: looked at again in `UNKNOWN_WAIT_S`).
     fn candidate(
         &mut self,
         p: Prn,
@@ -527,7 +531,7 @@ impl Scheduler {
                 && !predicted
                 && batch.level + 1 == max_level
                 && s.deep_not_before == 0
-                && tracked >= DEFER_DEEP_FROM_TRACKED
+                && tracked >= self.budget.defer_deep_from_tracked
             {
                 // Its first deepest search waits, as its later ones do.
                 s.deep_not_before = now + (DEEP_WAIT_S * self.fs_hz) as u64;
@@ -760,11 +764,17 @@ mod tests {
         // The predicted one goes on to the deep search at once.
         let predicted: Vec<usize> = log[12].iter().map(|x| x.0).collect();
         assert_eq!(&predicted[..3], &[0, 1, 2], "{predicted:?}");
-        // One satellite fewer: the round as before.
-        let fewer = run_tracking(5.0, &vis, budget, &wanted, DEFER_DEEP_FROM_TRACKED - 1);
-        for l in fewer.iter().skip(8).take(5) {
-            let levels: Vec<usize> = l.iter().map(|x| x.0).collect();
-            assert_eq!(&levels[..3], &[0, 1, 2], "{levels:?}");
+        // One satellite fewer, or the deferral turned off (33): the round as before.
+        let never = SearchBudget {
+            defer_deep_from_tracked: 33,
+            ..budget
+        };
+        for (budget, tracked) in [(budget, DEFER_DEEP_FROM_TRACKED - 1), (never, 12)] {
+            let log = run_tracking(5.0, &vis, budget, &wanted, tracked);
+            for l in log.iter().skip(8).take(5) {
+                let levels: Vec<usize> = l.iter().map(|x| x.0).collect();
+                assert_eq!(&levels[..3], &[0, 1, 2], "{levels:?}");
+            }
         }
     }
 
