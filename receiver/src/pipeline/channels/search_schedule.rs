@@ -139,8 +139,8 @@ pub const TICK_S: f64 = 0.1;
 /// thread of the pool) of batches of 1 and 8 PRNs over +-5 kHz at every level at 2.6 and
 /// 4 MHz, on 8-bit noise held as ci8 (`cargo bench -p gpsrx-benches --bench search_cost`), on
 /// the 2-core Intel Xeon (AVX-512) the project is measured on: within 17 % on all 12 (1 ms x 10
-/// 2.1 ms per PRN at 4 MHz, 10 ms x 13 17 ms at 2.6 and 26 ms at 4 MHz, 10 ms x 50 65 ms and
-/// 100 ms). It was fitted to PRNs searched alone on the AMD EPYC of earlier sessions (1.9e-9),
+/// 2.1 ms per PRN at 4 MHz, 10 ms x 13 17 ms at 2.6 and 26 ms at 4 MHz at its full 4096 lags,
+/// 10 ms x 50 65 ms and 100 ms). It was fitted to PRNs searched alone on the AMD EPYC of earlier sessions (1.9e-9),
 /// which made a batch of 8 on the Xeon 1.2-1.3 times its model.
 pub const COST_S_PER_SAMPLE_BIN: f64 = 2.5e-9;
 /// Modelled CPU time of the block spectra of a search (the forward FFTs every search makes
