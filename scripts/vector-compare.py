@@ -39,7 +39,7 @@ def truth_at(tr, tow):
     return tuple(a[i] + w * (b[i] - a[i]) for i in range(7))
 
 def run(sim, mode, out, extra=()):
-    cmd = [GPSRX, "run", f"{sim}/signal.sigmf-meta", "--nav", NAV, "--tropo", "none", "--allow-unhealthy",
+    cmd = [GPSRX, "run", f"{sim}/signal.sigmf-meta", "--nav", NAV, "--allow-unhealthy",
            "--tracking", mode, "--out", out, "--json", "--no-plots", *extra]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:

@@ -404,6 +404,7 @@ rate_hz = 1.0
             doppler_hz: (c.carrier_cycles - a.carrier_cycles) / (2.0 * h),
             doppler_rate_hz_s: (c.carrier_cycles - 2.0 * b.carrier_cycles + a.carrier_cycles)
                 / (h * h),
+            coast: false,
         })
     };
     // The turn runs from 3 s to 15 s (acceleration ramps in over 0.5 s): measure 4-14.5 s.
@@ -566,6 +567,86 @@ fn pocketsdr_capture_all_satellites_lock_with_the_reference_bit_edges_and_cn0() 
             "PRN {prn}: C/N0 {:.1} dB-Hz, reference {cn0}",
             s.cn0_dbhz
         );
+    }
+}
+
+/// Every satellite of `prns` at `cn0_dbhz`, every signal blocked from 3 to 6 s, tracked by
+/// default channels fed the true Doppler (and its rate) with [`gpsrx_tracking::DopplerAid::coast`]
+/// set to `coast`: per satellite, whether its channel was ever lost, the code error at the
+/// return (chips), and how long after the return it reported phase lock again (s).
+fn blockage_on_truth_aid(cn0_dbhz: f64, coast: bool) -> Vec<(u8, bool, f64, Option<f64>)> {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let (sim, data) = simulate(
+        &format!("[satellites]\nprns = [16, 26, 31]\ncn0_all_dbhz = {cn0_dbhz}\n[[outages]]\nstart_s = 3.0\nend_s = 6.0"),
+        7.5,
+        dir.path(),
+    );
+    let truth_aid = |prn: gpsrx_dsp::Prn, t: f64| {
+        let sat = sim.satellites.iter().find(|s| s.prn == prn)?;
+        let h = 1e-3;
+        let (a, _) = sim.observe(sat, t - h);
+        let (b, _) = sim.observe(sat, t);
+        let (c, _) = sim.observe(sat, t + h);
+        Some(gpsrx_tracking::DopplerAid {
+            doppler_hz: (c.carrier_cycles - a.carrier_cycles) / (2.0 * h),
+            doppler_rate_hz_s: (c.carrier_cycles - 2.0 * b.carrier_cycles + a.carrier_cycles)
+                / (h * h),
+            coast,
+        })
+    };
+    let truth = Truth::new(&sim);
+    let specs: Vec<ChannelSpec> = sim
+        .satellites
+        .iter()
+        .map(|s| ChannelSpec {
+            prn: s.prn.get(),
+            config: ChannelConfig::default(),
+            doppler_offset_hz: 0.0,
+        })
+        .collect();
+    let mut src = open_source(&SourceConfig::new(data)).unwrap_or_else(|e| panic!("{e}"));
+    let traces = if_sim::track_vs_truth(src.as_mut(), &sim, &truth, &specs, Some(&truth_aid))
+        .unwrap_or_else(|e| panic!("{e:#}"));
+    traces
+        .iter()
+        .map(|tr| {
+            let lost = tr.epochs.iter().any(|e| e.state == ChannelState::Lost);
+            let back = tr.epochs.iter().find(|e| e.t_s >= 6.0);
+            let code = back.map_or(f64::NAN, |e| e.code_error_chips);
+            let locked = tr
+                .epochs
+                .iter()
+                .find(|e| e.t_s >= 6.0 && e.pll_lock && e.state == ChannelState::Track)
+                .map(|e| e.t_s - 6.0);
+            (tr.prn, lost, code, locked)
+        })
+        .collect()
+}
+
+#[test]
+fn channels_coast_through_a_3_s_blockage_on_an_aid_that_predicts_their_signal() {
+    // Vector tracking's aid (`DopplerAid::coast`): a strong signal (40 dB-Hz, whose fall the
+    // fade detector flags) and a weak one (31 dB-Hz, whose fall only the C/N0 test sees) stay
+    // in tracking through 3 s of blockage on a perfect prediction, their code where the
+    // signal comes back, and lock again at once; without `coast` (an INS's aid) the weak
+    // ones are released by their C/N0 test, as before.
+    // (The weak ones run on noise until their C/N0 estimate falls: their DLL wanders a little.)
+    for (cn0, max_relock_s, max_code_chips) in [(40.0, 0.4, 0.05), (31.0, 1.0, 0.1)] {
+        for (prn, lost, code, locked) in blockage_on_truth_aid(cn0, true) {
+            eprintln!("{cn0} dB-Hz, coast: G{prn:02} lost {lost}, code error at the return {code:.4} chip, locked {locked:?} s after it");
+            assert!(!lost, "{cn0} dB-Hz: G{prn:02} was released");
+            assert!(
+                code.abs() < max_code_chips,
+                "{cn0} dB-Hz: G{prn:02} code {code} chip off"
+            );
+            assert!(
+                locked.is_some_and(|s| s <= max_relock_s),
+                "{cn0} dB-Hz: G{prn:02} locked again {locked:?} s after the return"
+            );
+        }
+    }
+    for (prn, lost, _, _) in blockage_on_truth_aid(31.0, false) {
+        assert!(lost, "31 dB-Hz, no coast: G{prn:02} was held");
     }
 }
 

@@ -169,6 +169,10 @@ pub struct VectorSettings {
     /// False-alarm probability of the innovation test that excludes a channel's measurement
     /// (chi-square, 1 degree of freedom), in (0, 0.5) (default 1e-3).
     pub gate_pfa: f64,
+    /// Longest time the filter predicts a satellite (and, with none, all of them) without an
+    /// admitted measurement and holds its channel through the outage on that prediction, s,
+    /// in (0, 30] (default 5; its position-sigma test may end it sooner).
+    pub max_coast_s: f64,
 }
 
 impl Default for VectorSettings {
@@ -178,6 +182,7 @@ impl Default for VectorSettings {
             clock_h0: 2e-19,
             clock_h_2: 2e-20,
             gate_pfa: 1e-3,
+            max_coast_s: 5.0,
         }
     }
 }
@@ -216,6 +221,9 @@ impl VectorSettings {
         }
         if !(self.gate_pfa > 0.0 && self.gate_pfa < 0.5) {
             return bad("gate_pfa", self.gate_pfa, "a probability in (0, 0.5)");
+        }
+        if !(self.max_coast_s > 0.0 && self.max_coast_s <= 30.0) {
+            return bad("max_coast_s", self.max_coast_s, "a time in (0, 30] s");
         }
         Ok(())
     }

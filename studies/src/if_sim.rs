@@ -327,6 +327,7 @@ impl SatTruth {
         DopplerAid {
             doppler_hz: (c - a) / (2.0 * h),
             doppler_rate_hz_s: (c - 2.0 * b + a) / (h * h),
+            coast: false,
         }
     }
 }

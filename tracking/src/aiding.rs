@@ -19,6 +19,13 @@ pub struct DopplerAid {
     /// Its rate of change over the interval, Hz/s (from the INS LOS acceleration, `-a_los/lambda`);
     /// 0 when unknown.
     pub doppler_rate_hz_s: f64,
+    /// The aid's source predicts the signal through an outage of it (vector tracking: the
+    /// navigation filter predicts every satellite from the others, or from its motion and clock
+    /// models when all are gone): while the prompt power has collapsed the channel coasts on the
+    /// aid, its loops holding their memories, its lock and its C/N0 test suspended
+    /// (`Channel::coasting_on_aid`). False for an INS's aid, whose channels run their own
+    /// outage rules.
+    pub coast: bool,
 }
 
 impl DopplerAid {
@@ -218,6 +225,7 @@ mod tests {
         let aid = DopplerAid {
             doppler_hz: 100.0,
             doppler_rate_hz_s: 50.0,
+            coast: false,
         };
         assert!((aid.mean_over_hz(0.02) - 100.5).abs() < 1e-12);
         assert_eq!(carrier_nco_hz(f64::NAN, 3.0), 3.0);

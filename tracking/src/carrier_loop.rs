@@ -103,6 +103,22 @@ impl CarrierLoop {
         self.last
     }
 
+    /// One interval without a usable prompt (the signal is gone and an aid predicts it,
+    /// [`aiding::DopplerAid::coast`]): the loop filter runs on zero error, so it holds its
+    /// frequency (a 3rd-order loop its Doppler rate too) and the NCO is `f_ff + memory`; the
+    /// FLL forgets its previous prompt.
+    pub fn coast(&mut self, feedforward_hz: f64) -> CarrierOutput {
+        let loop_hz = self.filter.update(0.0, 0.0, self.cfg.t_coh_s);
+        self.prev_prompt = None;
+        self.last = CarrierOutput {
+            nco_freq_hz: aiding::carrier_nco_hz(feedforward_hz, self.base_hz + loop_hz),
+            loop_hz,
+            phase_error_cycles: 0.0,
+            freq_error_hz: 0.0,
+        };
+        self.last
+    }
+
     /// Sets the signal's C/N0 (Hz; `None` or a non-finite or negative value: unknown) for the
     /// Costas gain normalisation ([`CarrierLoop::costas_gain`]).
     pub fn set_cn0_hz(&mut self, cn0_hz: Option<f64>) {

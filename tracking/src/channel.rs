@@ -391,6 +391,8 @@ pub struct Channel {
     ff_applied_hz: Option<f64>,
     /// The Doppler rate of the last feed-forward applied, Hz/s (0 unaided).
     ff_rate_applied_hz_s: f64,
+    /// The last loop update coasted on the aid ([`Channel::coasting_on_aid`]).
+    coasted_last: bool,
     /// Which tracking loops run (after pull-in).
     loops: TrackLoops,
     /// The C/N0 has fallen below [`ChannelConfig::weak_enter_dbhz`] (and not yet climbed back
@@ -506,6 +508,7 @@ impl Channel {
             aid: None,
             ff_applied_hz: None,
             ff_rate_applied_hz_s: 0.0,
+            coasted_last: false,
             loops: TrackLoops::Normal,
             weak: start.cn0_dbhz < cfg.weak_enter_dbhz || weak_pull_in.is_some(),
             dynamics: false,
@@ -856,6 +859,10 @@ impl Channel {
                 self.costas_hold_ms = Some(COSTAS_HOLD_AFTER_EDGE_MS);
             }
         }
+        // A blocked signal that an aid predicts: its noise is no new level (unless the C/N0
+        // still reads the signal: then the gain changed).
+        self.fade
+            .hold_reference(self.coast_aid() && !(self.cn0_dbhz >= self.cfg.cn0_lost_dbhz));
         self.fade.push(p);
         self.watch_fade();
         if matches!(self.bit_sync.state(), BitSyncState::Failed) {
@@ -924,8 +931,9 @@ impl Channel {
             let ok = self.code_lock.update(c);
             // An outage with a feed-forward: the NCO follows the motion through it, and the
             // estimates that average it are not the signal's (a search could do no better).
-            let coasting =
-                self.ff_applied_hz.is_some() && (self.fade.faded() || self.aided_fade_hold_ms > 0);
+            let coasting = self.ff_applied_hz.is_some()
+                && (self.fade.faded() || self.aided_fade_hold_ms > 0)
+                || self.coasting_on_aid();
             self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz && !coasting {
                 self.low_cn0_count + 1
             } else {
@@ -956,6 +964,15 @@ impl Channel {
                 self.weak_before_fade = None;
                 if self.ff_applied_hz.is_some() {
                     self.aided_fade_hold_ms = FADE_RECOVERY_HOLD_MS;
+                }
+                if self.state == ChannelState::Track && self.coast_aid() {
+                    // Coasted on the aid: the estimator's window holds the outage, so it
+                    // starts again on the returned signal, the level before standing until
+                    // its first estimate (five blocks, 0.1 s).
+                    self.cn0.reset();
+                    if self.tracked_cn0_dbhz.is_finite() {
+                        self.cn0_dbhz = self.tracked_cn0_dbhz;
+                    }
                 }
                 // Only where the NCO followed the signal through the outage: with a
                 // feed-forward, or without dynamics. Unaided in a manoeuvre it coasted tens
@@ -1038,10 +1055,26 @@ impl Channel {
         }
         self.ff_applied_hz = ff_opt;
         let ff = ff_opt.unwrap_or(0.0);
-        let co = self.carrier.update(pa, ff);
-        let cl = self
-            .code_loop
-            .update(ea, pa, la, code_doppler_chips_s(co.nco_freq_hz));
+        let coasting = self.coasting_on_aid();
+        if coasting && !self.coasted_last {
+            // The feed-forward supplies the Doppler rate; what a 3rd-order loop learned of it
+            // in the noise before the fade was flagged (40-60 ms) is noise: at 18 Hz a
+            // Doppler-rate memory wanders about 15 Hz/s in 40 ms, which the coast would carry
+            // on as a ramp (measured: 16 Hz/s, 40 Hz after 2.5 s).
+            self.carrier.preset_doppler_rate(0.0);
+        }
+        self.coasted_last = coasting;
+        let (co, cl) = if coasting {
+            let co = self.carrier.coast(ff);
+            (
+                co,
+                self.code_loop.coast(code_doppler_chips_s(co.nco_freq_hz)),
+            )
+        } else {
+            let co = self.carrier.update(pa, ff);
+            let aid = code_doppler_chips_s(co.nco_freq_hz);
+            (co, self.code_loop.update(ea, pa, la, aid))
+        };
         self.carrier_freq_hz = co.nco_freq_hz;
         self.code_rate_chips_s = cl.code_rate_chips_s;
         self.accumulate_rate_fit(co.nco_freq_hz, ff);
@@ -1178,6 +1211,26 @@ impl Channel {
         }
     }
 
+    /// An aid that predicts the signal through an outage is applied ([`DopplerAid::coast`]).
+    fn coast_aid(&self) -> bool {
+        self.ff_applied_hz.is_some() && self.aid.is_some_and(|(a, _)| a.coast)
+    }
+
+    /// The channel coasts on its aid: in tracking, its signal is gone (the prompt power has
+    /// collapsed, or, where the fade detector cannot see the fall of a weak signal, its C/N0
+    /// estimate is below [`ChannelConfig::cn0_lost_dbhz`]) and the aid predicts it through
+    /// the outage ([`DopplerAid::coast`]: vector tracking). Its
+    /// loops hold their memories (their discriminators would read noise) and its NCOs follow
+    /// the aid; its lock is not counted lost, its loops are not switched or narrowed, and its
+    /// C/N0 does not release it (the fade detector holds its reference, so the fade lasts
+    /// until the power comes back). The aid's source decides how long (vector tracking: while
+    /// its filter predicts the satellite).
+    pub(crate) fn coasting_on_aid(&self) -> bool {
+        self.state == ChannelState::Track
+            && (self.fade.faded() || self.cn0_dbhz < self.cfg.cn0_lost_dbhz)
+            && self.coast_aid()
+    }
+
     /// The signal is there: its prompt power has not collapsed ([`crate::fade_detector`]). (Not
     /// the C/N0: a loop under a manoeuvre's stress reads a falling C/N0 too, and narrowing it
     /// then loses the satellite.)
@@ -1218,7 +1271,7 @@ impl Channel {
     /// code loop restarts from the current code rate (carrier-aided, so only the DLL's small
     /// correction resets).
     fn maybe_switch_loops(&mut self, at_edge: bool) {
-        if self.state != ChannelState::Track || !at_edge {
+        if self.state != ChannelState::Track || !at_edge || self.coasting_on_aid() {
             return;
         }
         let which = self.wanted_loops();

@@ -64,6 +64,23 @@ impl CodeLoop {
         }
     }
 
+    /// One interval without a usable prompt (the signal is gone and an aid predicts it): the
+    /// DLL runs on zero error (a 1st-order DLL adds nothing, a 2nd-order one holds its rate), so
+    /// the code follows the carrier aid `carrier_aid_chips_s` alone.
+    pub fn coast(&mut self, carrier_aid_chips_s: f64) -> CodeOutput {
+        let dll_chips_s = self.filter.update(0.0, 0.0, self.cfg.t_coh_s);
+        let aid = if carrier_aid_chips_s.is_finite() {
+            carrier_aid_chips_s
+        } else {
+            0.0
+        };
+        CodeOutput {
+            code_rate_chips_s: aiding::code_rate_chips_s(0.0, aid + dll_chips_s),
+            dll_chips_s,
+            code_error_chips: 0.0,
+        }
+    }
+
     /// Changes the integration time (validated like [`LoopConfig::validate`]).
     pub fn set_t_coh_s(&mut self, t_coh_s: f64) -> Result<(), ConfigError> {
         let new_cfg = LoopConfig {

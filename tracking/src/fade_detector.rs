@@ -19,7 +19,9 @@
 //! [`REBASE_BLOCKS`] takes the new level as the reference (a front-end gain change, not a
 //! blockage); the C/N0 test releases a channel that has really lost its signal. A level of no
 //! power at all (zeros from a dropout or a stalled front end) is never taken as a reference:
-//! it stays a fade.
+//! it stays a fade. Nor is a fade rebased while the caller holds the reference
+//! ([`FadeDetector::hold_reference`]: vector tracking predicts the signal through a blockage,
+//! whose noise is a steady level too).
 
 use num_complex::Complex64;
 
@@ -46,6 +48,7 @@ pub struct FadeDetector {
     low: u32,
     faded_blocks: u32,
     faded: bool,
+    hold: bool,
 }
 
 impl FadeDetector {
@@ -62,6 +65,12 @@ impl FadeDetector {
     /// Whether the signal has faded.
     pub fn faded(&self) -> bool {
         self.faded
+    }
+
+    /// While `on`, a fade is not taken as a new level however long it lasts: it ends only when
+    /// the power comes back (the caller knows the signal is gone, not the gain changed).
+    pub fn hold_reference(&mut self, on: bool) {
+        self.hold = on;
     }
 
     /// Feeds one prompt (any fixed integration time; 1 ms in a channel). Non-finite prompts
@@ -93,7 +102,7 @@ impl FadeDetector {
                 self.faded = false;
                 self.faded_blocks = 0;
                 self.low = 0;
-            } else if self.faded_blocks >= REBASE_BLOCKS && w > 0.0 {
+            } else if self.faded_blocks >= REBASE_BLOCKS && w > 0.0 && !self.hold {
                 // A lasting new level: take it as the reference.
                 self.faded = false;
                 self.faded_blocks = 0;
@@ -224,6 +233,33 @@ mod tests {
             d.push(p.next(45.0, false));
             assert!(!d.faded());
         }
+    }
+
+    #[test]
+    fn a_held_reference_keeps_a_long_blockage_a_fade_until_the_signal_returns() {
+        let mut p = Prompts::new(22);
+        let mut d = FadeDetector::new();
+        for _ in 0..1000 {
+            d.push(p.next(40.0, true));
+        }
+        d.hold_reference(true);
+        // Three times the rebase time of noise alone: still a fade.
+        for k in 0..3 * 20 * REBASE_BLOCKS {
+            d.push(p.next(40.0, false));
+            assert!(d.faded() || k < 60, "not faded {k} ms into the blockage");
+        }
+        // The signal back: the fade ends within two blocks.
+        let back_ms = (1..=100).find(|_| {
+            d.push(p.next(40.0, true));
+            !d.faded()
+        });
+        assert!(back_ms.is_some_and(|ms| ms <= 40), "{back_ms:?}");
+        // Released: a lasting new level is taken again.
+        d.hold_reference(false);
+        for _ in 0..20 * (REBASE_BLOCKS + 5) {
+            d.push(p.next(40.0, false));
+        }
+        assert!(!d.faded());
     }
 
     #[test]

@@ -764,6 +764,9 @@ impl Receiver {
             Some(BlockEvent::Collapse(c)) => {
                 self.manager.request_realignment(&c);
                 self.arm_bridge(c.sample as f64 / self.fs_hz);
+                if let Some(v) = self.vector.as_mut() {
+                    v.collapse(c.sample as f64 / self.fs_hz);
+                }
             }
             None => {}
         }

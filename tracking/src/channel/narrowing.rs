@@ -193,7 +193,8 @@ impl Channel {
         let t_mid = (s0 as f64 / self.fs_hz) + 0.5 * dur_s;
         let feeding = self.state != ChannelState::Lost
             && self.pll_lock.locked()
-            && !self.weak_frequency_stage();
+            && !self.weak_frequency_stage()
+            && !self.coasting_on_aid();
         if !feeding || self.phase_fit.span_s(t_mid) > MAX_FIT_WINDOW_S {
             self.phase_fit.reset();
         }
@@ -216,7 +217,7 @@ impl Channel {
         let Some(n) = self.narrowing else {
             return;
         };
-        if !at_edge || self.ms_count < n.until_ms {
+        if !at_edge || self.ms_count < n.until_ms || self.coasting_on_aid() {
             return;
         }
         let bw = self.carrier.config().pll_bw_hz;

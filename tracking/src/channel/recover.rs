@@ -39,6 +39,9 @@ impl Channel {
                     self.unlocked_ms = 0;
                     return;
                 }
+                if self.coasting_on_aid() {
+                    return; // the aid holds the signal's place (`Channel::coasting_on_aid`)
+                }
                 self.unlocked_ms += dur_ms;
                 let limit_ms = (self.cfg.relock_after_s * 1e3).round() as u64;
                 if self.cfg.relock_after_s > 0.0 && self.unlocked_ms >= limit_ms {
@@ -438,6 +441,7 @@ mod tests {
                 let aid = crate::DopplerAid {
                     doppler_hz: DOPPLER_HZ,
                     doppler_rate_hz_s: 0.0,
+                    coast: false,
                 };
                 ch.set_aid((aided && t > 2.9).then_some(aid), t);
                 let x: Vec<Complex32> = (first..first + n as u64).map(|k| sig.sample(k)).collect();

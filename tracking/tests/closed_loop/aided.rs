@@ -49,6 +49,7 @@ fn perfect_aid(traj: &Trajectory, t: f64) -> f64 {
     DopplerAid {
         doppler_hz: f,
         doppler_rate_hz_s: a,
+        coast: false,
     }
     .mean_over_hz(T)
 }

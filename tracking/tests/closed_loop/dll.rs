@@ -194,6 +194,7 @@ fn carrier_aided_code_loop() {
             DopplerAid {
                 doppler_hz: f,
                 doppler_rate_hz_s: a,
+                coast: false,
             }
             .mean_over_hz(T),
         )

@@ -280,6 +280,7 @@ impl gpsrx_tracking::AidingPort for OutageBridge {
         Some(DopplerAid {
             doppler_hz: f,
             doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
+            coast: false,
         })
     }
 }

@@ -465,6 +465,7 @@ impl InsFeedForward {
                 DopplerAid {
                     doppler_hz: f,
                     doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
+                    coast: false,
                 }
             }
             Some(alpha) => {
@@ -479,6 +480,7 @@ impl InsFeedForward {
                 DopplerAid {
                     doppler_hz: y,
                     doppler_rate_hz_s: alpha * (f - y),
+                    coast: false,
                 }
             }
         };

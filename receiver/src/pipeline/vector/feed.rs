@@ -18,7 +18,17 @@
 //! or goes (its loop's base frequency takes up the difference, `Channel::set_aid`).
 //! Every satellite with an ephemeris gets the aid, its channel locked or not: the filter's
 //! prediction is what holds a channel whose own loop is losing a weak signal. Predictions
-//! more than [`MAX_COAST_S`] from the last update give no aid.
+//! more than the filter's coast limit (`[vector] max_coast_s`) from the last update give no
+//! aid.
+//!
+//! **Through an outage.** The aid of a satellite the filter admitted a measurement of within
+//! that limit carries [`DopplerAid::coast`]: when its signal is blocked the channel coasts on
+//! the prediction (its loops hold their memories, its C/N0 test waits) instead of being
+//! released and searched again, so it is there with its code, bits and SV time the moment
+//! the signal returns. The code follows the carrier aid, so the predicted range rate steers
+//! it: the code drifts by the range-rate error over the outage only (a static receiver:
+//! nothing the filter's clock-drift error does not cover; 1 m/s^2 of unmodelled acceleration
+//! over 3 s: 4.5 m, 0.015 chip).
 
 use super::ekf::{State, BIAS, DRIFT};
 use gpsrx_core::constants::SPEED_OF_LIGHT_MPS;
@@ -32,14 +42,6 @@ use std::sync::Arc;
 
 /// Step of the Doppler rate, s.
 pub const RATE_STEP_S: f64 = 0.01;
-/// Longest prediction from the last update that still aids the channels, s; also the longest
-/// time without an admitted measurement before the filter gives the channels back
-/// (`super::tracker`). After a blockage of every signal the channels are found again by the
-/// search, and the first fixes after it (4-5 satellites, a velocity good to metres per second)
-/// are no base for a feed-forward: a filter that had coasted 3 s and took the returning
-/// channels in from them threw one out of lock again (35 m fixes on 4 satellites). Taking
-/// channels in from the filter's prediction without a search is a later part.
-pub const MAX_COAST_S: f64 = 1.0;
 
 /// The filter's state at one update, as the channels need it.
 #[derive(Debug, Clone)]
@@ -52,14 +54,19 @@ pub struct Snapshot {
     pub x: State,
     /// The ephemerides of the satellites the filter uses.
     pub ephemerides: Arc<BTreeMap<u8, Ephemeris>>,
+    /// Stream time of each satellite's last admitted measurement, s.
+    pub admitted_s: Arc<BTreeMap<u8, f64>>,
+    /// Longest prediction (from the update, and from a satellite's last admitted
+    /// measurement for its [`DopplerAid::coast`]), s: `[vector] max_coast_s`.
+    pub max_coast_s: f64,
 }
 
 impl Snapshot {
     /// The predicted Doppler (Hz) of `prn` at stream time `t_s` (module docs), None without
-    /// its ephemeris, beyond [`MAX_COAST_S`] or when the geometry is degenerate.
+    /// its ephemeris, beyond [`Snapshot::max_coast_s`] or when the geometry is degenerate.
     pub fn doppler_hz(&self, prn: u8, t_s: f64) -> Option<f64> {
         let dt = t_s - self.t_stream_s;
-        if !(dt.is_finite() && dt.abs() <= MAX_COAST_S) {
+        if !(dt.is_finite() && dt.abs() <= self.max_coast_s) {
             return None;
         }
         let eph = self.ephemerides.get(&prn)?;
@@ -84,6 +91,15 @@ impl Snapshot {
         f.is_finite().then_some(f)
     }
 
+    /// Whether the channel of `prn` may coast on the prediction at stream time `t_s` through
+    /// an outage of its signal: the filter admitted a measurement of it within
+    /// [`Snapshot::max_coast_s`] (module docs).
+    pub fn coasts(&self, prn: u8, t_s: f64) -> bool {
+        self.admitted_s
+            .get(&prn)
+            .is_some_and(|t| t_s - t <= self.max_coast_s)
+    }
+
     /// The receiver clock bias at the update, m.
     pub fn clock_bias_m(&self) -> f64 {
         self.x[BIAS]
@@ -106,6 +122,7 @@ impl gpsrx_tracking::AidingPort for VectorPort {
         Some(DopplerAid {
             doppler_hz: f,
             doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
+            coast: snap.coasts(prn.get(), t_s),
         })
     }
 }

@@ -15,8 +15,20 @@
 //!   fixes' velocities have shown less than 3 m/s^2 for 1 s, and hands them back as soon as
 //!   they show more (its feed-forward is a prediction 0.2-0.3 s ahead of its last
 //!   measurement).
+//! - **Through an outage** the filter predicts: a satellite whose measurement it admitted
+//!   within `[vector] max_coast_s` (5 s) has its channel held on the prediction while its
+//!   signal is blocked (`super::feed`), and a blockage of every satellite is bridged the same
+//!   way: the filter predicts on its motion and clock models alone (its covariance grows),
+//!   and the channels are there the moment the signals return.
+//! - **At a collapse** of several satellites' prompt power at once (a blockage, lost
+//!   samples: `crate::pipeline::timing::code_jump`), the filter goes back to its state at the
+//!   last epoch before the onset and takes no measurement for [`QUARANTINE_S`]: the epochs
+//!   just after it hold channels whose lock detectors have not yet seen the signal go (the
+//!   weaker ones, whose fall the fade detector cannot flag), and their noise, admitted under
+//!   a car's process noise (1 m/s per 0.1 s), threw the velocity 2.4 m/s off (12 Hz of
+//!   feed-forward error carried through the blockage).
 //! - **Back to scalar** when the filter's health test fails [`UNHEALTHY_EPOCHS`] epochs in a
-//!   row, or when no row was admitted for [`MAX_COAST_S`] (1 s: the channels lost everything): an
+//!   row, or when no row was admitted for `max_coast_s` (the channels lost everything): an
 //!   epoch is unhealthy when it had measurements and none was admitted, when more rows were
 //!   excluded than admitted, or when the 3-D position sigma is above [`MAX_POSITION_SIGMA_M`].
 //!   Fewer than 4 satellites do not make it unhealthy: the filter coasts on its prediction
@@ -35,7 +47,7 @@
 
 use super::dynamics::AccelWatch;
 use super::ekf::{ClockModel, FilterParams, NavFilter, RowKind, BIAS};
-use super::feed::{Snapshot, VectorPort, MAX_COAST_S};
+use super::feed::{Snapshot, VectorPort};
 use super::measure::{epoch_rows, RowModel};
 use super::noise::LoopNoise;
 use crate::config::{IonoModel, ReceiverConfig, TropoModel};
@@ -47,7 +59,7 @@ use gpsrx_nav::ephemeris::{Ephemeris, HealthPolicy};
 use gpsrx_nav::pvt::{chi_square_quantile, PvtOptions, PvtSolution};
 use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_nav::time::GpsTime;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 use std::sync::Arc;
 
 /// Unhealthy epochs in a row that hand the channels back to their scalar loops.
@@ -58,6 +70,12 @@ pub const MAX_POSITION_SIGMA_M: f64 = 100.0;
 pub const MIN_START_SATELLITES: usize = 5;
 /// Largest per-axis velocity sigma of a fix that starts the filter, m/s.
 pub const MAX_START_VELOCITY_SIGMA_MPS: f64 = 0.5;
+/// After a collapse, how long the filter takes no measurement, s (module docs): the lock
+/// detector's power-change test restarts it from five 20 ms tests, so a channel whose signal
+/// went reports no lock 0.1-0.2 s after.
+pub const QUARANTINE_S: f64 = 0.3;
+/// How far back the filter's states are kept for a rollback, s.
+const HISTORY_S: f64 = 1.0;
 
 /// What the navigation processor emitted in a round that vector tracking takes.
 #[derive(Debug, Clone)]
@@ -126,6 +144,14 @@ pub struct VectorTracking {
     last: Option<(GpsTime, f64)>,
     /// Stream time of the last update that admitted a row.
     last_admitted_s: f64,
+    /// Stream time of each satellite's last admitted row.
+    admitted_s: BTreeMap<u8, f64>,
+    /// `[vector] max_coast_s`.
+    max_coast_s: f64,
+    /// The filter after each of its last epochs: `(stream time, filter, last)`.
+    history: VecDeque<(f64, NavFilter, Option<(GpsTime, f64)>)>,
+    /// No measurement is taken up to this stream time (after a collapse), s.
+    quarantine_until_s: f64,
     /// Receiver time and stream time of the last epoch with a fix (module docs, "Time").
     pair: Option<(GpsTime, f64)>,
     unhealthy_in_row: u32,
@@ -164,6 +190,10 @@ impl VectorTracking {
             filter: None,
             last: None,
             last_admitted_s: 0.0,
+            admitted_s: BTreeMap::new(),
+            max_coast_s: v.max_coast_s,
+            history: VecDeque::new(),
+            quarantine_until_s: f64::NEG_INFINITY,
             pair: None,
             unhealthy_in_row: 0,
             dynamics: AccelWatch::default(),
@@ -249,6 +279,7 @@ impl VectorTracking {
         self.filter = Some(filter);
         self.last = Some((epoch.time, t_stream_s));
         self.last_admitted_s = t_stream_s;
+        self.admitted_s.clear();
         self.unhealthy_in_row = 0;
         self.summary.engagements += 1;
         self.publish(epoch, t_stream_s, nav);
@@ -262,6 +293,7 @@ impl VectorTracking {
         }
         self.port.snapshot = None;
         self.last = None;
+        self.history.clear();
         self.unhealthy_in_row = 0;
     }
 
@@ -297,7 +329,7 @@ impl VectorTracking {
         if !(dt.is_finite() && dt > 0.0) {
             return;
         }
-        if t_stream_s - self.last_admitted_s > MAX_COAST_S {
+        if t_stream_s - self.last_admitted_s > self.max_coast_s {
             self.disengage(t_stream_s, "no measurement admitted for too long");
             return;
         }
@@ -319,7 +351,11 @@ impl VectorTracking {
             allow_unhealthy: self.allow_unhealthy,
         };
         let eph = |prn: u8| self.ephemeris(nav, prn, epoch.time);
-        let rows = epoch_rows(epoch, &eph, &x, &model);
+        let rows = if t_stream_s <= self.quarantine_until_s {
+            Vec::new()
+        } else {
+            epoch_rows(epoch, &eph, &x, &model)
+        };
         let Some(filter) = self.filter.as_mut() else {
             return;
         };
@@ -340,6 +376,15 @@ impl VectorTracking {
         }
         if out.admitted > 0 {
             self.last_admitted_s = t_stream_s;
+        }
+        for row in &rows {
+            let excluded = out
+                .rejected
+                .iter()
+                .any(|(prn, kind, _)| *prn == row.prn && *kind == row.kind);
+            if !excluded {
+                self.admitted_s.insert(row.prn, t_stream_s);
+            }
         }
         let v = filter.velocity_mps();
         tracing::debug!(
@@ -371,7 +416,43 @@ impl VectorTracking {
             self.disengage(t_stream_s, &why);
             return;
         }
+        self.history
+            .push_back((t_stream_s, filter.clone(), self.last));
+        while self
+            .history
+            .front()
+            .is_some_and(|h| t_stream_s - h.0 > HISTORY_S)
+        {
+            self.history.pop_front();
+        }
         self.publish(epoch, t_stream_s, nav);
+    }
+
+    /// The prompt power of several satellites collapsed at once at stream time `t_s` (module
+    /// docs): back to the filter's state at the last epoch before it, and no measurement for
+    /// [`QUARANTINE_S`]; the channels are aided from that state meanwhile.
+    pub fn collapse(&mut self, t_s: f64) {
+        if self.filter.is_none() {
+            return;
+        }
+        while self.history.back().is_some_and(|h| h.0 > t_s) {
+            self.history.pop_back();
+        }
+        self.quarantine_until_s = t_s + QUARANTINE_S;
+        let Some((t_epoch, filter, Some((rx, t_last)))) = self.history.back().cloned() else {
+            return;
+        };
+        tracing::debug!(
+            "{t_s:.3} s: collapse: the vector filter goes back to its epoch at {t_epoch:.2} s and takes no measurement for {QUARANTINE_S} s"
+        );
+        let x = *filter.state();
+        self.filter = Some(filter);
+        self.last = Some((rx, t_last));
+        if let Some(snap) = self.port.snapshot.as_mut() {
+            snap.t_stream_s = t_last;
+            snap.gps_time = rx.add_seconds(-x[BIAS] / SPEED_OF_LIGHT_MPS);
+            snap.x = x;
+        }
     }
 
     /// The snapshot the channels are aided from until the next epoch.
@@ -388,6 +469,8 @@ impl VectorTracking {
             gps_time: epoch.time.add_seconds(-x[BIAS] / SPEED_OF_LIGHT_MPS),
             x,
             ephemerides: Arc::new(ephemerides),
+            admitted_s: Arc::new(self.admitted_s.clone()),
+            max_coast_s: self.max_coast_s,
         });
     }
 }

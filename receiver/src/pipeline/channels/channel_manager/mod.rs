@@ -678,10 +678,10 @@ fn run_channel(
         }
         match window.get(start, n) {
             Some(x) => {
-                if let Some(aid) = aid {
-                    let t = start as f64 / ch.fs_hz();
-                    ch.set_aid(aid.doppler_aid(ch.prn(), t), t);
-                }
+                // Without a port (vector tracking off, an outage bridge over) the aid goes: a
+                // channel must not extrapolate the last one for ever.
+                let t = start as f64 / ch.fs_hz();
+                ch.set_aid(aid.and_then(|a| a.doppler_aid(ch.prn(), t)), t);
                 if let Some(e) = ch.process_period(x) {
                     out.push(e);
                 }
