@@ -1057,11 +1057,16 @@ impl Channel {
         let ff = ff_opt.unwrap_or(0.0);
         let coasting = self.coasting_on_aid();
         if coasting && !self.coasted_last {
-            // The feed-forward supplies the Doppler rate; what a 3rd-order loop learned of it
-            // in the noise before the fade was flagged (40-60 ms) is noise: at 18 Hz a
-            // Doppler-rate memory wanders about 15 Hz/s in 40 ms, which the coast would carry
-            // on as a ramp (measured: 16 Hz/s, 40 Hz after 2.5 s).
-            self.carrier.preset_doppler_rate(0.0);
+            // The feed-forward supplies the Doppler rate; what the loop learned of it in the
+            // noise before the loss was seen would be carried on as a ramp (measured: 16 Hz/s,
+            // 40 Hz after 2.5 s).
+            self.carrier.start_coast();
+            self.code_loop.start_coast();
+        }
+        if !coasting && self.coasted_last {
+            // The C/N0 estimates still average the outage for a while (a 31 dB-Hz satellite
+            // back from 3 s of blockage read 24.7 dB-Hz 1 s later and was released).
+            self.aided_fade_hold_ms = FADE_RECOVERY_HOLD_MS;
         }
         self.coasted_last = coasting;
         let (co, cl) = if coasting {
@@ -1218,8 +1223,8 @@ impl Channel {
 
     /// The channel coasts on its aid: in tracking, its signal is gone (the prompt power has
     /// collapsed, or, where the fade detector cannot see the fall of a weak signal, its C/N0
-    /// estimate is below [`ChannelConfig::cn0_lost_dbhz`]) and the aid predicts it through
-    /// the outage ([`DopplerAid::coast`]: vector tracking). Its
+    /// estimate is [`COAST_BELOW_LOST_DB`] below [`ChannelConfig::cn0_lost_dbhz`]) and the aid
+    /// predicts it through the outage ([`DopplerAid::coast`]: vector tracking). Its
     /// loops hold their memories (their discriminators would read noise) and its NCOs follow
     /// the aid; its lock is not counted lost, its loops are not switched or narrowed, and its
     /// C/N0 does not release it (the fade detector holds its reference, so the fade lasts
@@ -1227,7 +1232,7 @@ impl Channel {
     /// its filter predicts the satellite).
     pub(crate) fn coasting_on_aid(&self) -> bool {
         self.state == ChannelState::Track
-            && (self.fade.faded() || self.cn0_dbhz < self.cfg.cn0_lost_dbhz)
+            && (self.fade.faded() || self.cn0_dbhz < self.cfg.cn0_lost_dbhz - COAST_BELOW_LOST_DB)
             && self.coast_aid()
     }
 
@@ -1314,6 +1319,14 @@ impl Channel {
         self.loops == TrackLoops::WeakDynamic
     }
 }
+
+/// How far below [`ChannelConfig::cn0_lost_dbhz`] a C/N0 estimate says the signal is gone, so
+/// that a channel with a coasting aid coasts ([`Channel::coasting_on_aid`]), dB: the NWPR
+/// estimator on noise alone read 0-15 dB-Hz in 3 s blockages; a signal between this and the
+/// loss threshold keeps its loops running (coasting there froze satellites at 24-26 dB-Hz,
+/// whose estimates cross the threshold back and forth, out of their lock: 0.91 of the time
+/// locked scalar, 0.73 coasting).
+pub const COAST_BELOW_LOST_DB: f64 = 6.0;
 
 /// How long the Costas gain keeps its C/N0 after the first new bit edge of a restarted bit
 /// synchronisation, ms: the phase-lock detector's memory then holds the unaligned blocks;

@@ -64,6 +64,11 @@ impl CodeLoop {
         }
     }
 
+    /// Starts a coast ([`CodeLoop::coast`]): the filter forgets its last input.
+    pub fn start_coast(&mut self) {
+        self.filter.forget_input();
+    }
+
     /// One interval without a usable prompt (the signal is gone and an aid predicts it): the
     /// DLL runs on zero error (a 1st-order DLL adds nothing, a 2nd-order one holds its rate), so
     /// the code follows the carrier aid `carrier_aid_chips_s` alone.

@@ -273,6 +273,18 @@ impl LoopFilter {
         }
     }
 
+    /// Forgets the last error input: the bilinear integrators would otherwise add half of it
+    /// once more at the next update. Before a stretch of zero-error updates (a coast), so
+    /// that they hold the memories exactly (a 20 ms 3rd-order loop's last noisy input carried
+    /// on as 8 Hz/s of Doppler rate).
+    pub fn forget_input(&mut self) {
+        let mut carry = 0.0;
+        for i in 0..self.n_int {
+            self.x_prev[i] = carry;
+            carry = self.y[i];
+        }
+    }
+
     /// Clears the integrators.
     pub fn reset(&mut self) {
         self.y = [0.0; 2];
@@ -345,6 +357,29 @@ impl LoopFilter {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn after_forget_input_zero_errors_hold_the_memories_exactly() {
+        let t = 0.02;
+        for order in [2u8, 3] {
+            let mut f = LoopFilter::pll(order, 6.0).unwrap_or_else(|e| panic!("{e}"));
+            for k in 0..50 {
+                f.update(if k % 3 == 0 { 0.2 } else { -0.1 }, 0.0, t);
+            }
+            f.update(0.25, 0.0, t); // a last noisy error
+            f.preset_rate(0.0);
+            f.forget_input();
+            let before = f.integrator();
+            for _ in 0..150 {
+                assert_eq!(f.update(0.0, 0.0, t), f.integrator());
+            }
+            assert!(
+                (f.integrator() - before).abs() < 1e-12,
+                "order {order}: memory moved from {before} to {}",
+                f.integrator()
+            );
+        }
+    }
     use num_complex::Complex64;
 
     /// `update` and `transfer_functions` describe the same filter: drive both with the same
