@@ -629,6 +629,7 @@ fn aided_loops_are_used_while_the_aid_is_on() {
             doppler_hz: truth_doppler(prn.get(), t).unwrap_or(0.0),
             doppler_rate_hz_s: 0.0,
             coast: false,
+            checked: false,
         })
     };
     let mut src =

@@ -405,6 +405,7 @@ rate_hz = 1.0
             doppler_rate_hz_s: (c.carrier_cycles - 2.0 * b.carrier_cycles + a.carrier_cycles)
                 / (h * h),
             coast: false,
+            checked: false,
         })
     };
     // The turn runs from 3 s to 15 s (acceleration ramps in over 0.5 s): measure 4-14.5 s.
@@ -592,6 +593,7 @@ fn blockage_on_truth_aid(cn0_dbhz: f64, coast: bool) -> Vec<(u8, bool, f64, Opti
             doppler_rate_hz_s: (c.carrier_cycles - 2.0 * b.carrier_cycles + a.carrier_cycles)
                 / (h * h),
             coast,
+            checked: false,
         })
     };
     let truth = Truth::new(&sim);

@@ -419,6 +419,39 @@ fn outage_blocks_the_signal_and_it_returns() {
 }
 
 #[test]
+fn a_fade_lowers_the_cn0_at_its_rate_and_holds_the_level_reached() {
+    // 45 dB-Hz, faded by 20 dB/s from 0.3 to 0.6 s: 45 before, 39 at the end and after it.
+    let sc = scenario(
+        "[satellites]\nprns = [31]\ncn0_all_dbhz = 45.0\n[[fades]]\nstart_s = 0.3\nend_s = 0.6\ndb_per_s = -20.0\n[truth]\nrate_hz = 10.0",
+        0.9,
+        2.048e6,
+        "ci8",
+    );
+    let (sim, _dir, report, x) = simulate_and_read(&sc);
+    let sat = &sim.satellites[0];
+    let before = measured_cn0(&sim, sat, (&x, 2.048e6), 50, 200);
+    let after = measured_cn0(&sim, sat, (&x, 2.048e6), 650, 200);
+    assert!(
+        (before - 45.0).abs() < 1.0 && (after - 39.0).abs() < 1.0,
+        "{before} {after}"
+    );
+    // The truth file's C/N0 column follows the ramp.
+    let truth = std::fs::read_to_string(&report.truth_sv_path).unwrap_or_else(|e| panic!("{e}"));
+    for l in truth.lines().skip(1) {
+        let f: Vec<&str> = l.split(',').collect();
+        let (t, cn0): (f64, f64) = (
+            f[0].parse().unwrap_or(f64::NAN),
+            f[7].parse().unwrap_or(f64::NAN),
+        );
+        let want = 45.0 - 20.0 * (t.min(0.6) - 0.3).max(0.0);
+        assert!(
+            (cn0 - want).abs() < 1e-3,
+            "t {t}: truth C/N0 {cn0}, want {want}"
+        );
+    }
+}
+
+#[test]
 fn csv_trajectory_is_smooth_and_follows_the_points() {
     // A circle of radius 200 m at 20 m/s (2 m/s^2 centripetal) given as LLH points at 10 Hz.
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));

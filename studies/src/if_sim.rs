@@ -328,6 +328,7 @@ impl SatTruth {
             doppler_hz: (c - a) / (2.0 * h),
             doppler_rate_hz_s: (c - 2.0 * b + a) / (h * h),
             coast: false,
+            checked: false,
         }
     }
 }

@@ -26,6 +26,11 @@ pub struct DopplerAid {
     /// (`Channel::coasting_on_aid`). False for an INS's aid, whose channels run their own
     /// outage rules.
     pub coast: bool,
+    /// The aid's source checked the channel's measurements against the others within the
+    /// last second and admitted them (vector tracking's innovation test): the channel counts
+    /// as lost, and gives no observables, only below
+    /// `ChannelConfig::vector_cn0_lost_dbhz` instead of `cn0_lost_dbhz`.
+    pub checked: bool,
 }
 
 impl DopplerAid {
@@ -226,6 +231,7 @@ mod tests {
             doppler_hz: 100.0,
             doppler_rate_hz_s: 50.0,
             coast: false,
+            checked: false,
         };
         assert!((aid.mean_over_hz(0.02) - 100.5).abs() < 1e-12);
         assert_eq!(carrier_nco_hz(f64::NAN, 3.0), 3.0);

@@ -62,6 +62,13 @@ pub struct ChannelConfig {
     /// loops can stay wide enough for 10 g. An aided channel runs `aided_track` instead, with
     /// these loops' integration time while weak (when its bandwidth allows it).
     pub weak_track: Option<LoopConfig>,
+    /// Loops for a weak signal whose measurements the navigation filter of vector tracking
+    /// checks ([`DopplerAid::checked`]; `None`: `weak_track`, or `aided_track` if set). The
+    /// filter's feed-forward takes the dynamics out, so the loop can be narrower than
+    /// `weak_track` (3rd order at 3 Hz instead of 6: half the thermal phase variance, 15 deg
+    /// of jitter at 17.9 dB-Hz instead of 20.3 with 20 ms), its 3rd order following what the
+    /// prediction, 0.2-0.3 s behind, misses of a changing acceleration.
+    pub vector_weak_track: Option<LoopConfig>,
     /// C/N0 below which the channel takes the `weak_track` loops, dB-Hz.
     pub weak_enter_dbhz: f64,
     /// C/N0 above which it goes back to `track`, dB-Hz (> `weak_enter_dbhz`: hysteresis).
@@ -74,6 +81,14 @@ pub struct ChannelConfig {
     pub fll_assist_s: f64,
     /// C/N0 below which the code is considered lost, dB-Hz.
     pub cn0_lost_dbhz: f64,
+    /// C/N0 below which a channel whose measurements the navigation filter of vector tracking
+    /// checks ([`DopplerAid::checked`]) is considered lost, dB-Hz (a value above
+    /// `cn0_lost_dbhz` acts as `cn0_lost_dbhz`).
+    /// A scalar channel needs the margin of `cn0_lost_dbhz` against false locks and
+    /// cross-correlations, which nothing else checks; a checked one's pseudorange and Doppler
+    /// pass the filter's innovation test against the other satellites every epoch, and a
+    /// 20 ms loop at 6 Hz holds the phase to about 20.5 dB-Hz (thermal jitter 15 deg).
+    pub vector_cn0_lost_dbhz: f64,
     /// Length of one C/N0 estimate (NWPR over 20 ms blocks aligned to data bits), s: a multiple
     /// of 20 ms. 0.2 s estimates scatter by about 0.5 dB; 1 s ones by 0.2 dB.
     pub cn0_window_s: f64,
@@ -139,11 +154,23 @@ impl Default for ChannelConfig {
                 el_spacing_chips: 1.0,
                 ..LoopConfig::default()
             }),
+            vector_weak_track: Some(LoopConfig {
+                pll_order: 3,
+                pll_bw_hz: 3.0,
+                fll_order: 0,
+                fll_bw_hz: 0.0,
+                dll_order: 1,
+                dll_bw_hz: 0.5,
+                t_coh_s: 20.0e-3,
+                el_spacing_chips: 1.0,
+                ..LoopConfig::default()
+            }),
             weak_enter_dbhz: 32.0,
             weak_leave_dbhz: 35.0,
             min_pull_in_s: 0.5,
             fll_assist_s: 0.3,
             cn0_lost_dbhz: 25.0,
+            vector_cn0_lost_dbhz: 22.0,
             cn0_window_s: 0.2,
             lost_estimates: 5,
             // A slipped narrow loop does not come back by itself (issue 25): after 2 s out of
@@ -168,7 +195,11 @@ impl ChannelConfig {
         if let Some(w) = &self.weak_pull_in {
             w.validate()?;
         }
-        let others = self.aided_track.iter().chain(self.weak_track.iter());
+        let others = self
+            .aided_track
+            .iter()
+            .chain(self.weak_track.iter())
+            .chain(self.vector_weak_track.iter());
         for l in std::iter::once(&self.track).chain(others) {
             l.validate()?;
             let ms = (l.t_coh_s * 1e3).round() as usize;
@@ -233,6 +264,13 @@ impl ChannelConfig {
             return Err(ConfigError::OutOfRange {
                 field: "cn0_lost_dbhz",
                 value: self.cn0_lost_dbhz,
+                valid: "a C/N0 in dB-Hz".into(),
+            });
+        }
+        if !self.vector_cn0_lost_dbhz.is_finite() {
+            return Err(ConfigError::OutOfRange {
+                field: "vector_cn0_lost_dbhz",
+                value: self.vector_cn0_lost_dbhz,
                 valid: "a C/N0 in dB-Hz".into(),
             });
         }
@@ -306,6 +344,10 @@ pub struct ChannelEpoch {
     pub doppler_hz: f64,
     /// Latest C/N0 estimate, dB-Hz (NaN before the first).
     pub cn0_dbhz: f64,
+    /// The C/N0 below which the channel counted as lost over the interval, dB-Hz
+    /// ([`ChannelConfig::cn0_lost_dbhz`], or [`ChannelConfig::vector_cn0_lost_dbhz`] while the
+    /// navigation filter checks it): below it the report gives no observables.
+    pub cn0_lost_dbhz: f64,
     /// Phase lock: the `cos 2 phi` indicator says locked and the prompt power has not just
     /// collapsed ([`crate::fade_detector`]: a wide PLL on noise keeps `cos 2 phi` high for a
     /// second after a blockage). Measurements are usable only with it.
@@ -861,8 +903,8 @@ impl Channel {
         }
         // A blocked signal that an aid predicts: its noise is no new level (unless the C/N0
         // still reads the signal: then the gain changed).
-        self.fade
-            .hold_reference(self.coast_aid() && !(self.cn0_dbhz >= self.cfg.cn0_lost_dbhz));
+        let signal_read = self.cn0_dbhz >= self.cn0_lost_dbhz();
+        self.fade.hold_reference(self.coast_aid() && !signal_read);
         self.fade.push(p);
         self.watch_fade();
         if matches!(self.bit_sync.state(), BitSyncState::Failed) {
@@ -934,7 +976,7 @@ impl Channel {
             let coasting = self.ff_applied_hz.is_some()
                 && (self.fade.faded() || self.aided_fade_hold_ms > 0)
                 || self.coasting_on_aid();
-            self.low_cn0_count = if c < self.cfg.cn0_lost_dbhz && !coasting {
+            self.low_cn0_count = if c < self.cn0_lost_dbhz() && !coasting {
                 self.low_cn0_count + 1
             } else {
                 0
@@ -1132,6 +1174,7 @@ impl Channel {
             carrier_phase_cycles: ph0,
             doppler_hz: f0,
             cn0_dbhz: self.cn0_dbhz,
+            cn0_lost_dbhz: self.cn0_lost_dbhz(),
             pll_lock: self.pll_lock.locked() && !self.fade.faded(),
             pll_lock_metric: self.pll_lock.cos_2phi(),
             code_lock: self.code_lock.locked(),
@@ -1194,6 +1237,9 @@ impl Channel {
     /// applied (if configured), else the weak-signal ones while the C/N0 is low (if
     /// configured), else the normal ones.
     fn wanted_loops(&self) -> TrackLoops {
+        if self.weak && self.checked_aid() && self.cfg.vector_weak_track.is_some() {
+            return TrackLoops::VectorWeak;
+        }
         if self.ff_applied_hz.is_some() && self.cfg.aided_track.is_some() {
             if self.weak && self.aided_weak_config().is_some() {
                 TrackLoops::AidedWeak
@@ -1216,6 +1262,22 @@ impl Channel {
         }
     }
 
+    /// The C/N0 below which the channel counts as lost now: [`ChannelConfig::cn0_lost_dbhz`],
+    /// or [`ChannelConfig::vector_cn0_lost_dbhz`] while an aid that checks its measurements is
+    /// applied ([`DopplerAid::checked`]), dB-Hz.
+    pub fn cn0_lost_dbhz(&self) -> f64 {
+        if self.checked_aid() {
+            self.cfg.vector_cn0_lost_dbhz.min(self.cfg.cn0_lost_dbhz)
+        } else {
+            self.cfg.cn0_lost_dbhz
+        }
+    }
+
+    /// An aid that checks the channel's measurements is applied ([`DopplerAid::checked`]).
+    fn checked_aid(&self) -> bool {
+        self.ff_applied_hz.is_some() && self.aid.is_some_and(|(a, _)| a.checked)
+    }
+
     /// An aid that predicts the signal through an outage is applied ([`DopplerAid::coast`]).
     fn coast_aid(&self) -> bool {
         self.ff_applied_hz.is_some() && self.aid.is_some_and(|(a, _)| a.coast)
@@ -1223,7 +1285,7 @@ impl Channel {
 
     /// The channel coasts on its aid: in tracking, its signal is gone (the prompt power has
     /// collapsed, or, where the fade detector cannot see the fall of a weak signal, its C/N0
-    /// estimate is [`COAST_BELOW_LOST_DB`] below [`ChannelConfig::cn0_lost_dbhz`]) and the aid
+    /// estimate is [`COAST_BELOW_LOST_DB`] below its loss threshold, [`Channel::cn0_lost_dbhz`]) and the aid
     /// predicts it through the outage ([`DopplerAid::coast`]: vector tracking). Its
     /// loops hold their memories (their discriminators would read noise) and its NCOs follow
     /// the aid; its lock is not counted lost, its loops are not switched or narrowed, and its
@@ -1232,7 +1294,7 @@ impl Channel {
     /// its filter predicts the satellite).
     pub(crate) fn coasting_on_aid(&self) -> bool {
         self.state == ChannelState::Track
-            && (self.fade.faded() || self.cn0_dbhz < self.cfg.cn0_lost_dbhz - COAST_BELOW_LOST_DB)
+            && (self.fade.faded() || self.cn0_dbhz < self.cn0_lost_dbhz() - COAST_BELOW_LOST_DB)
             && self.coast_aid()
     }
 
@@ -1265,6 +1327,7 @@ impl Channel {
             TrackLoops::Aided => self.cfg.aided_track,
             TrackLoops::Weak => self.cfg.weak_track,
             TrackLoops::WeakDynamic => self.cfg.weak_track.map(|w| dynamic_weak_config(&w)),
+            TrackLoops::VectorWeak => self.cfg.vector_weak_track,
             TrackLoops::Normal => None,
         }
         .unwrap_or(self.cfg.track)
@@ -1320,7 +1383,7 @@ impl Channel {
     }
 }
 
-/// How far below [`ChannelConfig::cn0_lost_dbhz`] a C/N0 estimate says the signal is gone, so
+/// How far below its loss threshold ([`Channel::cn0_lost_dbhz`]) a C/N0 estimate says the signal is gone, so
 /// that a channel with a coasting aid coasts ([`Channel::coasting_on_aid`]), dB: the NWPR
 /// estimator on noise alone read 0-15 dB-Hz in 3 s blockages; a signal between this and the
 /// loss threshold keeps its loops running (coasting there froze satellites at 24-26 dB-Hz,
@@ -1351,6 +1414,8 @@ enum TrackLoops {
     Weak,
     /// [`ChannelConfig::weak_track`] widened for dynamics ([`dynamic_weak_config`]).
     WeakDynamic,
+    /// [`ChannelConfig::vector_weak_track`], while weak and checked by vector tracking.
+    VectorWeak,
 }
 
 /// Time in tracking before a channel's Doppler rate is read ([`Channel::los_rate_hz_s`]), ms:

@@ -57,6 +57,7 @@ pub fn default_toml() -> anyhow::Result<String> {
          min_pull_in_s = {:?}      # minimum pull-in time before the hand-over to [tracking.track], s\n\
          fll_assist_s = {:?}       # the pull-in FLL assist is switched off after this, s\n\
          cn0_lost_dbhz = {:?}      # C/N0 below which a channel counts as lost, dB-Hz\n\
+         vector_cn0_lost_dbhz = {:?}  # the same for a channel the vector filter checks (its innovation test), dB-Hz\n\
          cn0_window_s = {:?}       # length of one C/N0 estimate (bit-aligned NWPR), s\n\
          lost_estimates = {}       # consecutive low estimates that release the channel\n\
          relock_after_s = {:?}     # out of phase lock this long in tracking: pull the carrier in again (state recover), s (0: never)\n\
@@ -70,6 +71,7 @@ pub fn default_toml() -> anyhow::Result<String> {
          # Tracking loops after phase lock and bit synchronisation (--pll-order etc. set these).\n\
          # 3rd order at 18 Hz follows 10 g manoeuvres.\n{}\n\
          # Tracking loops for weak signals (C/N0 below weak_enter_dbhz): 20 ms, narrow.\n{}\n\
+         # Tracking loops for weak signals the vector filter checks and feeds forward: narrower.\n{}\n\
          # Weak-signal pull-in (acquisition C/N0 below enter_dbhz): an FLL alone on 10 ms sums\n\
          # while the bits are synchronised differentially, then a bit-aligned 20 ms PLL, then\n\
          # [tracking.weak_track]. Remove the section's keys to keep its defaults.\n\
@@ -119,6 +121,7 @@ pub fn default_toml() -> anyhow::Result<String> {
         c.min_pull_in_s,
         c.fll_assist_s,
         c.cn0_lost_dbhz,
+        c.vector_cn0_lost_dbhz,
         c.cn0_window_s,
         c.lost_estimates,
         c.relock_after_s,
@@ -130,6 +133,10 @@ pub fn default_toml() -> anyhow::Result<String> {
         loops("pull_in", &c.pull_in)?,
         loops("track", &c.track)?,
         loops("weak_track", &c.weak_track.unwrap_or(c.track))?,
+        loops(
+            "vector_weak_track",
+            &c.vector_weak_track.or(c.weak_track).unwrap_or(c.track)
+        )?,
         w.enter_dbhz,
         w.fll_assist_s,
         w.bit_sync_dbhz,

@@ -25,6 +25,7 @@ pub fn report(
         carrier_phase_cycles: carrier_cycles,
         doppler_hz,
         cn0_dbhz,
+        cn0_lost_dbhz: 25.0,
         pll_lock: true,
         pll_lock_metric: 0.9,
         code_lock: true,

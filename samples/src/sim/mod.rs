@@ -76,6 +76,8 @@ pub struct SimSatellite {
     cn0_fixed_dbhz: Option<f64>,
     /// Outage windows (s since start) that block this satellite.
     blocked: Vec<(f64, f64)>,
+    /// C/N0 ramps that apply to this satellite.
+    fades: Vec<scenario::Fade>,
     /// Elevation at the start, degrees.
     pub start_elevation_deg: f64,
 }
@@ -238,6 +240,12 @@ impl Simulator {
                 .filter(|o| o.prns.is_empty() || o.prns.contains(&prn.get()))
                 .map(|o| (o.start_s, o.end_s))
                 .collect();
+            let fades = scenario
+                .fades
+                .iter()
+                .filter(|f| f.prns.is_empty() || f.prns.contains(&prn.get()))
+                .cloned()
+                .collect();
             satellites.push(SimSatellite {
                 prn,
                 ephemeris: eph,
@@ -245,6 +253,7 @@ impl Simulator {
                 bits,
                 cn0_fixed_dbhz,
                 blocked,
+                fades,
                 start_elevation_deg: el_deg,
             });
         }
@@ -301,12 +310,14 @@ impl Simulator {
         self.total_samples.div_ceil(self.chunk_samples() as u64)
     }
 
-    /// C/N0 (dB-Hz) of a satellite at elevation `el_rad`.
-    pub fn cn0_dbhz(&self, sat: &SimSatellite, el_rad: f64) -> f64 {
-        sat.cn0_fixed_dbhz.unwrap_or_else(|| {
+    /// C/N0 (dB-Hz) of a satellite at elevation `el_rad` and time `t_s` (its fixed value or
+    /// the elevation model, plus its `[[fades]]`).
+    pub fn cn0_dbhz(&self, sat: &SimSatellite, el_rad: f64, t_s: f64) -> f64 {
+        let base = sat.cn0_fixed_dbhz.unwrap_or_else(|| {
             let s = &self.scenario.satellites;
             s.cn0_zenith_dbhz - s.cn0_horizon_loss_db * (1.0 - el_rad.max(0.0).sin())
-        })
+        });
+        base + sat.fades.iter().map(|f| f.db_at(t_s)).sum::<f64>()
     }
 
     /// Whether a satellite's signal is present at `t_s` (above the horizon, not blocked).
@@ -373,7 +384,7 @@ impl Simulator {
                 if !self.signal_on(sat, t_node, slow.el_rad) {
                     continue;
                 }
-                let amp = self.amplitude(self.cn0_dbhz(sat, slow.el_rad));
+                let amp = self.amplitude(self.cn0_dbhz(sat, slow.el_rad, t_node));
                 let (o0, o1) = (&obs[j], &obs[j + 1]);
                 let ramp = signal::PhaseRamp {
                     chips0: o0.chips,
@@ -487,7 +498,7 @@ impl Simulator {
                 (
                     s.prn.get(),
                     slow.el_rad.to_degrees(),
-                    self.cn0_dbhz(s, slow.el_rad),
+                    self.cn0_dbhz(s, slow.el_rad, 0.0),
                 )
             })
             .collect();

@@ -64,6 +64,9 @@ pub struct Scenario {
     /// Signal blockages.
     #[serde(default)]
     pub outages: Vec<Outage>,
+    /// C/N0 ramps (a tracking-threshold scan: satellites fading slowly to nothing).
+    #[serde(default)]
+    pub fades: Vec<Fade>,
     /// Truth output options.
     #[serde(default)]
     pub truth: TruthConfig,
@@ -461,6 +464,29 @@ impl Default for AtmosphereConfig {
     }
 }
 
+/// A C/N0 ramp: from `start_s` to `end_s` the listed satellites' C/N0 changes by `db_per_s`
+/// (negative: a fade), and stays at the level reached after it.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fade {
+    /// Start, seconds from the first sample.
+    pub start_s: f64,
+    /// End, seconds from the first sample.
+    pub end_s: f64,
+    /// Rate of the C/N0 change, dB/s.
+    pub db_per_s: f64,
+    /// Faded PRNs (empty: all).
+    #[serde(default)]
+    pub prns: Vec<u8>,
+}
+
+impl Fade {
+    /// The C/N0 change it has made at `t_s`, dB.
+    pub fn db_at(&self, t_s: f64) -> f64 {
+        self.db_per_s * (t_s.min(self.end_s) - self.start_s).max(0.0)
+    }
+}
+
 /// A window in which signals are blocked.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -637,6 +663,20 @@ impl Scenario {
                 return bad(format!(
                     "[[outages]] {}..{} s: end must follow start",
                     o.start_s, o.end_s
+                ));
+            }
+        }
+        for f in &self.fades {
+            if !(f.start_s.is_finite() && f.end_s.is_finite() && f.end_s > f.start_s) {
+                return bad(format!(
+                    "[[fades]] {}..{} s: end must follow start",
+                    f.start_s, f.end_s
+                ));
+            }
+            if !(f.db_per_s.is_finite() && f.db_per_s.abs() <= 100.0) {
+                return bad(format!(
+                    "[[fades]] db_per_s = {}: use a rate within +-100 dB/s",
+                    f.db_per_s
                 ));
             }
         }

@@ -119,7 +119,7 @@ pub fn write_satellite_truth(sim: &Simulator, path: &Path) -> Result<(), SimErro
                 code_rate,
                 o.carrier_cycles,
                 doppler,
-                if on { sim.cn0_dbhz(sat, slow.el_rad) } else { f64::NEG_INFINITY },
+                if on { sim.cn0_dbhz(sat, slow.el_rad, t) } else { f64::NEG_INFINITY },
                 o.pseudorange_m,
                 o.range_m,
                 slow.iono_m,

@@ -50,6 +50,7 @@ fn perfect_aid(traj: &Trajectory, t: f64) -> f64 {
         doppler_hz: f,
         doppler_rate_hz_s: a,
         coast: false,
+        checked: false,
     }
     .mean_over_hz(T)
 }

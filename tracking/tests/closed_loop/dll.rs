@@ -195,6 +195,7 @@ fn carrier_aided_code_loop() {
                 doppler_hz: f,
                 doppler_rate_hz_s: a,
                 coast: false,
+                checked: false,
             }
             .mean_over_hz(T),
         )

@@ -281,6 +281,7 @@ impl gpsrx_tracking::AidingPort for OutageBridge {
             doppler_hz: f,
             doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
             coast: false,
+            checked: false,
         })
     }
 }

@@ -466,6 +466,7 @@ impl InsFeedForward {
                     doppler_hz: f,
                     doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
                     coast: false,
+                    checked: false,
                 }
             }
             Some(alpha) => {
@@ -481,6 +482,7 @@ impl InsFeedForward {
                     doppler_hz: y,
                     doppler_rate_hz_s: alpha * (f - y),
                     coast: false,
+                    checked: false,
                 }
             }
         };

@@ -550,6 +550,7 @@ mod tests {
             carrier_phase_cycles: 0.0,
             doppler_hz,
             cn0_dbhz: 45.0,
+            cn0_lost_dbhz: 25.0,
             pll_lock: true,
             pll_lock_metric: 1.0,
             code_lock: true,

@@ -439,7 +439,7 @@ impl ObservableBuilder {
         // has settled.
         let usable = e.pll_lock
             && e.state != ChannelState::Lost
-            && e.cn0_dbhz >= self.min_cn0_dbhz
+            && e.cn0_dbhz >= self.min_cn0_dbhz.min(e.cn0_lost_dbhz)
             && e.ms_count >= CODE_SETTLE_MS;
         let lost = self.lli.entry(e.prn).or_insert(true);
         *lost |= !usable;

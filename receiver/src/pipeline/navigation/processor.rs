@@ -341,12 +341,13 @@ impl NavigationProcessor {
         self.time.push(e);
         self.searched.insert(e.prn);
         let locked = e.bit.is_some() || (e.pll_lock && e.state == ChannelState::Track);
-        if locked && e.cn0_dbhz >= self.cn0_lost_dbhz {
+        // The channel's own threshold where vector tracking checks it (lower), else ours.
+        let cn0_lost_dbhz = self.cn0_lost_dbhz.min(e.cn0_lost_dbhz);
+        if locked && e.cn0_dbhz >= cn0_lost_dbhz {
             self.locked.insert(e.prn);
         }
         self.decode(e, aiding, sink)?;
-        let usable =
-            e.pll_lock && e.state != ChannelState::Lost && e.cn0_dbhz >= self.cn0_lost_dbhz;
+        let usable = e.pll_lock && e.state != ChannelState::Lost && e.cn0_dbhz >= cn0_lost_dbhz;
         let note = match self.decoders.get_mut(&e.prn) {
             Some(dec) => self.time.observe(e, dec, usable),
             None => None,

@@ -42,6 +42,10 @@ use std::sync::Arc;
 
 /// Step of the Doppler rate, s.
 pub const RATE_STEP_S: f64 = 0.01;
+/// How recent the filter's last admitted measurement of a satellite must be for its channel
+/// to count as checked ([`DopplerAid::checked`]), s: a few epochs (a channel the innovation
+/// test starts excluding falls back to the scalar loss threshold within a second).
+pub const CHECKED_S: f64 = 1.0;
 
 /// The filter's state at one update, as the channels need it.
 #[derive(Debug, Clone)]
@@ -100,6 +104,15 @@ impl Snapshot {
             .is_some_and(|t| t_s - t <= self.max_coast_s)
     }
 
+    /// Whether the filter checked and admitted a measurement of `prn` within [`CHECKED_S`]
+    /// of stream time `t_s`: its channel's loss threshold is then
+    /// `[tracking] vector_cn0_lost_dbhz` ([`DopplerAid::checked`]).
+    pub fn checked(&self, prn: u8, t_s: f64) -> bool {
+        self.admitted_s
+            .get(&prn)
+            .is_some_and(|t| t_s - t <= CHECKED_S)
+    }
+
     /// The receiver clock bias at the update, m.
     pub fn clock_bias_m(&self) -> f64 {
         self.x[BIAS]
@@ -123,6 +136,7 @@ impl gpsrx_tracking::AidingPort for VectorPort {
             doppler_hz: f,
             doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
             coast: snap.coasts(prn.get(), t_s),
+            checked: snap.checked(prn.get(), t_s),
         })
     }
 }

@@ -112,6 +112,16 @@ fn starts_the_filter(sol: &PvtSolution) -> bool {
     sol.n_sv >= MIN_START_SATELLITES && velocity_ok && sol.vel_ecef_mps.is_some()
 }
 
+/// The filter after an epoch, kept for a rollback ([`VectorTracking::collapse`]).
+#[derive(Debug, Clone)]
+struct Saved {
+    /// Stream time of the epoch, s.
+    t_stream_s: f64,
+    filter: NavFilter,
+    /// Receiver time and stream time of the update.
+    last: Option<(GpsTime, f64)>,
+}
+
 /// Vector tracking over a run.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct VectorSummary {
@@ -148,8 +158,8 @@ pub struct VectorTracking {
     admitted_s: BTreeMap<u8, f64>,
     /// `[vector] max_coast_s`.
     max_coast_s: f64,
-    /// The filter after each of its last epochs: `(stream time, filter, last)`.
-    history: VecDeque<(f64, NavFilter, Option<(GpsTime, f64)>)>,
+    /// The filter after each of its last epochs.
+    history: VecDeque<Saved>,
     /// No measurement is taken up to this stream time (after a collapse), s.
     quarantine_until_s: f64,
     /// Receiver time and stream time of the last epoch with a fix (module docs, "Time").
@@ -239,7 +249,12 @@ impl VectorTracking {
             if let Some((t, sol, valid)) = &fix {
                 self.pair = Some((epoch.time, *t));
                 match (valid, sol.vel_ecef_mps) {
-                    (true, Some(v)) => self.dynamics.push(*t, v),
+                    (true, Some(v)) => {
+                        let sigma = sol
+                            .vel_covariance
+                            .map_or(0.0, |c| (c[(0, 0)] + c[(1, 1)] + c[(2, 2)]).max(0.0).sqrt());
+                        self.dynamics.push(*t, v, sigma)
+                    }
                     _ => self.dynamics.reset(),
                 }
             }
@@ -416,12 +431,15 @@ impl VectorTracking {
             self.disengage(t_stream_s, &why);
             return;
         }
-        self.history
-            .push_back((t_stream_s, filter.clone(), self.last));
+        self.history.push_back(Saved {
+            t_stream_s,
+            filter: filter.clone(),
+            last: self.last,
+        });
         while self
             .history
             .front()
-            .is_some_and(|h| t_stream_s - h.0 > HISTORY_S)
+            .is_some_and(|h| t_stream_s - h.t_stream_s > HISTORY_S)
         {
             self.history.pop_front();
         }
@@ -435,11 +453,16 @@ impl VectorTracking {
         if self.filter.is_none() {
             return;
         }
-        while self.history.back().is_some_and(|h| h.0 > t_s) {
+        while self.history.back().is_some_and(|h| h.t_stream_s > t_s) {
             self.history.pop_back();
         }
         self.quarantine_until_s = t_s + QUARANTINE_S;
-        let Some((t_epoch, filter, Some((rx, t_last)))) = self.history.back().cloned() else {
+        let Some(Saved {
+            t_stream_s: t_epoch,
+            filter,
+            last: Some((rx, t_last)),
+        }) = self.history.back().cloned()
+        else {
             return;
         };
         tracing::debug!(
