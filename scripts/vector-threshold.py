@@ -98,7 +98,7 @@ def main():
         cells = " ".join(f"G{p:02} {c:.1f}" for p, c in per.items())
         med = statistics.median(per.values()) if per else float("nan")
         medians[mode] = med
-        print(f"{mode}: thresholds (true C/N0 at the last fix using each satellite, dB-Hz): {cells}; "
+        print(f"{mode}: thresholds (true C/N0 at each satellite's last observables, dB-Hz): {cells}; "
               f"median {med:.1f} dB-Hz; used to the end: {to_end}")
     print(f"median threshold gain of vector over scalar: {medians['scalar'] - medians['vector']:.1f} dB")
 
