@@ -247,6 +247,27 @@ fn errors_vs_truth(
     out
 }
 
+/// The true Doppler of `prn` at `t` and its rate (central differences of the simulated carrier
+/// phase over 1 ms) as an aid, with [`gpsrx_tracking::DopplerAid::coast`] set to `coast`.
+fn truth_doppler_aid(
+    sim: &Simulator,
+    prn: gpsrx_dsp::Prn,
+    t: f64,
+    coast: bool,
+) -> Option<gpsrx_tracking::DopplerAid> {
+    let sat = sim.satellites.iter().find(|s| s.prn == prn)?;
+    let h = 1e-3;
+    let (a, _) = sim.observe(sat, t - h);
+    let (b, _) = sim.observe(sat, t);
+    let (c, _) = sim.observe(sat, t + h);
+    Some(gpsrx_tracking::DopplerAid {
+        doppler_hz: (c.carrier_cycles - a.carrier_cycles) / (2.0 * h),
+        doppler_rate_hz_s: (c.carrier_cycles - 2.0 * b.carrier_cycles + a.carrier_cycles) / (h * h),
+        coast,
+        checked: false,
+    })
+}
+
 fn loop_cfg(order: u8, bn: f64, t_ms: f64, dll_bn: f64) -> ChannelConfig {
     track_config(order, bn, t_ms * 1e-3, dll_bn)
 }
@@ -394,20 +415,7 @@ rate_hz = 1.0
         .run(dir.path(), &|_| {})
         .unwrap_or_else(|e| panic!("{e}"));
     let cfg = loop_cfg(2, 3.0, 1.0, 1.0);
-    let truth_aid = |prn: gpsrx_dsp::Prn, t: f64| {
-        let sat = sim.satellites.iter().find(|s| s.prn == prn)?;
-        let h = 1e-3;
-        let (a, _) = sim.observe(sat, t - h);
-        let (b, _) = sim.observe(sat, t);
-        let (c, _) = sim.observe(sat, t + h);
-        Some(gpsrx_tracking::DopplerAid {
-            doppler_hz: (c.carrier_cycles - a.carrier_cycles) / (2.0 * h),
-            doppler_rate_hz_s: (c.carrier_cycles - 2.0 * b.carrier_cycles + a.carrier_cycles)
-                / (h * h),
-            coast: false,
-            checked: false,
-        })
-    };
+    let truth_aid = |prn: gpsrx_dsp::Prn, t: f64| truth_doppler_aid(&sim, prn, t, false);
     // The turn runs from 3 s to 15 s (acceleration ramps in over 0.5 s): measure 4-14.5 s.
     let in_turn = |t: f64| (4.0..14.5).contains(&t);
     let mut aided_err: BTreeMap<u8, Vec<f64>> = BTreeMap::new();
@@ -582,20 +590,7 @@ fn blockage_on_truth_aid(cn0_dbhz: f64, coast: bool) -> Vec<(u8, bool, f64, Opti
         7.5,
         dir.path(),
     );
-    let truth_aid = |prn: gpsrx_dsp::Prn, t: f64| {
-        let sat = sim.satellites.iter().find(|s| s.prn == prn)?;
-        let h = 1e-3;
-        let (a, _) = sim.observe(sat, t - h);
-        let (b, _) = sim.observe(sat, t);
-        let (c, _) = sim.observe(sat, t + h);
-        Some(gpsrx_tracking::DopplerAid {
-            doppler_hz: (c.carrier_cycles - a.carrier_cycles) / (2.0 * h),
-            doppler_rate_hz_s: (c.carrier_cycles - 2.0 * b.carrier_cycles + a.carrier_cycles)
-                / (h * h),
-            coast,
-            checked: false,
-        })
-    };
+    let truth_aid = |prn: gpsrx_dsp::Prn, t: f64| truth_doppler_aid(&sim, prn, t, coast);
     let truth = Truth::new(&sim);
     let specs: Vec<ChannelSpec> = sim
         .satellites

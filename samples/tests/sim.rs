@@ -382,19 +382,44 @@ fn real_if_output_carries_the_configured_cn0() {
     assert!((cn0 - 42.0).abs() < 1.0, "measured {cn0:.2} dB-Hz at IF");
 }
 
-#[test]
-fn outage_blocks_the_signal_and_it_returns() {
+/// G31 alone at 45 dB-Hz for 0.9 s of ci8 at 2.048 MHz with `table` (an `[[outages]]` or a
+/// `[[fades]]` entry): its C/N0 measured over 200 ms from each of `from_ms`, and the rows of
+/// truth_sv.csv as `(t_s, signal_on, C/N0)`.
+fn g31_with(table: &str, from_ms: &[usize]) -> (Vec<f64>, Vec<(f64, bool, f64)>) {
     let sc = scenario(
-        "[satellites]\nprns = [31]\ncn0_all_dbhz = 45.0\n[[outages]]\nstart_s = 0.3\nend_s = 0.6\n[truth]\nrate_hz = 10.0",
+        &format!(
+            "[satellites]\nprns = [31]\ncn0_all_dbhz = 45.0\n{table}\n[truth]\nrate_hz = 10.0"
+        ),
         0.9,
         2.048e6,
         "ci8",
     );
     let (sim, _dir, report, x) = simulate_and_read(&sc);
     let sat = &sim.satellites[0];
-    let before = measured_cn0(&sim, sat, (&x, 2.048e6), 50, 200);
-    let during = measured_cn0(&sim, sat, (&x, 2.048e6), 350, 200);
-    let after = measured_cn0(&sim, sat, (&x, 2.048e6), 650, 200);
+    let cn0 = from_ms
+        .iter()
+        .map(|&ms| measured_cn0(&sim, sat, (&x, 2.048e6), ms, 200))
+        .collect();
+    let truth = std::fs::read_to_string(&report.truth_sv_path).unwrap_or_else(|e| panic!("{e}"));
+    let rows = truth
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (
+                f[0].parse().unwrap_or(f64::NAN),
+                f[2] == "1",
+                f[7].parse().unwrap_or(f64::NAN),
+            )
+        })
+        .collect();
+    (cn0, rows)
+}
+
+#[test]
+fn outage_blocks_the_signal_and_it_returns() {
+    let (cn0, truth) = g31_with("[[outages]]\nstart_s = 0.3\nend_s = 0.6", &[50, 350, 650]);
+    let (before, during, after) = (cn0[0], cn0[1], cn0[2]);
     assert!(
         (before - 45.0).abs() < 1.0 && (after - 45.0).abs() < 1.0,
         "{before} {after}"
@@ -403,50 +428,30 @@ fn outage_blocks_the_signal_and_it_returns() {
     // estimate of zero signal scatters around 1e-6..25 dB-Hz, far below 45).
     assert!(during < 30.0, "during the outage: {during:.1} dB-Hz");
     // And the truth file says so.
-    let truth = std::fs::read_to_string(&report.truth_sv_path).unwrap_or_else(|e| panic!("{e}"));
-    let on: Vec<(f64, bool)> = truth
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (f[0].parse().unwrap_or(f64::NAN), f[2] == "1")
-        })
-        .collect();
     assert!(
-        on.iter().all(|&(t, s)| s != (0.3..0.6).contains(&t)),
-        "{on:?}"
+        truth.iter().all(|&(t, s, _)| s != (0.3..0.6).contains(&t)),
+        "{truth:?}"
     );
 }
 
 #[test]
 fn a_fade_lowers_the_cn0_at_its_rate_and_holds_the_level_reached() {
     // 45 dB-Hz, faded by 20 dB/s from 0.3 to 0.6 s: 45 before, 39 at the end and after it.
-    let sc = scenario(
-        "[satellites]\nprns = [31]\ncn0_all_dbhz = 45.0\n[[fades]]\nstart_s = 0.3\nend_s = 0.6\ndb_per_s = -20.0\n[truth]\nrate_hz = 10.0",
-        0.9,
-        2.048e6,
-        "ci8",
+    let (cn0, truth) = g31_with(
+        "[[fades]]\nstart_s = 0.3\nend_s = 0.6\ndb_per_s = -20.0",
+        &[50, 650],
     );
-    let (sim, _dir, report, x) = simulate_and_read(&sc);
-    let sat = &sim.satellites[0];
-    let before = measured_cn0(&sim, sat, (&x, 2.048e6), 50, 200);
-    let after = measured_cn0(&sim, sat, (&x, 2.048e6), 650, 200);
+    let (before, after) = (cn0[0], cn0[1]);
     assert!(
         (before - 45.0).abs() < 1.0 && (after - 39.0).abs() < 1.0,
         "{before} {after}"
     );
     // The truth file's C/N0 column follows the ramp.
-    let truth = std::fs::read_to_string(&report.truth_sv_path).unwrap_or_else(|e| panic!("{e}"));
-    for l in truth.lines().skip(1) {
-        let f: Vec<&str> = l.split(',').collect();
-        let (t, cn0): (f64, f64) = (
-            f[0].parse().unwrap_or(f64::NAN),
-            f[7].parse().unwrap_or(f64::NAN),
-        );
+    for (t, _, c) in truth {
         let want = 45.0 - 20.0 * (t.min(0.6) - 0.3).max(0.0);
         assert!(
-            (cn0 - want).abs() < 1e-3,
-            "t {t}: truth C/N0 {cn0}, want {want}"
+            (c - want).abs() < 1e-3,
+            "t {t}: truth C/N0 {c}, want {want}"
         );
     }
 }

@@ -117,6 +117,21 @@ pub struct ChannelConfig {
     pub mode: crate::aiding::TrackingMode,
 }
 
+/// The default weak-signal loops ([`ChannelConfig::weak_track`]; the comment at their use).
+fn default_weak_track() -> LoopConfig {
+    LoopConfig {
+        pll_order: 3,
+        pll_bw_hz: 6.0,
+        fll_order: 0,
+        fll_bw_hz: 0.0,
+        dll_order: 1,
+        dll_bw_hz: 0.5,
+        t_coh_s: 20.0e-3,
+        el_spacing_chips: 1.0,
+        ..LoopConfig::default()
+    }
+}
+
 impl Default for ChannelConfig {
     fn default() -> Self {
         Self {
@@ -143,27 +158,10 @@ impl Default for ChannelConfig {
             // from the fixes); a 0.5 s jerk ramp to 1.5 m/s^2 (3 m/s^3 = 15.8 Hz/s^2) costs
             // `j/wn^3` = 0.035 cycle (wn = 6/0.7845 = 7.65 rad/s); thermal jitter at 28 dB-Hz
             // 6.4 deg with the realised Bn (7.6 Hz at Bn T = 0.12, tracking/README.md).
-            weak_track: Some(LoopConfig {
-                pll_order: 3,
-                pll_bw_hz: 6.0,
-                fll_order: 0,
-                fll_bw_hz: 0.0,
-                dll_order: 1,
-                dll_bw_hz: 0.5,
-                t_coh_s: 20.0e-3,
-                el_spacing_chips: 1.0,
-                ..LoopConfig::default()
-            }),
+            weak_track: Some(default_weak_track()),
             vector_weak_track: Some(LoopConfig {
-                pll_order: 3,
                 pll_bw_hz: 3.0,
-                fll_order: 0,
-                fll_bw_hz: 0.0,
-                dll_order: 1,
-                dll_bw_hz: 0.5,
-                t_coh_s: 20.0e-3,
-                el_spacing_chips: 1.0,
-                ..LoopConfig::default()
+                ..default_weak_track()
             }),
             weak_enter_dbhz: 32.0,
             weak_leave_dbhz: 35.0,
@@ -433,7 +431,7 @@ pub struct Channel {
     ff_applied_hz: Option<f64>,
     /// The Doppler rate of the last feed-forward applied, Hz/s (0 unaided).
     ff_rate_applied_hz_s: f64,
-    /// The last loop update coasted on the aid ([`Channel::coasting_on_aid`]).
+    /// The last loop update coasted on the aid (`Channel::coasting_on_aid`).
     coasted_last: bool,
     /// Which tracking loops run (after pull-in).
     loops: TrackLoops,
@@ -1384,7 +1382,7 @@ impl Channel {
 }
 
 /// How far below its loss threshold ([`Channel::cn0_lost_dbhz`]) a C/N0 estimate says the signal is gone, so
-/// that a channel with a coasting aid coasts ([`Channel::coasting_on_aid`]), dB: the NWPR
+/// that a channel with a coasting aid coasts (`Channel::coasting_on_aid`), dB: the NWPR
 /// estimator on noise alone read 0-15 dB-Hz in 3 s blockages; a signal between this and the
 /// loss threshold keeps its loops running (coasting there froze satellites at 24-26 dB-Hz,
 /// whose estimates cross the threshold back and forth, out of their lock: 0.91 of the time

@@ -52,16 +52,7 @@ impl CodeLoop {
             DllDiscriminator::DotProduct => discriminator::dll_dot_product(early, prompt, late),
         };
         let dll_chips_s = self.filter.update(code_error_chips, 0.0, self.cfg.t_coh_s);
-        let aid = if carrier_aid_chips_s.is_finite() {
-            carrier_aid_chips_s
-        } else {
-            0.0
-        };
-        CodeOutput {
-            code_rate_chips_s: aiding::code_rate_chips_s(0.0, aid + dll_chips_s),
-            dll_chips_s,
-            code_error_chips,
-        }
+        output(dll_chips_s, code_error_chips, carrier_aid_chips_s)
     }
 
     /// Starts a coast ([`CodeLoop::coast`]): the filter forgets its last input.
@@ -74,16 +65,7 @@ impl CodeLoop {
     /// the code follows the carrier aid `carrier_aid_chips_s` alone.
     pub fn coast(&mut self, carrier_aid_chips_s: f64) -> CodeOutput {
         let dll_chips_s = self.filter.update(0.0, 0.0, self.cfg.t_coh_s);
-        let aid = if carrier_aid_chips_s.is_finite() {
-            carrier_aid_chips_s
-        } else {
-            0.0
-        };
-        CodeOutput {
-            code_rate_chips_s: aiding::code_rate_chips_s(0.0, aid + dll_chips_s),
-            dll_chips_s,
-            code_error_chips: 0.0,
-        }
+        output(dll_chips_s, 0.0, carrier_aid_chips_s)
     }
 
     /// Changes the integration time (validated like [`LoopConfig::validate`]).
@@ -105,6 +87,21 @@ impl CodeLoop {
     /// The loop filter.
     pub fn filter(&self) -> &LoopFilter {
         &self.filter
+    }
+}
+
+/// The code NCO rate from the DLL's correction and the carrier aid (chips/s; a non-finite
+/// aid counts as none).
+fn output(dll_chips_s: f64, code_error_chips: f64, carrier_aid_chips_s: f64) -> CodeOutput {
+    let aid = if carrier_aid_chips_s.is_finite() {
+        carrier_aid_chips_s
+    } else {
+        0.0
+    };
+    CodeOutput {
+        code_rate_chips_s: aiding::code_rate_chips_s(0.0, aid + dll_chips_s),
+        dll_chips_s,
+        code_error_chips,
     }
 }
 

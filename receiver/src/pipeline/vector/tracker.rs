@@ -22,7 +22,7 @@
 //!   and the channels are there the moment the signals return.
 //! - **At a collapse** of several satellites' prompt power at once (a blockage, lost
 //!   samples: `crate::pipeline::timing::code_jump`), the filter goes back to its state at the
-//!   last epoch before the onset and takes no measurement for [`QUARANTINE_S`]: the epochs
+//!   last epoch before the onset and takes no measurement for `QUARANTINE_S`: the epochs
 //!   just after it hold channels whose lock detectors have not yet seen the signal go (the
 //!   weaker ones, whose fall the fade detector cannot flag), and their noise, admitted under
 //!   a car's process noise (1 m/s per 0.1 s), threw the velocity 2.4 m/s off (12 Hz of
@@ -448,7 +448,7 @@ impl VectorTracking {
 
     /// The prompt power of several satellites collapsed at once at stream time `t_s` (module
     /// docs): back to the filter's state at the last epoch before it, and no measurement for
-    /// [`QUARANTINE_S`]; the channels are aided from that state meanwhile.
+    /// `QUARANTINE_S`; the channels are aided from that state meanwhile.
     pub fn collapse(&mut self, t_s: f64) {
         if self.filter.is_none() {
             return;
