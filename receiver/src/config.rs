@@ -282,7 +282,8 @@ impl ReceiverConfig {
     }
 
     /// Checks every value against its valid range: the tracking loops (and
-    /// `[tracking] cn0_lost_dbhz` within [`CN0_LOST_RANGE_DBHZ`]), `[run]` and `[dr]`.
+    /// `[tracking] cn0_lost_dbhz` and `vector_cn0_lost_dbhz` within [`CN0_LOST_RANGE_DBHZ`]),
+    /// `[run]`, `[vector]` and `[dr]`.
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.tracking
             .validate()
@@ -292,6 +293,12 @@ impl ReceiverConfig {
         if !(lo..=hi).contains(&cn0_lost) {
             return Err(ConfigError::Invalid(format!(
                 "[tracking] cn0_lost_dbhz = {cn0_lost}: use {lo} to {hi} dB-Hz (the C/N0 below which a channel counts as lost; default 25)"
+            )));
+        }
+        let vector_lost = self.tracking.vector_cn0_lost_dbhz;
+        if !(lo..=hi).contains(&vector_lost) {
+            return Err(ConfigError::Invalid(format!(
+                "[tracking] vector_cn0_lost_dbhz = {vector_lost}: use {lo} to {hi} dB-Hz (the C/N0 below which a channel the vector filter checks counts as lost; default 22)"
             )));
         }
         self.run.validate()?;

@@ -305,6 +305,25 @@ fn the_tracking_mode_is_read_from_gpsrx_toml_and_a_wrong_one_is_named() {
         .map(|e| e.to_string())
         .unwrap_or_default();
     assert!(msg.contains("[vector] gate_pfa"), "{msg}");
+    for (edit, key) in [
+        (
+            (|c: &mut ReceiverConfig| c.vector.max_coast_s = 0.0) as fn(&mut ReceiverConfig),
+            "[vector] max_coast_s",
+        ),
+        (
+            |c: &mut ReceiverConfig| c.tracking.vector_cn0_lost_dbhz = 5.0,
+            "[tracking] vector_cn0_lost_dbhz",
+        ),
+    ] {
+        let mut c = ReceiverConfig::default();
+        edit(&mut c);
+        let msg = c
+            .validate()
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(msg.contains(key), "{key}: {msg}");
+    }
     // A Python keyword / manifest column `tracking = "vector"` is `[tracking] mode`.
     let mut t = toml::Table::new();
     t.insert("tracking".into(), toml::Value::String("vector".into()));
