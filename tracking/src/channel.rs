@@ -1233,7 +1233,8 @@ impl Channel {
 
     /// The loops the tracking state should run now: the aided ones while a feed-forward is
     /// applied (if configured), else the weak-signal ones while the C/N0 is low (if
-    /// configured), else the normal ones.
+    /// configured), else the normal ones; first of all the vector weak-signal loops while weak
+    /// and checked by vector tracking (if configured).
     fn wanted_loops(&self) -> TrackLoops {
         if self.weak && self.checked_aid() && self.cfg.vector_weak_track.is_some() {
             return TrackLoops::VectorWeak;
