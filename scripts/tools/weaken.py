@@ -25,13 +25,22 @@ def main():
     if not a.db > 0:
         sys.exit("weaken.py: --db must be above 0")
     rng = np.random.default_rng(a.seed)
-    with open(a.inp, "rb") as src:
-        head = np.frombuffer(src.read(CHUNK), dtype=np.int8).astype(np.float64)
+    try:
+        with open(a.inp, "rb") as src:
+            head = np.frombuffer(src.read(CHUNK), dtype=np.int8).astype(np.float64)
+    except OSError as e:
+        sys.exit(f"weaken.py: cannot read {a.inp}: {e.strerror}")
     if head.size == 0 or head.std() == 0:
         sys.exit("weaken.py: the input is empty or all zeros")
     sigma = head.std() * np.sqrt(10 ** (a.db / 10) - 1)
     clipped = total = 0
-    with open(a.inp, "rb") as src, open(a.out, "wb") as dst:
+    if head.size % 2:
+        sys.exit("weaken.py: the input is not ci8 (an odd number of bytes in its first block)")
+    try:
+        dst = open(a.out, "wb")
+    except OSError as e:
+        sys.exit(f"weaken.py: cannot write {a.out}: {e.strerror}")
+    with open(a.inp, "rb") as src, dst:
         while True:
             b = src.read(CHUNK)
             if not b:
