@@ -124,6 +124,8 @@ fn after_the_blockage(
     let mut rx = receiver_with(2.048e6, |c| {
         c.tracking.mode = mode;
         c.run.allow_unhealthy = true;
+        // The simulator's troposphere, modelled: the errors are the receiver's.
+        c.run.tropo = gpsrx_receiver::config::TropoModel::Saastamoinen;
     });
     let mut sink = MemorySink::new().with_channel_epochs();
     rx.run(&mut SimSource::new(sim), &mut sink)
@@ -168,12 +170,10 @@ fn after_a_3_s_blockage_of_every_satellite_vector_tracking_fixes_again_within_ha
         "vector: first valid fix {first} s after the return"
     );
     assert!(lost.is_empty(), "vector: channels lost {lost:?}");
-    // Horizontally 5 m; vertically this simulation leaves every fix a steady 6-8 m (no
-    // troposphere model in the receiver, the test above).
-    assert!(
-        h_max <= 5.0 && v_max <= 10.0,
-        "vector: {h_max} m, {v_max} m"
-    );
+    // None over 5 m (the bound, in 3-D): the carrier smoothing is bridged over the
+    // coast by each channel's own carrier, which followed the filter's prediction.
+    let max_3d = h_max.hypot(v_max); // at least the largest 3-D error
+    assert!(max_3d <= 5.0, "vector: {h_max} m, {v_max} m");
     let (scalar_first, _, _, scalar_lost) = after_the_blockage(&sim, TrackingMode::Scalar);
     assert!(
         scalar_first > first && !scalar_lost.is_empty(),

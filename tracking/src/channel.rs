@@ -370,6 +370,10 @@ pub struct ChannelEpoch {
     pub t_coh_s: f64,
     /// The feed-forward Doppler the carrier NCO held over the interval, Hz (None: unaided).
     pub feedforward_hz: Option<f64>,
+    /// The loops coasted on the aid at the end of the interval (the signal gone, an aid that
+    /// predicts it, [`DopplerAid::coast`]): the NCOs follow the aid alone, so the carrier
+    /// phase over the coast is the aid's prediction of the range change.
+    pub coasting: bool,
     /// Milliseconds since the channel started (count of code periods).
     pub ms_count: u64,
     /// Whether the interval starts on a data-bit edge (known after bit sync).
@@ -1184,6 +1188,7 @@ impl Channel {
             code_error_chips: cl.code_error_chips,
             t_coh_s: self.carrier.t_coh_s(),
             feedforward_hz: self.acc_feedforward_hz,
+            coasting: self.coasted_last,
             ms_count: ms_index + 1 - self.acc_ms as u64,
             bit_edge: timing.edge_phase.is_some_and(|edge| {
                 (ms_index + 1 - self.acc_ms as u64) % MS_PER_BIT as u64

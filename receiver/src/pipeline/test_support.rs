@@ -37,6 +37,7 @@ pub fn report(
         code_error_chips: 0.0,
         t_coh_s: 1e-3,
         feedforward_hz: None,
+        coasting: false,
         ms_count: k,
         bit_edge: false,
         bit: None,

@@ -562,6 +562,7 @@ mod tests {
             code_error_chips: 0.0,
             t_coh_s: 1e-3,
             feedforward_hz,
+            coasting: false,
             ms_count: 0,
             bit_edge: false,
             bit: None,

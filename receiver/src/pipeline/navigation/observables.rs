@@ -15,7 +15,9 @@
 
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::navigation::navdata::NavDecoder;
-use crate::pipeline::navigation::smoothing::{CarrierAnchor, Hatch, HatchEpoch};
+use crate::pipeline::navigation::smoothing::{
+    CarrierAnchor, GivenChange, Hatch, HatchEpoch, MAX_BRIDGE_S,
+};
 use gpsrx_dsp::constants::{CA_CHIP_RATE_HZ, F_L1_HZ, SPEED_OF_LIGHT_MPS};
 use gpsrx_nav::time::GpsTime;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
@@ -97,9 +99,32 @@ struct Coast {
     loop_share_hz: Option<f64>,
     /// Integration time of the break's reports without one, s (infinite: another channel).
     unaided_s: f64,
+    /// Stream time of the break's first report coasted on a predicting aid
+    /// ([`ChannelEpoch::coasting`]: vector tracking), s.
+    coast_start_s: Option<f64>,
+    /// Phase the loop added to the NCO over the break, `sum |doppler - feed-forward| T`,
+    /// cycles: on noise before the coast started (and pulling in after it), what the aid's own
+    /// range change does not carry.
+    loop_cycles: f64,
     /// The last break was coasted with a feed-forward that held the signal (decided at its
     /// end).
     coasted: bool,
+    /// ... and some of it on a predicting aid ([`Coast::coast_start_s`]).
+    predicted: bool,
+}
+
+impl Coast {
+    /// How long a break the channel's own carrier may bridge, s (None: it may not): an aid
+    /// that only steadies the loops holds as long as the carrier's own quadratic
+    /// ([`MAX_BRIDGE_S`]); a predicting one (vector tracking) for as long as it predicts the
+    /// signal (its miss at the re-lock was checked, whatever the length).
+    fn bridge_s(&self) -> Option<f64> {
+        match (self.coasted, self.predicted) {
+            (false, _) => None,
+            (true, false) => Some(MAX_BRIDGE_S),
+            (true, true) => Some(f64::INFINITY),
+        }
+    }
 }
 
 /// Largest error of the range change a coasted channel's carrier may carry into the carrier
@@ -285,9 +310,14 @@ impl ObservableBuilder {
     /// NCO frequency (`doppler - feed-forward`) changed by `d` Hz from the break's first aided
     /// report to the re-lock, which is what the feed-forward missed; a miss growing
     /// linearly over the break of `T` s leaves `|d| T / 2` cycles in the carrier's range
-    /// change, which must be within [`MAX_COAST_ERROR_M`]. Returns that, from the first usable
-    /// report after the break (it must hold a feed-forward too) until the next break.
-    fn note_coast(&mut self, e: &ChannelEpoch, usable: bool) -> bool {
+    /// change, which must be within [`MAX_COAST_ERROR_M`]. A channel that coasted on a
+    /// predicting aid ([`ChannelEpoch::coasting`], vector tracking) held its loop's share at
+    /// zero from the coast's start `t_c`: its error is the phase its loop added over the break
+    /// on noise (and pulling in again), `sum |doppler - feed-forward| T`, plus `|d| (t - t_c) / 2`
+    /// with `d` the loop's share at the re-lock. Returns the longest break the channel's own
+    /// carrier may bridge ([`Coast::bridge_s`]; None: it may not), from the first usable report
+    /// after the break (it must hold a feed-forward too) until the next break.
+    fn note_coast(&mut self, e: &ChannelEpoch, usable: bool) -> Option<f64> {
         let ff = e.feedforward_hz.filter(|f| f.is_finite());
         let t_s = e.sample_index as f64 / self.fs_hz;
         let c = self.coasts.entry(e.prn).or_default();
@@ -296,17 +326,23 @@ impl ObservableBuilder {
         if usable {
             if c.in_break {
                 let lambda = SPEED_OF_LIGHT_MPS / F_L1_HZ;
-                let held = match (ff, c.loop_share_hz) {
-                    (Some(f), Some(start)) => {
-                        let missed_hz = (e.doppler_hz - f) - start;
-                        (missed_hz * (t_s - c.start_s) / 2.0).abs() * lambda <= MAX_COAST_ERROR_M
+                let error_cycles = match (ff, c.coast_start_s, c.loop_share_hz) {
+                    // Coasted on a prediction: the loop's share was zero over the coast, so
+                    // what it holds at the re-lock is the aid's miss there.
+                    (Some(f), Some(coast_s), _) => {
+                        Some(c.loop_cycles + ((e.doppler_hz - f) * (t_s - coast_s) / 2.0).abs())
                     }
-                    _ => false,
+                    (Some(f), None, Some(start)) => {
+                        Some(((e.doppler_hz - f) - start) * (t_s - c.start_s) / 2.0)
+                    }
+                    _ => None,
                 };
+                let held = error_cycles.is_some_and(|x| x.abs() * lambda <= MAX_COAST_ERROR_M);
                 c.coasted = same && held && c.unaided_s <= MAX_UNAIDED_COAST_S;
+                c.predicted = c.coasted && c.coast_start_s.is_some();
                 c.in_break = false;
             }
-            return c.coasted;
+            return c.bridge_s();
         }
         if !c.in_break {
             *c = Coast {
@@ -319,13 +355,17 @@ impl ObservableBuilder {
         match ff {
             Some(f) => {
                 c.loop_share_hz.get_or_insert(e.doppler_hz - f);
+                c.loop_cycles += (e.doppler_hz - f).abs() * e.t_coh_s;
             }
             None => c.unaided_s += e.t_coh_s,
+        }
+        if e.coasting {
+            c.coast_start_s.get_or_insert(t_s);
         }
         if !same {
             c.unaided_s = f64::INFINITY;
         }
-        false
+        None
     }
 
     /// The anchor of a bridge of `prn`'s smoothing from stream time `from_s` to `to_s`: the
@@ -358,7 +398,7 @@ impl ObservableBuilder {
         he: &HatchEpoch,
         lost_flag: bool,
         aid: Option<&InsFeedForward>,
-        coasted: bool,
+        coasted_s: Option<f64>,
     ) -> (f64, f64) {
         let (n, t_stream, steps) = (he.epoch, he.t_stream_s, he.steps_ms);
         let max_m = self.hatch_epochs;
@@ -392,16 +432,24 @@ impl ObservableBuilder {
                     (Some(a), Some(g), Some(total)) => a
                         .carrier_change_cycles(e.prn, t_stream, t_stream - h.t_stream_s + g)
                         .filter(|&(_, told)| (told - total).abs() < 1e-4)
-                        .map(|(cycles, _)| -cycles * SPEED_OF_LIGHT_MPS / F_L1_HZ),
+                        .map(|(cycles, _)| GivenChange {
+                            change_m: -cycles * SPEED_OF_LIGHT_MPS / F_L1_HZ,
+                            max_s: MAX_BRIDGE_S,
+                        }),
                     _ => None,
                 };
-                // A channel that coasted with a feed-forward (an INS, the outage bridge) moved
-                // its NCO with the motion: its own carrier is the range change (no samples lost).
-                let by_own = (coasted && lost_s.is_some_and(|g| g.abs() < 1e-9)).then(|| {
+                // A channel that coasted with a feed-forward (an INS, the outage bridge, vector
+                // tracking's prediction) moved its NCO with the motion: its own carrier is the
+                // range change (no samples lost).
+                let own_s = coasted_s.filter(|_| lost_s.is_some_and(|g| g.abs() < 1e-9));
+                let by_own = own_s.map(|max_s| {
                     let cycles = |c: f64, steps: i64| c - steps as f64 * 1e-3 * F_L1_HZ;
-                    SPEED_OF_LIGHT_MPS / F_L1_HZ
-                        * (cycles(he.carrier_cycles, he.steps_ms)
-                            - cycles(h.carrier_cycles, h.steps_ms))
+                    GivenChange {
+                        change_m: SPEED_OF_LIGHT_MPS / F_L1_HZ
+                            * (cycles(he.carrier_cycles, he.steps_ms)
+                                - cycles(h.carrier_cycles, h.steps_ms)),
+                        max_s,
+                    }
                 });
                 let given = by_ins.or(by_own);
                 let break_s = t_stream - h.t_stream_s;
@@ -412,7 +460,7 @@ impl ObservableBuilder {
                     if bridged { "bridged" } else { "restarted" },
                     break_s,
                     lost_s,
-                    by_own
+                    by_own.map(|g| g.change_m)
                 );
                 if !bridged {
                     *h = Hatch::start(he);

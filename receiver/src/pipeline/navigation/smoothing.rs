@@ -57,6 +57,16 @@ pub const SHORT_WINDOWS_S: [f64; 2] = [2.0, 1.0];
 /// starts from the raw code: metres of noise under a manoeuvre's geometry).
 pub const MAX_EXTRAPOLATION_ERROR_M: f64 = 0.5;
 
+/// A range change over a break known from outside the carrier's history (m, carrier sign,
+/// without the clock terms), and the longest break it is good for, s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GivenChange {
+    /// The range change, m.
+    pub change_m: f64,
+    /// The longest break over which it is taken, s.
+    pub max_s: f64,
+}
+
 /// The first locked report of a satellite's channel after a break: its stream time (s) and
 /// carrier phase (cycles, RINEX sign, without the clock steps). The channel's carrier phase
 /// is continuous from it to the current epoch.
@@ -198,7 +208,7 @@ impl Hatch {
         &self,
         e: &HatchEpoch,
         lost_s: f64,
-        signal_change_m: Option<f64>,
+        given: Option<GivenChange>,
         anchor: Option<CarrierAnchor>,
     ) -> Option<f64> {
         let elapsed_s = e.t_stream_s - self.t_stream_s + lost_s;
@@ -219,15 +229,16 @@ impl Hatch {
         if let Some(change) = anchored {
             return Some(change + clock_m);
         }
-        if !(0.0..=MAX_BRIDGE_S).contains(&elapsed_s) {
-            return None;
-        }
         // The carrier's own quadratic when it follows the phase (it holds a steady
-        // acceleration to millimetres), else the change given from outside (an INS).
-        let given = signal_change_m.filter(|c| c.is_finite());
-        self.quadratic_change_m(elapsed_s)
-            .or(given)
-            .map(|change| change + clock_m)
+        // acceleration to millimetres), else the change given from outside.
+        let quadratic = (0.0..=MAX_BRIDGE_S)
+            .contains(&elapsed_s)
+            .then(|| self.quadratic_change_m(elapsed_s))
+            .flatten();
+        let given = given
+            .filter(|g| g.change_m.is_finite() && (0.0..=g.max_s).contains(&elapsed_s))
+            .map(|g| g.change_m);
+        quadratic.or(given).map(|change| change + clock_m)
     }
 
     /// The range change (m, carrier sign, without the clock terms) over `elapsed_s` of signal
@@ -269,20 +280,20 @@ impl Hatch {
     /// `e`, `lost_s` of samples lost since the last epoch. The range change over the break
     /// (m, carrier sign, without the clock terms) is, with an `anchor` (the channel's first
     /// settled locked report since), the extrapolation up to it plus the carrier after it;
-    /// else the extrapolated quadratic when it follows the phase, else `signal_change_m` when
-    /// given (from an INS,
-    /// [`crate::pipeline::aiding::InsFeedForward::carrier_change_cycles`]: it follows a
-    /// manoeuvre's jerk). Returns false (the caller restarts the
-    /// filter) when the break cannot be bridged or the bridged prediction misses the new code.
+    /// else the extrapolated quadratic when it follows the phase, else the change `given` from
+    /// outside (an INS, [`crate::pipeline::aiding::InsFeedForward::carrier_change_cycles`]: it
+    /// follows a manoeuvre's jerk; the channel's own carrier coasted on an aid) over a break
+    /// within its [`GivenChange::max_s`]. Returns false (the caller restarts the filter) when
+    /// the break cannot be bridged or the bridged prediction misses the new code.
     pub fn bridge(
         &mut self,
         e: &HatchEpoch,
         lost_s: f64,
         max_m: u32,
-        signal_change_m: Option<f64>,
+        given: Option<GivenChange>,
         anchor: Option<CarrierAnchor>,
     ) -> bool {
-        let Some(change) = self.bridge_change_m(e, lost_s, signal_change_m, anchor) else {
+        let Some(change) = self.bridge_change_m(e, lost_s, given, anchor) else {
             return false;
         };
         if (self.smoothed_m + change - e.pseudorange_m).abs() > MAX_INNOVATION_M {
@@ -424,6 +435,52 @@ mod tests {
         assert!(!h.bridge(&at(60, 0.0, 20e6 - 1000.0, 6.0), 0.0, 100, None, None));
     }
 
+    #[test]
+    fn a_given_range_change_bridges_as_long_a_break_as_it_is_good_for() {
+        // 5 s without carrier (a channel coasted on vector tracking's prediction, whose own
+        // carrier over the coast is the range change: -190 m/s here).
+        let at = |k: i64, p: f64, t: f64| HatchEpoch {
+            epoch: k,
+            carrier_cycles: 0.0,
+            pseudorange_m: p,
+            steps_ms: 0,
+            t_stream_s: t,
+        };
+        let mut h = Hatch::start(&at(0, 20e6, 0.0));
+        for k in 1..10 {
+            let kf = k as f64;
+            let mut e = at(k, 20e6 - kf * 19.0, kf * 0.1);
+            e.carrier_cycles = -kf * 19.0 * F_L1_HZ / SPEED_OF_LIGHT_MPS;
+            h.update(&e, 100);
+        }
+        let after = at(59, 20e6 - 59.0 * 19.0 + 2.0, 5.9);
+        let given = |max_s| {
+            Some(GivenChange {
+                change_m: -5.0 * 190.0,
+                max_s,
+            })
+        };
+        // Beyond the quadratic's 3 s: only a change good for 5 s or more bridges.
+        assert!(!h
+            .clone()
+            .bridge(&after, 0.0, 100, given(MAX_BRIDGE_S), None));
+        let mut bridged = h.clone();
+        assert!(bridged.bridge(&after, 0.0, 100, given(f64::INFINITY), None));
+        // The smoothed range carries the change (the new code's 2 m weighs 1/10).
+        let expected = 20e6 - 59.0 * 19.0;
+        assert!(
+            (bridged.smoothed_m - expected).abs() < 0.3,
+            "{}",
+            bridged.smoothed_m - expected
+        );
+        // A change that is not finite does not.
+        let nan = Some(GivenChange {
+            change_m: f64::NAN,
+            max_s: f64::INFINITY,
+        });
+        assert!(!h.bridge(&after, 0.0, 100, nan, None));
+    }
+
     /// A 10 g turn at 250 m/s (radius 637 m, 0.385 rad/s) seen by a satellite on the
     /// horizon: the range's acceleration turns with the aircraft (jerk up to 38 m/s^3, snap
     /// 15 m/s^4). Epochs every 0.1 s of stream; `lost` s of samples lost at stream `t_gap`
@@ -511,7 +568,19 @@ mod tests {
         let change =
             (e.carrier_cycles - offset - last.carrier_cycles) * lambda + SPEED_OF_LIGHT_MPS * lost;
         let mut by_ins = h;
-        assert!(by_ins.bridge(&e, lost, 100, Some(change), None), "refused");
+        assert!(
+            by_ins.bridge(
+                &e,
+                lost,
+                100,
+                Some(GivenChange {
+                    change_m: change,
+                    max_s: MAX_BRIDGE_S
+                }),
+                None
+            ),
+            "refused"
+        );
         assert!((by_ins.smoothed_m - truth).abs() < 1.0);
     }
 }
