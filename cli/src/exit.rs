@@ -10,7 +10,6 @@
 
 use gpsrx_receiver::config::ConfigError;
 use gpsrx_receiver::snapshot::SnapshotError;
-use gpsrx_receiver::ReceiverError;
 use gpsrx_samples::SampleError;
 use std::io::{self, Write};
 
@@ -96,9 +95,6 @@ fn option_for(cause: &(dyn std::error::Error + 'static)) -> Option<&'static str>
     }
     if let Some(SnapshotError::NoEphemerides) = cause.downcast_ref::<SnapshotError>() {
         return Some("--nav FILE");
-    }
-    if let Some(ReceiverError::VectorWithIns) = cause.downcast_ref::<ReceiverError>() {
-        return Some("--tracking scalar with --ins, or --tracking vector without --ins");
     }
     None
 }

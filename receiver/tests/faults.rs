@@ -443,7 +443,7 @@ fn motion_receiver(heading_deg: f64, speed_mps: f64, transition_s: f64, segments
 /// The aircraft of `samples/scenarios/gaps-turn-10g.toml`: 250 m/s, heading 30 deg, `cruise_s`
 /// of straight flight, a 6 s left turn at 10 g (jerk-limited over 1 s), `after_s` of straight
 /// flight; satellites at 30-45 dB-Hz by elevation.
-fn ten_g_turn(cruise_s: f64, after_s: f64) -> Simulator {
+pub(crate) fn ten_g_turn(cruise_s: f64, after_s: f64) -> Simulator {
     let receiver = motion_receiver(
         30.0,
         250.0,

@@ -5,7 +5,7 @@
 
 use crate::pipeline::{receiver_with, simulator, simulator_with, SimSource};
 use gpsrx_receiver::pipeline::MemorySink;
-use gpsrx_receiver::{Assistance, Receiver, ReceiverConfig, ReceiverError};
+use gpsrx_receiver::{Assistance, Receiver, ReceiverConfig};
 use gpsrx_tracking::TrackingMode;
 
 #[test]
@@ -242,39 +242,101 @@ fn vector_tracking_holds_fading_satellites_3_db_below_scalar_tracking() {
     }
 }
 
+/// The simulator's truth as a 50 Hz INS whose accelerometers are biased by `bias_mps2` on
+/// every ECEF axis (velocity `v + B t`, position `p + B t^2 / 2`), with its GPS time column.
+fn biased_ins(sim: &gpsrx_samples::sim::Simulator, bias_mps2: f64) -> gpsrx_ins_aiding::InsTrack {
+    let n = (sim.duration_s() * 50.0).floor() as usize;
+    let samples = (0..=n)
+        .map(|k| {
+            let t_s = k as f64 / 50.0;
+            let (tow, s) = sim.receiver_truth(t_s);
+            let b = gpsrx_nav::frames::Vector3::repeat(bias_mps2);
+            gpsrx_ins_aiding::InsSample {
+                t_s,
+                gps_tow_s: Some(tow),
+                pos_m: s.pos_m + b * (0.5 * t_s * t_s),
+                vel_mps: s.vel_mps + b * t_s,
+            }
+        })
+        .collect();
+    gpsrx_ins_aiding::InsTrack::from_samples(samples).unwrap_or_else(|e| panic!("{e}"))
+}
+
 #[test]
-fn vector_tracking_with_an_ins_is_refused_with_a_clear_message() {
-    let mut config = ReceiverConfig::default();
-    config.tracking.mode = TrackingMode::Vector;
-    let track = gpsrx_ins_aiding::InsTrack::from_samples(
-        (0..20)
-            .map(|k| gpsrx_ins_aiding::InsSample {
-                t_s: k as f64 * 0.1,
-                gps_tow_s: None,
-                pos_m: gpsrx_nav::frames::Vector3::new(6.4e6, 0.0, 0.0),
-                vel_mps: gpsrx_nav::frames::Vector3::zeros(),
-            })
-            .collect(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let assistance = Assistance {
-        ins: Some(gpsrx_receiver::pipeline::InsAiding {
-            track,
-            band_limit_rad_s: None,
-        }),
-        ..Assistance::default()
+fn vector_tracking_with_an_ins_holds_every_satellite_through_a_10_g_turn() {
+    // Issue 29: with `--ins` the INS's motion drives the filter's prediction and the channels'
+    // aid between updates, so the filter keeps the channels through the turn (without an INS
+    // it hands them back at the onset and the 29-32 dB-Hz ones fall out: 5 of 8 held on
+    // samples/scenarios/turn-10g-ins-1mg.toml).
+    let sim = crate::faults::ten_g_turn(12.0, 2.0);
+    let run = |ins: Option<gpsrx_ins_aiding::InsTrack>| {
+        let mut config = ReceiverConfig::default();
+        config.tracking.mode = TrackingMode::Vector;
+        config.run.week = Some(2190);
+        config.run.allow_unhealthy = true;
+        let nav =
+            gpsrx_nav::rinex_nav::parse_rinex_nav(gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT)
+                .unwrap_or_else(|e| panic!("{e}"));
+        let assistance = Assistance {
+            nav: Some(nav),
+            ins: ins.map(|track| gpsrx_receiver::pipeline::InsAiding {
+                track,
+                band_limit_rad_s: None,
+            }),
+            ..Assistance::default()
+        };
+        let mut rx = Receiver::new(&config, 2.048e6, assistance).unwrap_or_else(|e| panic!("{e}"));
+        let mut sink = MemorySink::new().with_channel_epochs();
+        let summary = rx
+            .run(&mut SimSource::new(&sim), &mut sink)
+            .unwrap_or_else(|e| panic!("{e}"));
+        (summary, sink)
     };
-    let err = match Receiver::new(&config, 2.048e6, assistance) {
-        Ok(_) => panic!("vector tracking with an INS was accepted"),
-        Err(e) => e,
-    };
-    // The library names what conflicts (the command line adds its options).
-    assert!(matches!(err, ReceiverError::VectorWithIns), "{err}");
-    let text = err.to_string();
-    assert!(
-        text.contains("vector tracking") && text.contains("INS") && !text.contains("--"),
-        "{text}"
+    // Without an INS the filter hands the channels back at the onset.
+    let (alone, alone_sink) = run(None);
+    let alone = alone.vector.unwrap_or_else(|| panic!("no vector summary"));
+    assert!(alone.disengagements >= 1, "without an INS: {alone:?}");
+    let (summary, sink) = run(Some(biased_ins(&sim, 1e-3 * 9.80665)));
+    let v = summary
+        .vector
+        .clone()
+        .unwrap_or_else(|| panic!("no vector summary"));
+    eprintln!("{v:?}, first fix {:?} s", summary.first_fix_s);
+    // On before the turn (12-18 s), never handed back.
+    assert_eq!((v.engagements, v.disengagements), (1, 0), "{v:?}");
+    assert!(v.vector_s > 20.0 - 11.0, "vector for {:.1} s", v.vector_s);
+    // Every satellite tracked before the turn is in tracking with phase lock through it.
+    let before = locked_in(&sink, 11.0, 12.0);
+    assert!(before.len() >= 7, "tracked before the turn: {before:?}");
+    let through = locked_in(&sink, 12.0, 19.0);
+    assert_eq!(through, before, "locked through the turn");
+    eprintln!(
+        "with the INS: {} of {} satellites locked through the turn; alone: {} of {}",
+        through.len(),
+        before.len(),
+        locked_in(&alone_sink, 12.0, 19.0).len(),
+        locked_in(&alone_sink, 11.0, 12.0).len()
     );
+}
+
+/// The satellites whose every report from `t0_s` to `t1_s` was in tracking and at least 95 of
+/// 100 with phase lock.
+fn locked_in(sink: &MemorySink, t0_s: f64, t1_s: f64) -> std::collections::BTreeSet<u8> {
+    let mut per: std::collections::BTreeMap<u8, (usize, usize, usize)> = Default::default();
+    for (_, e) in sink
+        .channel_epochs
+        .iter()
+        .filter(|(_, e)| (t0_s..t1_s).contains(&e.t_rx_s))
+    {
+        let c = per.entry(e.prn).or_default();
+        c.0 += 1;
+        c.1 += usize::from(e.state == gpsrx_tracking::ChannelState::Track);
+        c.2 += usize::from(e.pll_lock);
+    }
+    per.into_iter()
+        .filter(|(_, (n, tracked, locked))| tracked == n && locked * 100 >= n * 95)
+        .map(|(prn, _)| prn)
+        .collect()
 }
 
 #[test]

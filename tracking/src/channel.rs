@@ -437,6 +437,9 @@ pub struct Channel {
     ff_rate_applied_hz_s: f64,
     /// The last loop update coasted on the aid (`Channel::coasting_on_aid`).
     coasted_last: bool,
+    /// Receive time until which the aid counts as a manoeuvre's, s
+    /// ([`AID_MANOEUVRE_HZ_S`]).
+    aid_manoeuvre_until_s: f64,
     /// Which tracking loops run (after pull-in).
     loops: TrackLoops,
     /// The C/N0 has fallen below [`ChannelConfig::weak_enter_dbhz`] (and not yet climbed back
@@ -553,6 +556,7 @@ impl Channel {
             ff_applied_hz: None,
             ff_rate_applied_hz_s: 0.0,
             coasted_last: false,
+            aid_manoeuvre_until_s: f64::NEG_INFINITY,
             loops: TrackLoops::Normal,
             weak: start.cn0_dbhz < cfg.weak_enter_dbhz || weak_pull_in.is_some(),
             dynamics: false,
@@ -662,7 +666,16 @@ impl Channel {
     /// extrapolated with its rate. `None` removes the aid. Switching the aid on or off keeps the
     /// NCO frequency continuous (the loop's base frequency takes up the difference).
     pub fn set_aid(&mut self, aid: Option<DopplerAid>, t_s: f64) {
+        if aid.is_some_and(|a| a.doppler_rate_hz_s.abs() > AID_MANOEUVRE_HZ_S) {
+            self.aid_manoeuvre_until_s = t_s + AID_MANOEUVRE_HOLD_S;
+        }
         self.aid = aid.map(|a| (a, t_s));
+    }
+
+    /// The aid predicts a manoeuvre: its Doppler rate was above [`AID_MANOEUVRE_HZ_S`] within
+    /// [`AID_MANOEUVRE_HOLD_S`].
+    fn aid_manoeuvre(&self) -> bool {
+        (self.next_sample as f64 / self.fs_hz) < self.aid_manoeuvre_until_s
     }
 
     /// Feed-forward (Hz) for an interval of `t_coh_s` starting at the channel's next sample.
@@ -1239,9 +1252,14 @@ impl Channel {
     /// The loops the tracking state should run now: the aided ones while a feed-forward is
     /// applied (if configured), else the weak-signal ones while the C/N0 is low (if
     /// configured), else the normal ones; first of all the vector weak-signal loops while weak
-    /// and checked by vector tracking (if configured).
+    /// and checked by vector tracking (if configured), unless the aid predicts a manoeuvre
+    /// ([`AID_MANOEUVRE_HZ_S`]).
     fn wanted_loops(&self) -> TrackLoops {
-        if self.weak && self.checked_aid() && self.cfg.vector_weak_track.is_some() {
+        if self.weak
+            && self.checked_aid()
+            && !self.aid_manoeuvre()
+            && self.cfg.vector_weak_track.is_some()
+        {
             return TrackLoops::VectorWeak;
         }
         if self.ff_applied_hz.is_some() && self.cfg.aided_track.is_some() {
@@ -1394,6 +1412,16 @@ impl Channel {
 /// whose estimates cross the threshold back and forth, out of their lock: 0.91 of the time
 /// locked scalar, 0.73 coasting).
 pub const COAST_BELOW_LOST_DB: f64 = 6.0;
+
+/// An aid's Doppler rate above which it predicts a manoeuvre, Hz/s (1 m/s^2 along the line of
+/// sight; a satellite's own motion gives at most 0.9 Hz/s). Its prediction is then good to
+/// tenths of a hertz but not steady: the vector weak-signal loops (3 Hz) lost phase lock on
+/// its 0.3-0.9 Hz swings in a 10 g turn with an INS (31-32 dB-Hz satellites: 0.36 of the turn
+/// locked); the weak-signal loops (6 Hz) held them.
+pub const AID_MANOEUVRE_HZ_S: f64 = 5.0;
+/// How long after its last rate above [`AID_MANOEUVRE_HZ_S`] an aid still counts as a
+/// manoeuvre's, s (the end of a turn swings as its start does).
+pub const AID_MANOEUVRE_HOLD_S: f64 = 2.0;
 
 /// How long the Costas gain keeps its C/N0 after the first new bit edge of a restarted bit
 /// synchronisation, ms: the phase-lock detector's memory then holds the unaligned blocks;

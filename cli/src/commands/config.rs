@@ -153,8 +153,9 @@ pub fn default_toml() -> anyhow::Result<String> {
          clock_h0 = {:e}          # receiver oscillator white frequency noise h0, s (a TCXO)\n\
          clock_h_2 = {:e}         # receiver oscillator random-walk frequency noise h-2, 1/s (a TCXO)\n\
          gate_pfa = {:?}          # false-alarm probability of the innovation test that excludes a channel\n\
-         max_coast_s = {:?}         # longest prediction of a satellite without a measurement that holds its channel through an outage, s\n",
-        v.accel_psd_m2_s3, v.clock_h0, v.clock_h_2, v.gate_pfa, v.max_coast_s,
+         max_coast_s = {:?}         # longest prediction of a satellite without a measurement that holds its channel through an outage, s\n\
+         ins_accel_psd_m2_s3 = {:?} # with --ins: the INS velocity error's random-walk PSD per ECEF axis, m^2/s^3 (the INS's motion drives the filter)\n",
+        v.accel_psd_m2_s3, v.clock_h0, v.clock_h_2, v.gate_pfa, v.max_coast_s, v.ins_accel_psd_m2_s3,
     );
     Ok(text + &vector)
 }

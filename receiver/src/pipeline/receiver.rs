@@ -40,6 +40,7 @@ use gpsrx_samples::{SampleError, SampleSource};
 use gpsrx_tracking::{AidingPort, ChannelEpoch, TrackingMode};
 use num_complex::Complex32;
 use std::path::Path;
+use std::sync::Arc;
 
 mod overlap;
 
@@ -72,9 +73,6 @@ pub enum ReceiverError {
     /// The INS input cannot be used.
     #[error("INS: {0}")]
     Ins(String),
-    /// Vector tracking was asked for with an INS, which it does not take yet.
-    #[error("vector tracking does not take an INS yet (the vector + INS coupling is a later part of issue 29): track scalar with the INS, or vector without it")]
-    VectorWithIns,
     /// Samples after the end of the stream.
     #[error("the stream has ended (finish was called): make a new Receiver for another stream")]
     Finished,
@@ -268,7 +266,7 @@ pub struct Receiver {
     window: SampleWindow,
     manager: ChannelManager,
     nav: NavigationProcessor,
-    aiding: Option<InsFeedForward>,
+    aiding: Option<Arc<InsFeedForward>>,
     /// The integrity monitor of the aiding (with `aiding`).
     monitor: AidMonitor,
     /// Vector tracking (`[tracking] mode = "vector"`).
@@ -337,11 +335,7 @@ impl Receiver {
         search: SearchSettings,
     ) -> Result<Self, ReceiverError> {
         config.validate()?;
-        if config.tracking.mode == TrackingMode::Vector && assistance.ins.is_some() {
-            return Err(ReceiverError::VectorWithIns);
-        }
-        let vector = (config.tracking.mode == TrackingMode::Vector)
-            .then(|| VectorTracking::new(config, assistance.nav.clone()));
+        let vector_nav = assistance.nav.clone();
         let run = &config.run;
         let manager = ChannelManager::new(fs_hz, config.tracking, search)?;
         // The week that labels receiver time until subframe 1 is decoded, and resolves the
@@ -372,7 +366,11 @@ impl Receiver {
                     .pll_order,
             )?),
             None => None,
-        };
+        }
+        .map(Arc::new);
+        // With an INS, its motion drives the filter's prediction (`crate::pipeline::vector`).
+        let vector = (config.tracking.mode == TrackingMode::Vector)
+            .then(|| VectorTracking::new(config, vector_nav).with_ins(aiding.clone()));
         let nav = NavigationProcessor::new(
             fs_hz,
             run.clone(),
@@ -449,7 +447,7 @@ impl Receiver {
 
     /// The INS feed-forward, when the receiver is aided.
     pub fn aiding(&self) -> Option<&InsFeedForward> {
-        self.aiding.as_ref()
+        self.aiding.as_deref()
     }
 
     /// Vector tracking, with `[tracking] mode = "vector"`.
@@ -661,7 +659,7 @@ impl Receiver {
         let due = self
             .manager
             .due_search(view, &|p| nav.visibility(p.get(), t_s));
-        let gated = gated_aid(self.aiding.as_ref(), &self.monitor);
+        let gated = gated_aid(self.aiding.as_deref(), &self.monitor);
         let bridge = self.bridge.as_ref().map(|(b, _)| b);
         let aid = round_aid(gated.as_ref(), self.vector.as_ref(), bridge);
         let manager = &mut self.manager;
@@ -710,7 +708,7 @@ impl Receiver {
         let reports = ReportsOut {
             nav: &mut self.nav,
             reports: self.manager.reports_mut(),
-            aiding: self.aiding.as_ref(),
+            aiding: self.aiding.as_deref(),
             monitor: &mut self.monitor,
             vector: self.vector.as_mut(),
             span: done_span(self.first_sample, self.processed_to, self.fs_hz),
@@ -730,7 +728,7 @@ impl Receiver {
         ReportsOut {
             nav: &mut self.nav,
             reports: self.manager.reports_mut(),
-            aiding: self.aiding.as_ref(),
+            aiding: self.aiding.as_deref(),
             monitor: &mut self.monitor,
             vector: self.vector.as_mut(),
             span: done_span(self.first_sample, self.processed_to, self.fs_hz),
@@ -934,9 +932,9 @@ fn gated_aid<'a>(
     })
 }
 
-/// The aiding port of the next round: the gated INS feed-forward with `--ins`, the
-/// navigation filter's with `--tracking vector` while it drives the channels (the two are
-/// never both on), else the bridge over an outage under way, else none.
+/// The aiding port of the next round: the navigation filter's with `--tracking vector` while
+/// it drives the channels (with `--ins` the INS's motion is in its prediction), else the gated
+/// INS feed-forward with `--ins`, else the bridge over an outage under way, else none.
 fn round_aid<'a>(
     gated: Option<&'a GatedAid<'a, InsFeedForward>>,
     vector: Option<&'a VectorTracking>,
@@ -944,8 +942,8 @@ fn round_aid<'a>(
 ) -> Option<&'a dyn AidingPort> {
     let vector = vector.filter(|v| v.port().snapshot.is_some());
     match (gated, vector, bridge) {
-        (Some(g), _, _) => Some(g as &dyn AidingPort),
-        (None, Some(v), _) => Some(v.port() as &dyn AidingPort),
+        (_, Some(v), _) => Some(v.port() as &dyn AidingPort),
+        (Some(g), None, _) => Some(g as &dyn AidingPort),
         (None, None, Some(b)) => Some(b as &dyn AidingPort),
         (None, None, None) => None,
     }

@@ -221,6 +221,23 @@ impl InsFeedForward {
         }
     }
 
+    /// The INS position and velocity (ECEF m, m/s) at stream time `t_s` (seconds from the
+    /// first sample; samples lost are added, module docs "Time"), None outside the INS file
+    /// or, for a file in the GPS time base, before the GPS time is known. Vector tracking
+    /// with an INS propagates its filter with it (`crate::pipeline::vector`).
+    pub fn motion_at(&self, t_s: f64) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let (t0, lost_s) = {
+            let k = self.know.read().ok()?;
+            (k.t0, k.lost_s)
+        };
+        let t_s = t_s + lost_s;
+        match t0 {
+            Some(t0) => self.ins_at(t0, t_s),
+            None if self.ins.gps_time_base_tow_s().is_none() => self.ins.at(t_s),
+            None => None,
+        }
+    }
+
     /// The elapsed time since the first sample for stream time `t_s`.
     fn elapsed_s(&self, t_s: f64) -> f64 {
         t_s + self.know.read().map_or(0.0, |k| k.lost_s)

@@ -16,6 +16,16 @@
 //!     [0   0    0  1 ]
 //! ```
 //!
+//! # With an INS
+//!
+//! The INS measures the motion: over an interval its velocity change `dv` (from the INS
+//! file's velocities) drives the prediction, `r += v dt + dv dt / 2`, `v += dv`, and the
+//! process noise is that of the INS's velocity error (`[vector] ins_accel_psd_m2_s3`: an
+//! accelerometer bias of 1 mg grows 0.01 m/s per second, a late INS output errs by its latency times the change of acceleration), not of the vehicle's acceleration.
+//! The velocity state is then the INS velocity corrected by the measurements: its error is
+//! a random walk the Dopplers follow (no accelerometer-bias states: the INS log gives no
+//! attitude, and a body-frame bias turns with the vehicle).
+//!
 //! # Measurement update
 //!
 //! Linearised rows `z - h(x_prior) = H dx + e`, `e ~ N(0, R)` (built in `measure`). Every row's
@@ -237,12 +247,30 @@ impl NavFilter {
 
     /// Propagates state and covariance by `dt_s`.
     pub fn predict(&mut self, dt_s: f64) {
+        self.predict_driven(dt_s, &Vector3::zeros(), self.params.accel_psd_m2_s3);
+    }
+
+    /// Propagates state and covariance by `dt_s` with the velocity change `dv_mps` an INS
+    /// measured over it (module docs, "With an INS"): `r += v dt + dv dt / 2`, `v += dv`, and
+    /// the process noise of `accel_psd_m2_s3` (the INS's velocity error, not the vehicle's
+    /// motion). A non-finite `dv_mps` counts as none.
+    pub fn predict_driven(&mut self, dt_s: f64, dv_mps: &Vector3<f64>, accel_psd_m2_s3: f64) {
         if !(dt_s.is_finite() && dt_s != 0.0) {
             return;
         }
         let f = Self::transition(dt_s);
         self.x = f * self.x;
-        self.p = f * self.p * f.transpose() + Self::process_noise(&self.params, dt_s);
+        if dv_mps.iter().all(|v| v.is_finite()) {
+            for i in 0..3 {
+                self.x[i] += 0.5 * dv_mps[i] * dt_s;
+                self.x[3 + i] += dv_mps[i];
+            }
+        }
+        let params = FilterParams {
+            accel_psd_m2_s3,
+            ..self.params
+        };
+        self.p = f * self.p * f.transpose() + Self::process_noise(&params, dt_s);
         self.p = 0.5 * (self.p + self.p.transpose());
     }
 

@@ -6,7 +6,10 @@
 //! state at its last update (stream time `t_u`, GPS time `T_u`):
 //!
 //! 1. the receiver `dt = t - t_u` later: `r = r_u + v dt`, `v`, clock drift `d` (the
-//!    constant-velocity model of the filter);
+//!    constant-velocity model of the filter); with an INS, the filter's state moved by the
+//!    INS's motion since the update: `v = v_u + (v_ins(t) - v_ins(t_u))`,
+//!    `r = r_u + (v_u - v_ins(t_u)) dt + (r_ins(t) - r_ins(t_u))` (its position error and
+//!    velocity error held), so the aid follows a manoeuvre between updates;
 //! 2. the satellite seen from `r` at GPS time `T_u + dt` (its ephemeris at the transmit time,
 //!    rotated by the Earth's rotation during the flight: `Ephemeris::at_reception`);
 //! 3. the Doppler `f = -((v_sv - v_rx) . u) / lambda + f_L1 (d_sv - d / c)`
@@ -31,6 +34,7 @@
 //! over 3 s: 4.5 m, 0.015 chip).
 
 use super::ekf::{State, BIAS, DRIFT};
+use crate::pipeline::aiding::InsFeedForward;
 use gpsrx_core::constants::SPEED_OF_LIGHT_MPS;
 use gpsrx_core::{los_doppler_hz, PosVel};
 use gpsrx_nav::ephemeris::Ephemeris;
@@ -63,6 +67,31 @@ pub struct Snapshot {
     /// Longest prediction (from the update, and from a satellite's last admitted
     /// measurement for its [`DopplerAid::coast`]), s: `[vector] max_coast_s`.
     pub max_coast_s: f64,
+    /// With an INS: its motion at the update, which the prediction follows from there.
+    pub ins: Option<InsAnchor>,
+}
+
+/// The INS whose motion a [`Snapshot`]'s prediction follows, and its state at the update.
+#[derive(Debug, Clone)]
+pub struct InsAnchor {
+    /// The INS (its positions and velocities at stream times).
+    pub ins: Arc<InsFeedForward>,
+    /// Its position at the update, ECEF m.
+    pub pos_m: Vector3<f64>,
+    /// Its velocity at the update, ECEF m/s.
+    pub vel_mps: Vector3<f64>,
+}
+
+impl InsAnchor {
+    /// The anchor at stream time `t_s` (None outside the INS file).
+    pub fn at(ins: &Arc<InsFeedForward>, t_s: f64) -> Option<Self> {
+        let (pos_m, vel_mps) = ins.motion_at(t_s)?;
+        Some(Self {
+            ins: Arc::clone(ins),
+            pos_m,
+            vel_mps,
+        })
+    }
 }
 
 impl Snapshot {
@@ -74,8 +103,7 @@ impl Snapshot {
             return None;
         }
         let eph = self.ephemerides.get(&prn)?;
-        let vel = Vector3::new(self.x[3], self.x[4], self.x[5]);
-        let pos = Vector3::new(self.x[0], self.x[1], self.x[2]) + vel * dt;
+        let (pos, vel) = self.motion(t_s, dt);
         let drift_mps = self.x[DRIFT];
         let seen = eph.at_reception(self.gps_time.add_seconds(dt), &pos, 0.075, 2);
         let sv = PosVel {
@@ -93,6 +121,22 @@ impl Snapshot {
             drift_mps / SPEED_OF_LIGHT_MPS,
         )?;
         f.is_finite().then_some(f)
+    }
+
+    /// The receiver's predicted position and velocity (ECEF m, m/s) at stream time `t_s`,
+    /// `dt` after the update: the filter's velocity held, or with an INS the filter's state
+    /// moved by the INS's motion since the update (module docs).
+    fn motion(&self, t_s: f64, dt: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let vel = Vector3::new(self.x[3], self.x[4], self.x[5]);
+        let pos = Vector3::new(self.x[0], self.x[1], self.x[2]);
+        let by_ins = self.ins.as_ref().and_then(|a| {
+            let (p, v) = a.ins.motion_at(t_s)?;
+            Some((
+                pos + (vel - a.vel_mps) * dt + (p - a.pos_m),
+                vel + (v - a.vel_mps),
+            ))
+        });
+        by_ins.unwrap_or((pos + vel * dt, vel))
     }
 
     /// Whether the channel of `prn` may coast on the prediction at stream time `t_s` through

@@ -12,9 +12,14 @@
 //!   the filter to the epoch and updates it with the pseudoranges and Dopplers of the tracked
 //!   channels (`measure`), each weighted by its C/N0 (`noise`), each tested (`ekf`).
 //! - **Not under hard dynamics** (`dynamics`): the filter takes the channels only once the
-//!   fixes' velocities have shown less than 3 m/s^2 for 1 s, and hands them back as soon as
-//!   they show more (its feed-forward is a prediction 0.2-0.3 s ahead of its last
-//!   measurement).
+//!   fixes' velocities have shown less than 3 m/s^2 for 1 s, and, without an INS, hands them
+//!   back as soon as they show more (its feed-forward is a prediction 0.2-0.3 s ahead of its
+//!   last measurement, on a constant velocity).
+//! - **With an INS** (`--ins`) the INS's motion drives the prediction, both the filter's
+//!   (`super::ekf`, "With an INS") and the channels' between updates (`super::feed`): the
+//!   channels' aid follows a manoeuvre as the INS sees it, corrected by the measurements, and
+//!   the filter keeps the channels through it. Before the first fix and after a hand-back the
+//!   channels take the INS feed-forward of seed 004 (`crate::pipeline::aiding`).
 //! - **Through an outage** the filter predicts: a satellite whose measurement it admitted
 //!   within `[vector] max_coast_s` (5 s) has its channel held on the prediction while its
 //!   signal is blocked (`super::feed`), and a blockage of every satellite is bridged the same
@@ -29,8 +34,11 @@
 //!   feed-forward error carried through the blockage).
 //! - **Back to scalar** when the filter's health test fails [`UNHEALTHY_EPOCHS`] epochs in a
 //!   row, or when no row was admitted for `max_coast_s` (the channels lost everything): an
-//!   epoch is unhealthy when it had measurements and none was admitted, when more rows were
-//!   excluded than admitted, or when the 3-D position sigma is above [`MAX_POSITION_SIGMA_M`].
+//!   epoch is unhealthy when it had measurements and none was admitted, when more
+//!   pseudoranges or more Dopplers were excluded than admitted (a filter whose velocity went
+//!   wrong, under an INS whose motion is 50 ms late in a 10 g turn, kept admitting the
+//!   pseudoranges while it excluded 6 of 8 Dopplers, and stayed 4 m/s off after the turn), or
+//!   when the 3-D position sigma is above [`MAX_POSITION_SIGMA_M`].
 //!   Fewer than 4 satellites do not make it unhealthy: the filter coasts on its prediction
 //!   through a partial blockage (its covariance grows, the sigma test ends it). The next valid
 //!   fix starts the filter again.
@@ -47,10 +55,11 @@
 
 use super::dynamics::AccelWatch;
 use super::ekf::{ClockModel, FilterParams, NavFilter, RowKind, BIAS};
-use super::feed::{Snapshot, VectorPort};
+use super::feed::{InsAnchor, Snapshot, VectorPort};
 use super::measure::{epoch_rows, RowModel};
 use super::noise::LoopNoise;
 use crate::config::{IonoModel, ReceiverConfig, TropoModel};
+use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::navigation::NavigationProcessor;
 use crate::pipeline::sink::{FixQuality, FixReport, ObsEpoch};
 use gpsrx_core::constants::SPEED_OF_LIGHT_MPS;
@@ -169,6 +178,10 @@ pub struct VectorTracking {
     dynamics: AccelWatch,
     port: VectorPort,
     summary: VectorSummary,
+    /// With an INS (`--ins`): its motion drives the prediction (`super::ekf`, "With an INS").
+    ins: Option<Arc<InsFeedForward>>,
+    /// `[vector] ins_accel_psd_m2_s3`.
+    ins_accel_psd_m2_s3: f64,
 }
 
 impl VectorTracking {
@@ -209,7 +222,15 @@ impl VectorTracking {
             dynamics: AccelWatch::default(),
             port: VectorPort::default(),
             summary: VectorSummary::default(),
+            ins: None,
+            ins_accel_psd_m2_s3: v.ins_accel_psd_m2_s3,
         }
+    }
+
+    /// Propagates the filter with an INS's motion (module docs, "With an INS").
+    pub fn with_ins(mut self, ins: Option<Arc<InsFeedForward>>) -> Self {
+        self.ins = ins;
+        self
     }
 
     /// The aiding port for the channels' next round.
@@ -262,7 +283,7 @@ impl VectorTracking {
                 continue;
             };
             let t_stream_s = t0 + epoch.time.diff_s(rx0);
-            if self.filter.is_some() && self.dynamics.too_high() {
+            if self.filter.is_some() && self.ins.is_none() && self.dynamics.too_high() {
                 let a = self.dynamics.accel_mps2().unwrap_or(f64::NAN);
                 self.disengage(
                     t_stream_s,
@@ -348,7 +369,16 @@ impl VectorTracking {
             self.disengage(t_stream_s, "no measurement admitted for too long");
             return;
         }
-        filter.predict(dt);
+        // With an INS, the velocity change it measured over the interval.
+        let dv = self.ins.as_ref().and_then(|ins| {
+            let (_, v1) = ins.motion_at(t_stream_s)?;
+            let (_, v0) = ins.motion_at(t_last)?;
+            Some(v1 - v0)
+        });
+        match dv {
+            Some(dv) => filter.predict_driven(dt, &dv, self.ins_accel_psd_m2_s3),
+            None => filter.predict(dt),
+        }
         let x = *filter.state();
         let opts = PvtOptions {
             iono: self.iono(nav),
@@ -413,8 +443,13 @@ impl VectorTracking {
             filter.state()[super::ekf::DRIFT],
             filter.position_sigma_m()
         );
+        // Per kind: a filter whose velocity went wrong (an INS whose motion is late or
+        // scaled) keeps admitting the pseudoranges while it excludes most Dopplers.
+        let rejected = |kind| out.rejected.iter().filter(|r| r.1 == kind).count();
+        let admitted_doppler = out.admitted - out.admitted_code;
         let healthy = (rows.is_empty() || out.admitted > 0)
-            && out.rejected.len() <= out.admitted
+            && rejected(RowKind::Code) <= out.admitted_code
+            && rejected(RowKind::Doppler) <= admitted_doppler
             && filter.position_sigma_m() <= MAX_POSITION_SIGMA_M;
         self.unhealthy_in_row = if healthy {
             0
@@ -423,9 +458,11 @@ impl VectorTracking {
         };
         if self.unhealthy_in_row >= UNHEALTHY_EPOCHS {
             let why = format!(
-                "health test failed {UNHEALTHY_EPOCHS} epochs in a row: {} pseudoranges admitted, {} rows excluded, position sigma {:.1} m",
+                "health test failed {UNHEALTHY_EPOCHS} epochs in a row: {} pseudoranges and {} Dopplers admitted, {} and {} excluded, position sigma {:.1} m",
                 out.admitted_code,
-                out.rejected.len(),
+                admitted_doppler,
+                rejected(RowKind::Code),
+                rejected(RowKind::Doppler),
                 filter.position_sigma_m()
             );
             self.disengage(t_stream_s, &why);
@@ -475,6 +512,7 @@ impl VectorTracking {
             snap.t_stream_s = t_last;
             snap.gps_time = rx.add_seconds(-x[BIAS] / SPEED_OF_LIGHT_MPS);
             snap.x = x;
+            snap.ins = self.ins.as_ref().and_then(|i| InsAnchor::at(i, t_last));
         }
     }
 
@@ -494,6 +532,7 @@ impl VectorTracking {
             ephemerides: Arc::new(ephemerides),
             admitted_s: Arc::new(self.admitted_s.clone()),
             max_coast_s: self.max_coast_s,
+            ins: self.ins.as_ref().and_then(|i| InsAnchor::at(i, t_stream_s)),
         });
     }
 }
