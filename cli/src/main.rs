@@ -15,8 +15,14 @@ fn main() -> ExitCode {
     return_large_blocks_to_the_system();
     main_thread_in_the_pool();
     let cli = Cli::parse();
+    // A study runs the receiver on tens of cases: their progress lines would bury its table.
+    let quiet = matches!(cli.command, Command::Study(_));
     let filter = tracing_subscriber::EnvFilter::try_from_env("GPSRX_LOG").unwrap_or_else(|_| {
-        tracing_subscriber::EnvFilter::new(if cli.verbose { "debug" } else { "info" })
+        tracing_subscriber::EnvFilter::new(match (cli.verbose, quiet) {
+            (true, _) => "debug",
+            (false, true) => "warn",
+            (false, false) => "info",
+        })
     });
     // No colour codes in a log file or a pipe (nor with NO_COLOR set).
     let ansi = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();

@@ -630,6 +630,7 @@ fn aided_loops_are_used_while_the_aid_is_on() {
             doppler_rate_hz_s: 0.0,
             coast: false,
             checked: false,
+            source: gpsrx_tracking::AidSource::Ins,
         })
     };
     let mut src =

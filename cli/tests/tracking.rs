@@ -265,6 +265,7 @@ fn truth_doppler_aid(
         doppler_rate_hz_s: (c.carrier_cycles - 2.0 * b.carrier_cycles + a.carrier_cycles) / (h * h),
         coast,
         checked: false,
+        source: gpsrx_tracking::AidSource::Vector,
     })
 }
 

@@ -329,6 +329,7 @@ impl SatTruth {
             doppler_rate_hz_s: (c - 2.0 * b + a) / (h * h),
             coast: false,
             checked: false,
+            source: gpsrx_tracking::AidSource::Ins,
         }
     }
 }

@@ -14,6 +14,7 @@ pub mod landmarks;
 pub mod report;
 pub mod steady_state;
 pub mod threshold;
+pub mod vector;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
@@ -54,6 +55,10 @@ pub enum StudyKind {
     /// rule of thumb 3 sigma + theta_e <= 45 deg, cross-checked on IF samples, and the DLL's
     /// code jitter against theory; also writes threshold.csv and dll.csv.
     Threshold(threshold::ThresholdArgs),
+    /// Scalar, INS-aided, vector and vector + INS tracking side by side (issue 29): the
+    /// tracking threshold on a fading sky (against Lashley et al.'s 2.4-6.2 dB), the time back
+    /// to a fix after a 3 s blockage, the satellites held through 4 and 10 g turns.
+    Vector(vector::VectorArgs),
 }
 
 /// Options every study has.
@@ -79,6 +84,7 @@ pub fn run(args: &StudyArgs) -> anyhow::Result<()> {
         StudyKind::Dynamics(a) => (dynamics::run(a, true)?, &a.common.out),
         StudyKind::Dr(a) => (dr::run(a, true)?, &a.common.out),
         StudyKind::Landmarks(a) => (landmarks::run(a, true)?, &a.common.out),
+        StudyKind::Vector(a) => (vector::run(a, true)?, &a.common.out),
         StudyKind::Threshold(a) => {
             let (report, dll) = threshold::run_with_dll(a, true)?;
             extra_csv = Some(dll);

@@ -29,3 +29,4 @@ mod study_dynamics;
 mod study_landmarks;
 mod study_steady_state;
 mod study_threshold;
+mod study_vector;

@@ -31,6 +31,24 @@ pub struct DopplerAid {
     /// as lost, and gives no observables, only below
     /// `ChannelConfig::vector_cn0_lost_dbhz` instead of `cn0_lost_dbhz`.
     pub checked: bool,
+    /// Where the aid comes from: when it changes, the channel keeps its NCO frequency
+    /// continuous as when an aid comes or goes (two sources leave different shares to the
+    /// loop: the INS feed-forward leaves it the receiver clock drift of when it came on, vector
+    /// tracking's carries the whole drift; a switch between them stepped every NCO by
+    /// `f_L1 d_rx`, 63 Hz at 4e-8, which read as samples lost).
+    pub source: AidSource,
+}
+
+/// The source of a [`DopplerAid`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AidSource {
+    /// An INS's velocity (seed 004's feed-forward).
+    #[default]
+    Ins,
+    /// The bridge over an outage (the fixes' motion).
+    Bridge,
+    /// Vector tracking's navigation filter.
+    Vector,
 }
 
 impl DopplerAid {
@@ -232,6 +250,7 @@ mod tests {
             doppler_rate_hz_s: 50.0,
             coast: false,
             checked: false,
+            source: crate::AidSource::Ins,
         };
         assert!((aid.mean_over_hz(0.02) - 100.5).abs() < 1e-12);
         assert_eq!(carrier_nco_hz(f64::NAN, 3.0), 3.0);

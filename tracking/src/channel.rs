@@ -437,6 +437,8 @@ pub struct Channel {
     ff_rate_applied_hz_s: f64,
     /// The last loop update coasted on the aid (`Channel::coasting_on_aid`).
     coasted_last: bool,
+    /// The source of the feed-forward applied over the last interval.
+    ff_source: Option<crate::AidSource>,
     /// Receive time until which the aid counts as a manoeuvre's, s
     /// ([`AID_MANOEUVRE_HZ_S`]).
     aid_manoeuvre_until_s: f64,
@@ -556,6 +558,7 @@ impl Channel {
             ff_applied_hz: None,
             ff_rate_applied_hz_s: 0.0,
             coasted_last: false,
+            ff_source: None,
             aid_manoeuvre_until_s: f64::NEG_INFINITY,
             loops: TrackLoops::Normal,
             weak: start.cn0_dbhz < cfg.weak_enter_dbhz || weak_pull_in.is_some(),
@@ -1089,6 +1092,7 @@ impl Channel {
         // supplies, its Doppler and its Doppler rate, so the NCO does not move (bumpless).
         // Keeping the rate a 3rd-order loop learned in a turn would count it twice.
         let ff_rate = self.aid.map_or(0.0, |(a, _)| a.doppler_rate_hz_s);
+        let ff_source = self.aid.map(|(a, _)| a.source);
         match (self.ff_applied_hz, ff_opt) {
             (None, Some(f)) => {
                 // The feed-forward's phase is counted from the next interval's first sample: the
@@ -1107,10 +1111,21 @@ impl Channel {
                 self.carrier.shift_doppler_rate(self.ff_rate_applied_hz_s);
                 self.ff_rate_applied_hz_s = 0.0;
             }
+            (Some(old), Some(f)) if self.ff_source != ff_source => {
+                // Another source (vector tracking taking over from the INS feed-forward, or
+                // handing back): as the old aid going and the new one coming.
+                let t_c = self.next_sample as f64 / self.fs_hz;
+                self.aid_switched = Some((t_c, f - old, ff_rate - self.ff_rate_applied_hz_s));
+                self.carrier.shift_base_hz(old - f);
+                self.carrier
+                    .shift_doppler_rate(self.ff_rate_applied_hz_s - ff_rate);
+                self.ff_rate_applied_hz_s = ff_rate;
+            }
             (Some(_), Some(_)) => self.ff_rate_applied_hz_s = ff_rate,
             (None, None) => {}
         }
         self.ff_applied_hz = ff_opt;
+        self.ff_source = ff_source.filter(|_| ff_opt.is_some());
         let ff = ff_opt.unwrap_or(0.0);
         let coasting = self.coasting_on_aid();
         if coasting && !self.coasted_last {

@@ -38,7 +38,7 @@ pub mod loop_filter;
 pub mod phase_fit;
 pub mod phase_sim;
 
-pub use aiding::{AidingPort, DopplerAid, TrackingMode};
+pub use aiding::{AidSource, AidingPort, DopplerAid, TrackingMode};
 pub use bit_sync::{Bit, BitSync, BitSyncConfig, BitSyncState};
 pub use carrier_loop::{CarrierLoop, CarrierOutput};
 pub use channel::{

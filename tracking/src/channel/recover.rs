@@ -443,6 +443,7 @@ mod tests {
                     doppler_rate_hz_s: 0.0,
                     coast: false,
                     checked: false,
+                    source: crate::AidSource::Ins,
                 };
                 ch.set_aid((aided && t > 2.9).then_some(aid), t);
                 let x: Vec<Complex32> = (first..first + n as u64).map(|k| sig.sample(k)).collect();

@@ -51,6 +51,7 @@ fn perfect_aid(traj: &Trajectory, t: f64) -> f64 {
         doppler_rate_hz_s: a,
         coast: false,
         checked: false,
+        source: gpsrx_tracking::AidSource::Ins,
     }
     .mean_over_hz(T)
 }

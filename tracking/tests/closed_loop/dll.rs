@@ -196,6 +196,7 @@ fn carrier_aided_code_loop() {
                 doppler_rate_hz_s: a,
                 coast: false,
                 checked: false,
+                source: gpsrx_tracking::AidSource::Ins,
             }
             .mean_over_hz(T),
         )

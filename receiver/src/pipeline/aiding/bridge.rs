@@ -282,6 +282,7 @@ impl gpsrx_tracking::AidingPort for OutageBridge {
             doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
             coast: false,
             checked: false,
+            source: gpsrx_tracking::AidSource::Bridge,
         })
     }
 }

@@ -484,6 +484,7 @@ impl InsFeedForward {
                     doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
                     coast: false,
                     checked: false,
+                    source: gpsrx_tracking::AidSource::Ins,
                 }
             }
             Some(alpha) => {
@@ -500,6 +501,7 @@ impl InsFeedForward {
                     doppler_rate_hz_s: alpha * (f - y),
                     coast: false,
                     checked: false,
+                    source: gpsrx_tracking::AidSource::Ins,
                 }
             }
         };

@@ -181,6 +181,7 @@ impl gpsrx_tracking::AidingPort for VectorPort {
             doppler_rate_hz_s: (f2 - f) / RATE_STEP_S,
             coast: snap.coasts(prn.get(), t_s),
             checked: snap.checked(prn.get(), t_s),
+            source: gpsrx_tracking::AidSource::Vector,
         })
     }
 }
