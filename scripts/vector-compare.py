@@ -5,9 +5,13 @@ Usage: simulate first (VEC_WORK defaults to /tmp/vec):
   gpsrx simulate samples/scenarios/vector-weak-26-32dbhz.toml -o $VEC_WORK/sim-vector-weak-26-32dbhz
   gpsrx simulate samples/scenarios/vector-blockage-3s.toml   -o $VEC_WORK/sim-vector-blockage-3s
   gpsrx simulate samples/scenarios/turn-10g-ins-perfect.toml -o $VEC_WORK/sim-turn
-then `scripts/vector-compare.py weak|block|turn`. Prints, per mode: valid fixes, mean satellites
-in the fixes, the PRNs used, horizontal RMS against truth.csv, the time back to a valid fix after
-the blockage, and the share of 20-27 s each satellite's channel was in carrier lock in the turn.
+  gpsrx simulate samples/scenarios/turn-10g-ins-1mg.toml    -o $VEC_WORK/sim-turn-ins-1mg
+then `scripts/vector-compare.py weak|block|turn|turn-ins`. Prints, per mode: valid fixes, mean
+satellites in the fixes, the PRNs used, horizontal RMS against truth.csv, the time back to a valid
+fix after the blockage and the largest 3-D error in the 3 s after it, and the share of 20-27 s
+each satellite's channel was in carrier lock in the turn. `block SIM` scores another simulation
+of the blockage (the scenario with another seed); `turn-ins` runs scalar with the INS, vector,
+and vector with the INS on the turn with a 1 mg INS.
 """
 import csv, json, math, subprocess, sys, os
 
@@ -55,7 +59,7 @@ def score(sim, out, t_start_tow, window=None):
         tow = float(f["tow_s"])
         t = truth_at(tr, tow - float(f["clock_bias_m"]) / 299792458.0)
         e, n, u = ecef_to_enu_err(float(f["x_m"]), float(f["y_m"]), float(f["z_m"]), t[1], t[2], t[3], t[4], t[5])
-        res.append((tow - t_start_tow, math.hypot(e, n), abs(u), int(f["n_sv"]), f["used_prns"].split(), float(f["sigma_e_m"]), float(f["sigma_n_m"])))
+        res.append((tow - t_start_tow, math.hypot(e, n), abs(u), int(f["n_sv"]), f["used_prns"].split(), float(f["sigma_e_m"]), float(f["sigma_n_m"]), math.sqrt(e * e + n * n + u * u)))
     return res
 
 def summary(name, summ, res, sel=lambda r: True):
@@ -89,17 +93,32 @@ if __name__ == "__main__":
             summary(f"weak {mode} (t>=20s)", s, res, lambda r: r[0] >= 20)
             print("  lock share 20-40 s:", {p: round(v, 2) for p, v in sorted(locks(out, 20, 40).items(), key=lambda x: int(x[0]))})
     if which == "block":
-        sim = f"{base}/sim-vector-blockage-3s"
+        sim = sys.argv[2] if len(sys.argv) > 2 else f"{base}/sim-vector-blockage-3s"
+        tag = os.path.basename(sim.rstrip("/"))
         for mode in ("scalar", "vector"):
-            out = f"{base}/block-{mode}"
+            out = f"{base}/block-{tag}-{mode}"
             s = run(sim, mode, out)
             res = score(sim, out, 538194.0)
             summary(f"block {mode} (before)", s, res, lambda r: r[0] < 20)
             after = [r for r in res if r[0] >= 23]
             if after:
+                first3 = [r for r in after if r[0] <= after[0][0] + 3.0]
                 print(f"  first valid fix after the blockage: {after[0][0] - 23:.2f} s after it ended, "
-                      f"errors of the first 10: {[round(r[1], 1) for r in after[:10]]}, n_sv {[r[3] for r in after[:10]]}")
+                      f"errors of the first 10: {[round(r[1], 1) for r in after[:10]]}, n_sv {[r[3] for r in after[:10]]}; "
+                      f"in the 3 s after it: 3-D max {max(r[7] for r in first3):.1f} m, horizontal max {max(r[1] for r in first3):.1f} m")
                 summary(f"block {mode} (after)", s, res, lambda r: r[0] >= 23)
+    if which == "turn-ins":
+        sim = f"{base}/sim-turn-ins-1mg"
+        ins = ["--ins", f"{sim}/ins.csv"]
+        for mode, extra in (("scalar", ins), ("vector", []), ("vector", ins)):
+            out = f"{base}/turn-ins-{mode}-{len(extra)}"
+            s = run(sim, mode, out, extra)
+            res = score(sim, out, 538194.0)
+            name = f"turn {mode}{' + INS' if extra else ''}"
+            summary(f"{name} (20-27 s)", s, res, lambda r: 20 <= r[0] <= 27)
+            lk = locks(out, 20, 27)
+            held = [p for p, v in lk.items() if v >= 0.95]
+            print(f"  satellites held through the turn (carrier lock >= 95% of 20-27 s): {len(held)} of {len(lk)}: {sorted(lk.items(), key=lambda x: int(x[0]))}")
     if which == "turn":
         PSD1000 = f"{base}/psd1000.toml"
         with open(PSD1000, "w") as f:

@@ -895,8 +895,13 @@ impl ReportsOut<'_> {
         let predict = |prn: u8, t: f64| aiding.and_then(|ff| ff.predicted_doppler_hz(prn, t));
         let mut captured: Vec<Captured> = Vec::new();
         let tapping = vector.is_some();
+        // While the navigation filter drives the channels (vector tracking with an INS) their
+        // feed-forward is the filter's, not the INS's: nothing for the INS's monitor to judge
+        // (it read the filter's clock drift as 63 Hz of INS error and rejected the INS).
+        let judged =
+            aiding.is_some() && !vector.as_ref().is_some_and(|v| v.port().snapshot.is_some());
         drain_in_stream_order(reports, |i, e| {
-            if aiding.is_some() {
+            if judged {
                 monitor.observe(i, e, &predict);
             }
             if tapping {
@@ -913,7 +918,7 @@ impl ReportsOut<'_> {
         if let Some(v) = vector {
             v.take(captured, nav);
         }
-        if let (Some(ff), Some((t_first, t_done))) = (aiding, span) {
+        if let (Some(ff), Some((t_first, t_done)), true) = (aiding, span, judged) {
             monitor.evaluate(t_first, t_done, ff.expected_common_residual_hz(), &predict);
         }
         Ok(())

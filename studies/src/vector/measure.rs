@@ -42,6 +42,9 @@ pub struct CaseResult {
     pub locked_through: Vec<u8>,
     /// Seconds the navigation filter drove the channels (vector modes).
     pub vector_s: Option<f64>,
+    /// Times the INS's integrity monitor rejected its aid (modes with an INS; the INS is
+    /// good, so any is a false alarm).
+    pub ins_rejections: Option<usize>,
 }
 
 /// Tracks `case` on its scenario (noise seed `seed`).
@@ -77,6 +80,7 @@ pub fn run_case(case: &Case, seed: u64) -> anyhow::Result<CaseResult> {
     let summary = rx.run(&mut SimSource::new(&sim), &mut sink)?;
     let mut r = CaseResult {
         vector_s: summary.vector.map(|v| v.vector_s),
+        ins_rejections: summary.ins_aiding.map(|a| a.rejections),
         ..CaseResult::default()
     };
     match case.test {
