@@ -899,7 +899,7 @@ impl ReportsOut<'_> {
         // feed-forward is the filter's, not the INS's: nothing for the INS's monitor to judge
         // (it read the filter's clock drift as 63 Hz of INS error and rejected the INS).
         let judged =
-            aiding.is_some() && !vector.as_ref().is_some_and(|v| v.port().snapshot.is_some());
+            aiding.is_some() && vector.as_ref().is_none_or(|v| v.port().snapshot.is_none());
         drain_in_stream_order(reports, |i, e| {
             if judged {
                 monitor.observe(i, e, &predict);
