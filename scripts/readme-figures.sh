@@ -254,7 +254,7 @@ section_jitter() {
 }
 
 section_studies() {
-    for s in steady-state bandwidth dynamics dr landmarks threshold; do
+    for s in steady-state bandwidth dynamics dr landmarks threshold vector; do
         if "$GPSRX" study --help 2>/dev/null | grep -q "$s"; then
             run "$GPSRX" study "$s" --out "$WORK/study-$s"
         fi

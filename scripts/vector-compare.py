@@ -11,7 +11,9 @@ satellites in the fixes, the PRNs used, horizontal RMS against truth.csv, the ti
 fix after the blockage and the largest 3-D error in the 3 s after it, and the share of 20-27 s
 each satellite's channel was in carrier lock in the turn. `block SIM` scores another simulation
 of the blockage (the scenario with another seed); `turn-ins` runs scalar with the INS, vector,
-and vector with the INS on the turn with a 1 mg INS.
+and vector with the INS on the turn with a 1 mg INS; `turn-ins-wrong` runs scalar and vector with
+that INS log altered three ways (50 ms late, 10 mg more bias, 5 % scale factor on its velocity
+change) and prints the satellites held and the 3-D RMS over 19-30 s.
 """
 import csv, json, math, subprocess, sys, os
 
@@ -134,3 +136,47 @@ if __name__ == "__main__":
             lk = locks(out, 20, 27)
             held = [p for p, v in lk.items() if v >= 0.95]
             print(f"  satellites held through the turn (carrier lock >= 95% of 20-27 s): {len(held)} of {len(lk)}: {sorted(lk.items(), key=lambda x: int(x[0]))}")
+
+def altered_ins(src, dst_dir):
+    """The INS log `src` altered three ways; returns {name: path}."""
+    rows = list(csv.DictReader(open(src)))
+    cols = list(rows[0].keys())
+    pos, vel = ["x_m", "y_m", "z_m"], ["vx_mps", "vy_mps", "vz_mps"]
+    out = {}
+    def write(name, rs):
+        path = f"{dst_dir}/ins-{name}.csv"
+        with open(path, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=cols); w.writeheader(); w.writerows(rs)
+        out[name] = path
+    # 50 ms late (5 samples at 100 Hz): the content of 50 ms before, same time stamps.
+    write("late-50ms", [dict(r, **{c: rows[max(k - 5, 0)][c] for c in pos + vel}) for k, r in enumerate(rows)])
+    b = 0.0980665
+    def biased(r):
+        t = float(r["t_s"])
+        return dict(r, **{c: "%.9f" % (float(r[c]) + b * t) for c in vel}, **{c: "%.6f" % (float(r[c]) + 0.5 * b * t * t) for c in pos})
+    write("bias-10mg", [biased(r) for r in rows])
+    v0 = [float(rows[0][c]) for c in vel]; p0 = [float(rows[0][c]) for c in pos]
+    def scaled(r):
+        t = float(r["t_s"])
+        d = {c: "%.9f" % (float(r[c]) + 0.05 * (float(r[c]) - v0[i])) for i, c in enumerate(vel)}
+        d.update({c: "%.6f" % (float(r[c]) + 0.05 * (float(r[c]) - p0[i] - v0[i] * t)) for i, c in enumerate(pos)})
+        return dict(r, **d)
+    write("scale-5pc", [scaled(r) for r in rows])
+    return out
+
+def rms_3d(res, t0, t1):
+    rs = [r[7] for r in res if t0 <= r[0] <= t1]
+    return math.sqrt(sum(x * x for x in rs) / len(rs)) if rs else float("nan")
+
+if __name__ == "__main__" and sys.argv[1] == "turn-ins-wrong":
+    base = os.environ.get("VEC_WORK", "/tmp/vec")
+    sim = f"{base}/sim-turn-ins-1mg"
+    for name, path in altered_ins(f"{sim}/ins.csv", base).items():
+        for mode in ("scalar", "vector"):
+            out = f"{base}/wrong-{name}-{mode}"
+            s = run(sim, mode, out, ["--ins", path])
+            res = score(sim, out, 538194.0)
+            lk = locks(out, 20, 27)
+            held = sum(1 for v in lk.values() if v >= 0.95)
+            v = s.get("vector") or {}
+            print(f"INS {name}, {mode}: held {held} of {len(lk)}, 3-D RMS 19-30 s {rms_3d(res, 19, 30):.2f} m, handed back {v.get('disengagements', '-')} times")

@@ -100,7 +100,7 @@ pub fn conclusions_md(results: &[(Case, CaseResult)], tests: &[Test], seed: u64)
     }
     let _ = writeln!(
         md,
-        "One noise seed ({seed}; `--seed` to change it), one simulated sky: the numbers move by a few tenths of a dB and of a second between seeds."
+        "Measured on one noise seed ({seed}) and one simulated sky; `--seed N` runs another."
     );
     md
 }
@@ -189,6 +189,15 @@ fn turn(md: &mut String, results: &[(Case, CaseResult)], test: &Test, g: f64) {
     }
     md.pop();
     md.push('.');
+    let kept_by = |mode| all.iter().find(|a| a.0 == mode).map(|a| a.1);
+    if let (Some(v), Some(s)) = (kept_by(Mode::Vector), kept_by(Mode::Scalar)) {
+        if v < s {
+            let _ = write!(
+                md,
+                " Vector tracking alone keeps fewer than scalar tracking: its prediction has no acceleration, so it hands the channels back at the onset, and the weak ones, on its narrow loops until then, fall out."
+            );
+        }
+    }
     if let Some(&(_, kept, of)) = all.iter().find(|a| a.0 == Mode::VectorIns) {
         let _ = write!(
             md,
@@ -277,6 +286,13 @@ mod tests {
             md.contains("vector 1 of 3") && md.contains("kept every satellite"),
             "{md}"
         );
+        assert!(!md.contains("fewer than scalar"), "{md}");
+        let md = conclusions_md(
+            &[case(Mode::Scalar, &[1, 2, 3]), case(Mode::Vector, &[1])],
+            &[test],
+            1,
+        );
+        assert!(md.contains("keeps fewer than scalar"), "{md}");
         let md = conclusions_md(&[case(Mode::VectorIns, &[1, 2])], &[test], 1);
         assert!(md.contains("lost 1 satellite"), "{md}");
     }
