@@ -13,7 +13,8 @@ each satellite's channel was in carrier lock in the turn. `block SIM` scores ano
 of the blockage (the scenario with another seed); `turn-ins` runs scalar with the INS, vector,
 and vector with the INS on the turn with a 1 mg INS; `turn-ins-wrong` runs scalar and vector with
 that INS log altered three ways (50 ms late, 10 mg more bias, 5 % scale factor on its velocity
-change) and prints the satellites held and the 3-D RMS over 19-30 s.
+change) and prints the satellites held and the 3-D RMS over 19-30 s; `turn-ins-cut` cuts 31 ms
+of samples at 22 s (inside the turn) and scores scalar and vector with the INS.
 """
 import csv, json, math, subprocess, sys, os
 
@@ -180,3 +181,19 @@ if __name__ == "__main__" and sys.argv[1] == "turn-ins-wrong":
             held = sum(1 for v in lk.values() if v >= 0.95)
             v = s.get("vector") or {}
             print(f"INS {name}, {mode}: held {held} of {len(lk)}, 3-D RMS 19-30 s {rms_3d(res, 19, 30):.2f} m, handed back {v.get('disengagements', '-')} times")
+
+if __name__ == "__main__" and sys.argv[1] == "turn-ins-cut":
+    base = os.environ.get("VEC_WORK", "/tmp/vec")
+    sim = f"{base}/sim-turn-ins-1mg"
+    cut = f"{base}/turn-ins-cut22.ci8"
+    subprocess.run([sys.executable, os.path.join(ROOT, "scripts/tools/fault.py"), f"{sim}/signal.ci8", cut,
+                    "--bytes-per-sample", "2", "--fs", "2.6e6", "--cut", "22", "0.031"], check=True, capture_output=True)
+    for mode in ("scalar", "vector"):
+        out = f"{base}/turn-ins-cut-{mode}"
+        cmd = [GPSRX, "run", cut, "--format", "ci8", "--fs", "2.6e6", "--nav", NAV, "--allow-unhealthy",
+               "--tracking", mode, "--ins", f"{sim}/ins.csv", "--out", out, "--json", "--no-plots"]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        res = score(sim, out, 538194.0)
+        rs = [x for x in res if 19 <= x[0] <= 30]
+        worst = max((x[7] for x in rs), default=float("nan"))
+        print(f"31 ms cut at 22 s, {mode} + INS: {len(rs)} valid fixes over 19-30 s, 3-D RMS {rms_3d(res, 19, 30):.2f} m, max {worst:.1f} m")

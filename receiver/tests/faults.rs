@@ -389,8 +389,30 @@ fn a_31_ms_cut_at_250_m_s_is_found_from_the_moved_bit_edges_and_bridged() {
 }
 
 /// Every valid fix from stream time `from_s` on against the simulator's truth at its GPS time
-/// (a perfect receiver clock): within 5 m, or within its stated 3-sigma and 5 m; and valid
-/// fixes back within 1.5 s of the fault at `at_s`.
+/// (a perfect receiver clock): (stream time s, 3-D error m, stated 3-sigma m).
+fn valid_fix_errors(sim: &Simulator, sink: &MemorySink, from_s: f64) -> Vec<(f64, f64, f64)> {
+    let start_tow = 538_198.0;
+    sink.fixes
+        .iter()
+        .filter(|f| f.fix.quality != FixQuality::None && f.t_stream_s >= from_s)
+        .map(|f| {
+            let (_, truth) = sim.receiver_truth(f.fix.time.tow_s - start_tow);
+            let e = f.fix.ecef_m;
+            let err = ((e[0] - truth.pos_m.x).powi(2)
+                + (e[1] - truth.pos_m.y).powi(2)
+                + (e[2] - truth.pos_m.z).powi(2))
+            .sqrt();
+            let s3 = f.fix.sigma_enu_m.map_or(0.0, |s| {
+                3.0 * (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()
+            });
+            (f.t_stream_s, err, s3)
+        })
+        .collect()
+}
+
+/// Every valid fix from stream time `from_s` on within 5 m of the truth, or within its stated
+/// 3-sigma and 5 m ([`valid_fix_errors`]); and valid fixes back within 1.5 s of the fault at
+/// `at_s`.
 fn assert_moving_fixes_and_back(
     name: &str,
     sim: &Simulator,
@@ -398,30 +420,15 @@ fn assert_moving_fixes_and_back(
     at_s: f64,
     from_s: f64,
 ) -> Vec<(f64, f64)> {
-    let start_tow = 538_198.0;
     let (mut back, mut after) = (None, Vec::new());
-    for f in sink
-        .fixes
-        .iter()
-        .filter(|f| f.fix.quality != FixQuality::None && f.t_stream_s >= from_s)
-    {
-        let (_, truth) = sim.receiver_truth(f.fix.time.tow_s - start_tow);
-        let e = f.fix.ecef_m;
-        let err = ((e[0] - truth.pos_m.x).powi(2)
-            + (e[1] - truth.pos_m.y).powi(2)
-            + (e[2] - truth.pos_m.z).powi(2))
-        .sqrt();
-        let s3 = f.fix.sigma_enu_m.map_or(0.0, |s| {
-            3.0 * (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()
-        });
+    for (t, err, s3) in valid_fix_errors(sim, sink, from_s) {
         assert!(
             err <= 5.0 + s3,
-            "{name}: a valid fix at {:.2} s is {err:.1} m off (3-sigma {s3:.1} m)",
-            f.t_stream_s
+            "{name}: a valid fix at {t:.2} s is {err:.1} m off (3-sigma {s3:.1} m)"
         );
-        if f.t_stream_s > at_s {
-            back.get_or_insert(f.t_stream_s - at_s);
-            after.push((f.t_stream_s, err));
+        if t > at_s {
+            back.get_or_insert(t - at_s);
+            after.push((t, err));
         }
     }
     assert!(
@@ -429,6 +436,61 @@ fn assert_moving_fixes_and_back(
         "{name}: valid fixes back {back:?} s after the cut"
     );
     after
+}
+
+#[test]
+fn a_31_ms_cut_inside_a_10_g_turn_under_vector_tracking_with_an_ins_gives_no_wrong_fix() {
+    // The INS is then looked up 31 ms off (3 m/s in the turn). On
+    // samples/scenarios/turn-10g-ins-1mg.toml with the cut at 22 s (`scripts/vector-compare.py
+    // turn-ins-cut`) the lost-sample detectors missed it and the filter, re-converging on the
+    // INS within 0.3 s, held the channels on a receiver time 31 ms wrong: fixes up to 60 m off
+    // until frame sync; now its Dopplers breaking on every satellite at once hand the channels
+    // back (`BREAK_NIS`). This simulation's cut (at 13.5-16 s) is caught by the detectors
+    // either way: it checks that no valid fix is wrong, whichever catches it.
+    let sim = ten_g_turn(12.0, 4.0);
+    let mut config = gpsrx_receiver::config::ReceiverConfig::default();
+    config.run.week = Some(2190);
+    config.run.allow_unhealthy = true;
+    config.tracking.mode = gpsrx_tracking::TrackingMode::Vector;
+    let nav = gpsrx_nav::rinex_nav::parse_rinex_nav(gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let assistance = gpsrx_receiver::pipeline::Assistance {
+        nav: Some(nav),
+        ins: Some(gpsrx_receiver::pipeline::InsAiding {
+            track: crate::vector::biased_ins(&sim, 1e-3 * 9.80665),
+            band_limit_rad_s: None,
+        }),
+        ..Default::default()
+    };
+    let rx = Receiver::new(&config, FS_HZ, assistance).unwrap_or_else(|e| panic!("{e}"));
+    let sink = run_with(
+        rx,
+        &sim,
+        Fault::Cut {
+            at_s: 15.0,
+            len_s: 0.031,
+        },
+    );
+    let errors = valid_fix_errors(&sim, &sink, 8.0);
+    let worst = errors
+        .iter()
+        .map(|e| e.1 - e.2)
+        .fold(f64::NEG_INFINITY, f64::max);
+    eprintln!(
+        "{} valid fixes from 8 s, {} after the cut; worst error beyond its 3-sigma {worst:.1} m",
+        errors.len(),
+        errors.iter().filter(|e| e.0 > 15.0).count()
+    );
+    for (t, err, s3) in &errors {
+        assert!(
+            *err <= 5.0 + s3,
+            "a valid fix at {t:.2} s is {err:.1} m off (3-sigma {s3:.1} m)"
+        );
+    }
+    assert!(
+        errors.iter().any(|e| e.0 > 16.0),
+        "no valid fix after the cut"
+    );
 }
 
 /// The `[receiver]` body of a vehicle starting at [`LLH_DEG`] with `heading_deg`,

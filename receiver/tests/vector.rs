@@ -244,7 +244,10 @@ fn vector_tracking_holds_fading_satellites_3_db_below_scalar_tracking() {
 
 /// The simulator's truth as a 50 Hz INS whose accelerometers are biased by `bias_mps2` on
 /// every ECEF axis (velocity `v + B t`, position `p + B t^2 / 2`), with its GPS time column.
-fn biased_ins(sim: &gpsrx_samples::sim::Simulator, bias_mps2: f64) -> gpsrx_ins_aiding::InsTrack {
+pub(crate) fn biased_ins(
+    sim: &gpsrx_samples::sim::Simulator,
+    bias_mps2: f64,
+) -> gpsrx_ins_aiding::InsTrack {
     let n = (sim.duration_s() * 50.0).floor() as usize;
     let samples = (0..=n)
         .map(|k| {

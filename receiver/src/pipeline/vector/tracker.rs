@@ -38,7 +38,12 @@
 //!   pseudoranges or more Dopplers were excluded than admitted (a filter whose velocity went
 //!   wrong, under an INS whose motion is 50 ms late in a 10 g turn, kept admitting the
 //!   pseudoranges while it excluded 6 of 8 Dopplers, and stayed 4 m/s off after the turn), or
-//!   when the 3-D position sigma is above [`MAX_POSITION_SIGMA_M`].
+//!   when the 3-D position sigma is above [`MAX_POSITION_SIGMA_M`]; and at once when the
+//!   Dopplers of [`BREAK_SATELLITES`] satellites are [`BREAK_NIS`] off its prediction in one
+//!   epoch (a 31 ms cut inside a 10 g turn with an INS: the INS looked up 31 ms off, 3 m/s;
+//!   the lost-sample detectors missed it there, and the filter, re-converging on the INS's
+//!   motion within 0.3 s, held the channels on a receiver time 31 ms wrong: fixes up to 60 m
+//!   off for 6 s, until frame sync).
 //!   Fewer than 4 satellites do not make it unhealthy: the filter coasts on its prediction
 //!   through a partial blockage (its covariance grows, the sigma test ends it). The next valid
 //!   fix starts the filter again.
@@ -73,6 +78,10 @@ use std::sync::Arc;
 
 /// Unhealthy epochs in a row that hand the channels back to their scalar loops.
 pub const UNHEALTHY_EPOCHS: u32 = 3;
+/// A Doppler row this far out (NIS) is a break of the prediction, not noise (10 sigma).
+pub const BREAK_NIS: f64 = 100.0;
+/// Satellites whose Dopplers break at once that end vector tracking at once (module docs).
+pub const BREAK_SATELLITES: usize = 3;
 /// 3-D position sigma above which the filter is unhealthy, m.
 pub const MAX_POSITION_SIGMA_M: f64 = 100.0;
 /// Fewest satellites of a fix that starts the filter (RAIM can check it).
@@ -447,6 +456,23 @@ impl VectorTracking {
         // scaled) keeps admitting the pseudoranges while it excludes most Dopplers.
         let rejected = |kind| out.rejected.iter().filter(|r| r.1 == kind).count();
         let admitted_doppler = out.admitted - out.admitted_code;
+        // Several satellites' Dopplers 10 sigma off at once: the prediction broke for all of
+        // them (samples lost in a manoeuvre with an INS, whose motion is then looked up at the
+        // wrong time: 3 m/s in a 10 g turn for 31 ms; an INS fault). The lost-sample detectors
+        // can miss it in a turn; the scalar loops, handed back, lose and re-acquire the
+        // channels and time them again from their data bits.
+        let broken = out
+            .rejected
+            .iter()
+            .filter(|r| r.1 == RowKind::Doppler && r.2 > BREAK_NIS)
+            .count();
+        if broken >= BREAK_SATELLITES {
+            let why = format!(
+                "the Dopplers of {broken} satellites are more than 10 sigma off its prediction at once (samples lost, or the INS wrong)"
+            );
+            self.disengage(t_stream_s, &why);
+            return;
+        }
         let healthy = (rows.is_empty() || out.admitted > 0)
             && rejected(RowKind::Code) <= out.admitted_code
             && rejected(RowKind::Doppler) <= admitted_doppler
