@@ -242,27 +242,30 @@ fn vector_tracking_holds_fading_satellites_3_db_below_scalar_tracking() {
     }
 }
 
-/// The simulator's truth as a 50 Hz INS whose accelerometers are biased by `bias_mps2` on
-/// every ECEF axis (velocity `v + B t`, position `p + B t^2 / 2`), with its GPS time column.
+/// The simulator's truth as a 50 Hz INS ([`gpsrx_ins_aiding::simulate_ins`]) whose
+/// accelerometers are biased by `bias_mps2` on every east-north-up axis, with its GPS time
+/// column.
 pub(crate) fn biased_ins(
     sim: &gpsrx_samples::sim::Simulator,
     bias_mps2: f64,
 ) -> gpsrx_ins_aiding::InsTrack {
-    let n = (sim.duration_s() * 50.0).floor() as usize;
-    let samples = (0..=n)
-        .map(|k| {
-            let t_s = k as f64 / 50.0;
-            let (tow, s) = sim.receiver_truth(t_s);
-            let b = gpsrx_nav::frames::Vector3::repeat(bias_mps2);
-            gpsrx_ins_aiding::InsSample {
-                t_s,
-                gps_tow_s: Some(tow),
-                pos_m: s.pos_m + b * (0.5 * t_s * t_s),
-                vel_mps: s.vel_mps + b * t_s,
-            }
-        })
-        .collect();
-    gpsrx_ins_aiding::InsTrack::from_samples(samples).unwrap_or_else(|e| panic!("{e}"))
+    let cfg = gpsrx_ins_aiding::InsErrorConfig {
+        rate_hz: 50.0,
+        accel_bias_enu_mps2: [bias_mps2; 3],
+        ..Default::default()
+    };
+    let truth = |t_s: f64| {
+        let (tow, s) = sim.receiver_truth(t_s);
+        gpsrx_ins_aiding::TruthState {
+            t_s,
+            gps_tow_s: Some(tow),
+            pos_m: s.pos_m,
+            vel_mps: s.vel_mps,
+        }
+    };
+    gpsrx_ins_aiding::simulate_ins(&truth, sim.duration_s(), &cfg)
+        .and_then(gpsrx_ins_aiding::InsTrack::from_samples)
+        .unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]

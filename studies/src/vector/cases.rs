@@ -7,7 +7,8 @@ use std::path::Path;
 pub const FS_HZ: f64 = 2.048e6;
 /// GPS time of week of the first sample, s.
 pub const START_TOW_S: f64 = 538_198.0;
-/// An accelerometer bias of 1 mg, m/s^2: the INS of the aided modes has it on every ECEF axis.
+/// An accelerometer bias of 1 mg, m/s^2: the INS of the aided modes has it on every
+/// east-north-up axis.
 pub const INS_BIAS_MPS2: f64 = 1e-3 * 9.80665;
 /// Rate of the simulated INS log, Hz.
 pub const INS_RATE_HZ: f64 = 50.0;
@@ -161,23 +162,24 @@ pub fn tests(quick: bool) -> Vec<Test> {
     }
 }
 
-/// The simulator's truth as an INS log at [`INS_RATE_HZ`] whose accelerometers are biased by
-/// [`INS_BIAS_MPS2`] on every ECEF axis (velocity `v + B t`, position `p + B t^2 / 2`), with its
+/// The simulator's truth as an INS log at [`INS_RATE_HZ`] ([`gpsrx_ins_aiding::simulate_ins`])
+/// whose accelerometers are biased by [`INS_BIAS_MPS2`] on every east-north-up axis, with its
 /// GPS time column.
 pub fn biased_ins(sim: &Simulator) -> anyhow::Result<gpsrx_ins_aiding::InsTrack> {
-    let n = (sim.duration_s() * INS_RATE_HZ).floor() as usize;
-    let b = gpsrx_nav::frames::Vector3::repeat(INS_BIAS_MPS2);
-    let samples = (0..=n)
-        .map(|k| {
-            let t_s = k as f64 / INS_RATE_HZ;
-            let (tow, s) = sim.receiver_truth(t_s);
-            gpsrx_ins_aiding::InsSample {
-                t_s,
-                gps_tow_s: Some(tow),
-                pos_m: s.pos_m + b * (0.5 * t_s * t_s),
-                vel_mps: s.vel_mps + b * t_s,
-            }
-        })
-        .collect();
+    let cfg = gpsrx_ins_aiding::InsErrorConfig {
+        rate_hz: INS_RATE_HZ,
+        accel_bias_enu_mps2: [INS_BIAS_MPS2; 3],
+        ..Default::default()
+    };
+    let truth = |t_s: f64| {
+        let (tow, s) = sim.receiver_truth(t_s);
+        gpsrx_ins_aiding::TruthState {
+            t_s,
+            gps_tow_s: Some(tow),
+            pos_m: s.pos_m,
+            vel_mps: s.vel_mps,
+        }
+    };
+    let samples = gpsrx_ins_aiding::simulate_ins(&truth, sim.duration_s(), &cfg)?;
     Ok(gpsrx_ins_aiding::InsTrack::from_samples(samples)?)
 }

@@ -13,7 +13,7 @@
 //!   before the turn that stay in tracking and in phase lock (95 % of the reports) through it.
 //!
 //! The INS of the aided modes is the simulator's truth with an accelerometer bias of 1 mg on
-//! every ECEF axis, logged at 50 Hz ([`cases::biased_ins`]). Every case (scenario x mode) is
+//! every east-north-up axis, logged at 50 Hz ([`cases::biased_ins`]). Every case (scenario x mode) is
 //! simulated and tracked on its own, in parallel ([`super::run_cases`]). The conclusions
 //! ([`conclusions`]) are computed from the results; `--quick` runs one fade (1 dB/s), the
 //! blockage and the 10 g turn.
