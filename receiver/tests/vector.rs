@@ -382,6 +382,10 @@ fn the_tracking_mode_is_read_from_gpsrx_toml_and_a_wrong_one_is_named() {
             |c: &mut ReceiverConfig| c.tracking.vector_cn0_lost_dbhz = 5.0,
             "[tracking] vector_cn0_lost_dbhz",
         ),
+        (
+            |c: &mut ReceiverConfig| c.vector.ins_accel_psd_m2_s3 = f64::NAN,
+            "[vector] ins_accel_psd_m2_s3",
+        ),
     ] {
         let mut c = ReceiverConfig::default();
         edit(&mut c);

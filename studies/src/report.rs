@@ -132,6 +132,22 @@ impl StudyReport {
     }
 }
 
+/// The median of the finite values of `v` (NaN for none; the mean of the middle two for an
+/// even count).
+pub fn median(v: &[f64]) -> f64 {
+    let mut c: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if c.is_empty() {
+        return f64::NAN;
+    }
+    c.sort_by(f64::total_cmp);
+    let n = c.len();
+    if n % 2 == 1 {
+        c[n / 2]
+    } else {
+        0.5 * (c[n / 2 - 1] + c[n / 2])
+    }
+}
+
 /// Formats a number with `digits` decimals, `-` for NaN (a cell with no value).
 pub fn fmt(v: f64, digits: usize) -> String {
     if v.is_finite() {

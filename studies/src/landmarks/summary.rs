@@ -2,6 +2,7 @@
 
 use super::grid::{Cell, Trial};
 use super::params::USABLE_PDOP;
+use crate::report::median;
 
 /// Statistics of one cell.
 #[derive(Debug, Clone, Copy)]
@@ -24,19 +25,6 @@ pub struct CellStats {
     pub rms_error_m: f64,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 /// Statistics of `trials` of `cell`.
 pub fn stats(cell: Cell, trials: &[Trial]) -> CellStats {
     let n = trials.len().max(1) as f64;
@@ -53,8 +41,8 @@ pub fn stats(cell: Cell, trials: &[Trial]) -> CellStats {
         rank4: dops.len() as f64 / n,
         allows: dops.iter().filter(|d| d.pdop <= USABLE_PDOP).count() as f64 / n,
         available: errors.len() as f64 / n,
-        median_pdop: median(dops.iter().map(|d| d.pdop).collect()),
-        median_hdop: median(dops.iter().map(|d| d.hdop).collect()),
+        median_pdop: median(&dops.iter().map(|d| d.pdop).collect::<Vec<_>>()),
+        median_hdop: median(&dops.iter().map(|d| d.hdop).collect::<Vec<_>>()),
         rms_error_m: rms,
     }
 }

@@ -3,7 +3,7 @@
 
 use super::cases::{Mode, Test, AFTER_BLOCKAGE_S};
 use super::measure::{Case, CaseResult};
-use crate::report::fmt;
+use crate::report::{fmt, median};
 use std::fmt::Write;
 
 /// The threshold gain of vector over scalar tracking Lashley, Bevly and Hung measured
@@ -11,21 +11,6 @@ use std::fmt::Write;
 pub const LASHLEY_GAIN_DB: (f64, f64) = (2.4, 6.2);
 /// The largest error of the first fixes after a blockage issue 29 accepts, m.
 pub const BLOCKAGE_MAX_ERROR_M: f64 = 5.0;
-
-/// The median of `v` (NaN for none).
-pub fn median(v: &[f64]) -> f64 {
-    let mut c: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-    if c.is_empty() {
-        return f64::NAN;
-    }
-    c.sort_by(f64::total_cmp);
-    let n = c.len();
-    if n % 2 == 1 {
-        c[n / 2]
-    } else {
-        0.5 * (c[n / 2 - 1] + c[n / 2])
-    }
-}
 
 /// The result of `mode` on `test`.
 pub fn find<'a>(

@@ -111,7 +111,7 @@ fn table(results: &[(Case, CaseResult)], tests: &[Test]) -> Table {
                 test.label(),
                 mode.label().to_string(),
                 if fade {
-                    fmt(conclusions::median(&th), 1)
+                    fmt(super::report::median(&th), 1)
                 } else {
                     "-".into()
                 },
