@@ -349,7 +349,7 @@ fn the_navigation_processor_alone_and_the_file_sink_alone_reproduce_a_run() {
     );
     for (i, e) in &memory.channel_epochs {
         alone
-            .on_report(*i, e, None, &mut replay)
+            .on_report(*i, e, None, None, &mut replay)
             .unwrap_or_else(|e| panic!("{e}"));
     }
     replay

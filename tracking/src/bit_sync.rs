@@ -209,6 +209,20 @@ impl BitSync {
         self.k
     }
 
+    /// Takes the data-bit edges from outside while still searching: a bit starts at every
+    /// prompt whose position (counted from the first prompt since the last reset) is `edge`
+    /// modulo 20, as if the histogram had decided on it. The first bit is reported from the
+    /// next edge on. Ignored once synchronised or failed.
+    pub fn assume_edge(&mut self, edge: usize) {
+        if self.state == BitSyncState::Searching {
+            self.state = BitSyncState::Synced {
+                edge: edge % MS_PER_BIT,
+            };
+            self.acc = Complex64::new(0.0, 0.0);
+            self.acc_n = 0;
+        }
+    }
+
     /// Starts over.
     pub fn reset(&mut self) {
         *self = Self::new(self.cfg);

@@ -715,6 +715,20 @@ impl Channel {
         self.weak_restart_frequency_stage();
     }
 
+    /// Takes the data-bit edges from outside (vector tracking's predicted SV time, whose
+    /// 20 ms boundaries are the edges): a bit starts at every code period whose `ms_count` is
+    /// `edge_phase` modulo 20. Only while the bit synchroniser still searches (its histogram
+    /// needs 2-10 s at 24-28 dB-Hz); a weak pull-in then moves to its bit-aligned phase stage
+    /// at the next edge, as after its own synchronisation.
+    pub fn assume_bit_edge(&mut self, edge_phase: usize) {
+        if self.state == ChannelState::Lost || self.bit_sync.state() != BitSyncState::Searching {
+            return;
+        }
+        let origin = (self.bit_sync_origin_ms % MS_PER_BIT as u64) as usize;
+        self.bit_sync
+            .assume_edge((edge_phase % MS_PER_BIT + MS_PER_BIT - origin) % MS_PER_BIT);
+    }
+
     /// Forgets the data-bit edges (after samples were lost, the bits no longer fall where they
     /// did): the bit synchroniser starts again on the coming prompts; the loops keep running.
     /// A channel integrating longer than 1 ms (aligned to the old edges, so now straddling

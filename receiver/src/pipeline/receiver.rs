@@ -758,15 +758,26 @@ impl Receiver {
         sink: &mut dyn Sink,
     ) -> Result<(), ReceiverError> {
         match event {
-            Some(BlockEvent::PhaseJump(_)) => self.manager.restart_bit_sync(),
+            Some(BlockEvent::PhaseJump(_)) => {
+                self.manager.restart_bit_sync();
+                if let Some(v) = self.vector.as_mut() {
+                    v.doubt_time(end as f64 / self.fs_hz);
+                }
+            }
             Some(BlockEvent::Collapse(c)) => {
                 self.manager.request_realignment(&c);
                 self.arm_bridge(c.sample as f64 / self.fs_hz);
                 if let Some(v) = self.vector.as_mut() {
                     v.collapse(c.sample as f64 / self.fs_hz);
+                    v.doubt_time(c.sample as f64 / self.fs_hz);
                 }
             }
             None => {}
+        }
+        if let Some(v) = self.vector.as_mut() {
+            for (channel, prn, edge) in v.take_bit_edges() {
+                self.manager.assume_bit_edge(channel, prn, edge);
+            }
         }
         self.follow_bridge(end as f64 / self.fs_hz);
         match found {
@@ -780,6 +791,9 @@ impl Receiver {
                 if let Some(r) = realigned {
                     // The bit edges of every channel moved with the code.
                     self.manager.restart_bit_sync();
+                    if let Some(v) = self.vector.as_mut() {
+                        v.doubt_time(end as f64 / self.fs_hz);
+                    }
                     self.nav
                         .on_code_realigned(&r, sink)
                         .map_err(ReceiverError::Sink)?;
@@ -900,18 +914,23 @@ impl ReportsOut<'_> {
         // (it read the filter's clock drift as 63 Hz of INS error and rejected the INS).
         let judged =
             aiding.is_some() && vector.as_ref().is_none_or(|v| v.port().snapshot.is_none());
+        let mut vector = vector;
         drain_in_stream_order(reports, |i, e| {
             if judged {
                 monitor.observe(i, e, &predict);
             }
+            let predicted_sv_tow_s = vector.as_deref_mut().and_then(|v| {
+                v.vouch(i, e);
+                v.predicted_sv_tow_s(e)
+            });
             if tapping {
                 let mut tap = Tap {
                     inner: &mut *sink,
                     captured: &mut captured,
                 };
-                nav.on_report(i, e, aiding, &mut tap)
+                nav.on_report(i, e, aiding, predicted_sv_tow_s, &mut tap)
             } else {
-                nav.on_report(i, e, aiding, sink)
+                nav.on_report(i, e, aiding, predicted_sv_tow_s, sink)
             }
         })
         .map_err(ReceiverError::Sink)?;

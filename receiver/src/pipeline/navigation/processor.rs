@@ -21,6 +21,7 @@ use crate::pipeline::navigation::observables::ObservableBuilder;
 use crate::pipeline::sink::ChannelRow;
 use crate::pipeline::sink::{NavigationEnd, Progress, ReceiverEvent, Sink, SinkError};
 use crate::pipeline::timing::coarse_fix::CoarseFixer;
+use crate::pipeline::timing::predicted;
 use crate::pipeline::timing::quick_sync::QuickSync;
 use crate::pipeline::timing::sv_time::CarryNote;
 use crate::pipeline::timing::{BlockEvent, FoundBy, TimeKeeper};
@@ -329,12 +330,15 @@ impl NavigationProcessor {
     }
 
     /// Takes one channel report: decodes its bit, writes the channel row, builds observables
-    /// and solves every epoch that is complete.
+    /// and solves every epoch that is complete. `predicted_sv_tow_s`: vector tracking's
+    /// prediction of the satellite's SV time at the report's first sample, which a channel
+    /// without frame sync takes at a bit edge (`crate::pipeline::timing::predicted`).
     pub fn on_report(
         &mut self,
         channel: usize,
         e: &ChannelEpoch,
         aiding: Option<&InsFeedForward>,
+        predicted_sv_tow_s: Option<f64>,
         sink: &mut dyn Sink,
     ) -> Result<(), SinkError> {
         sink.channel_epoch(channel, e)?;
@@ -374,6 +378,9 @@ impl NavigationProcessor {
             }
             None => {}
         }
+        if let (Some(sv), true) = (predicted_sv_tow_s, usable) {
+            self.take_predicted_sv_time(e, sv);
+        }
         self.start_long_gap();
         self.coarse_step(e, sink)?;
         self.channel_row(channel, e, sink)?;
@@ -411,6 +418,31 @@ impl NavigationProcessor {
             })?;
         }
         Ok(())
+    }
+
+    /// A channel in phase lock at a bit edge, its decoder without an SV time, takes the one
+    /// vector tracking predicts (`crate::pipeline::timing::predicted`); not while the length
+    /// of lost samples is unknown.
+    fn take_predicted_sv_time(&mut self, e: &ChannelEpoch, predicted_sv_tow_s: f64) {
+        if !e.bit_edge || self.time.gap().is_some() {
+            return;
+        }
+        let Some(dec) = self.decoders.get_mut(&e.prn).filter(|d| !d.synced()) else {
+            return;
+        };
+        match predicted::edge_sv_tow_s(e, predicted_sv_tow_s) {
+            Ok(sv_tow_s) => {
+                dec.carry_time(e.ms_count, sv_tow_s);
+                tracing::info!(
+                    "G{:02}: SV time {sv_tow_s:.3} s from vector tracking's prediction at its bit edge (before frame sync)",
+                    e.prn
+                );
+            }
+            Err(off_ms) => tracing::debug!(
+                "G{:02}: vector tracking's predicted SV time falls {off_ms:+.3} ms off its bit edge: not taken",
+                e.prn
+            ),
+        }
     }
 
     /// The channel's row, at most once per fix interval.

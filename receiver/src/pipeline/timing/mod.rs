@@ -15,6 +15,7 @@
 //! - `modulo`: remainders modulo a period (phase, data bit, code period);
 //! - `long_gap`: the receiver time re-established after a gap too long to measure;
 //! - `quick_sync`: frame sync from one TLM and HOW, confirmed across satellites;
+//! - `predicted`: SV time from vector tracking's prediction at a channel's bit edge;
 //! - `coarse_fix`: the first fix from code phases alone (approximate time and position);
 //! - `dating`: which GPS week labels receiver time before subframe 1 is decoded
 //!   ([`WeekReference`]).
@@ -29,6 +30,7 @@ mod gap_length;
 mod keeper;
 pub(crate) mod long_gap;
 pub(crate) mod modulo;
+pub(crate) mod predicted;
 pub(crate) mod quick_sync;
 pub(crate) mod sv_time;
 

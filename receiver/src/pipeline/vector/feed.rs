@@ -32,10 +32,24 @@
 //! it: the code drifts by the range-rate error over the outage only (a static receiver:
 //! nothing the filter's clock-drift error does not cover; 1 m/s^2 of unmodelled acceleration
 //! over 3 s: 4.5 m, 0.015 chip).
+//!
+//! **Before a satellite's first measurement.** A weak satellite's channel gives observables
+//! only after its bits and frame are synchronised (10-20 s at 24 dB-Hz), and under the
+//! scalar loss threshold (25 dB-Hz) it is released long before: the filter never sees it, so
+//! it is never checked. Its code phase can be checked at once: the prediction gives the SV
+//! time at the channel's sample, `t_sv = T - tau + dt_sv` (`T` the GPS time of the sample,
+//! `tau` the flight time, `dt_sv` the SV clock), so the code phase modulo one period,
+//! `1.023e6 (t_sv mod 1 ms)` chips ([`code_phase_chips`]). A channel within
+//! [`super::vouch::VOUCH_CHIPS`] of it tracks that satellite's signal: a cross-correlation
+//! peak or a false acquisition sits anywhere in the 1023 chips (1 in 1000 to fall within
+//! half a chip). Such a channel counts as checked ([`Snapshot::checked`]) until the filter
+//! excludes one of its measurements (`super::vouch`).
 
 use super::ekf::{State, BIAS, DRIFT};
 use crate::pipeline::aiding::InsFeedForward;
-use gpsrx_core::constants::SPEED_OF_LIGHT_MPS;
+use gpsrx_core::constants::{
+    CA_CHIP_RATE_HZ, CA_CODE_LENGTH, CA_CODE_PERIOD_S, SPEED_OF_LIGHT_MPS,
+};
 use gpsrx_core::{los_doppler_hz, PosVel};
 use gpsrx_nav::ephemeris::Ephemeris;
 use gpsrx_nav::time::GpsTime;
@@ -64,6 +78,9 @@ pub struct Snapshot {
     pub ephemerides: Arc<BTreeMap<u8, Ephemeris>>,
     /// Stream time of each satellite's last admitted measurement, s.
     pub admitted_s: Arc<BTreeMap<u8, f64>>,
+    /// Stream time at which each satellite's channel last agreed with the predicted code
+    /// phase, s (`super::vouch`; none while the filter excludes its measurements).
+    pub vouched_s: Arc<BTreeMap<u8, f64>>,
     /// Longest prediction (from the update, and from a satellite's last admitted
     /// measurement for its [`DopplerAid::coast`]), s: `[vector] max_coast_s`.
     pub max_coast_s: f64,
@@ -149,12 +166,32 @@ impl Snapshot {
     }
 
     /// Whether the filter checked and admitted a measurement of `prn` within [`CHECKED_S`]
-    /// of stream time `t_s`: its channel's loss threshold is then
+    /// of stream time `t_s`, or its channel's code agreed with the prediction then (module
+    /// docs, "Before a satellite's first measurement"): its channel's loss threshold is then
     /// `[tracking] vector_cn0_lost_dbhz` ([`DopplerAid::checked`]).
     pub fn checked(&self, prn: u8, t_s: f64) -> bool {
-        self.admitted_s
-            .get(&prn)
-            .is_some_and(|t| t_s - t <= CHECKED_S)
+        let recent = |m: &BTreeMap<u8, f64>| m.get(&prn).is_some_and(|t| t_s - t <= CHECKED_S);
+        recent(&self.admitted_s) || recent(&self.vouched_s)
+    }
+
+    /// The predicted SV time of `prn` at stream time `t_s`: the time of week (s) its signal
+    /// arriving then left it by its own clock, `t_sv = T - tau + dt_sv` (module docs).
+    /// Without the ionosphere and troposphere (2-50 m, 7-170 ns; the filter's clock bias
+    /// holds their mean). None as [`Snapshot::doppler_hz`].
+    pub fn sv_tow_s(&self, prn: u8, t_s: f64) -> Option<f64> {
+        let dt = t_s - self.t_stream_s;
+        if !(dt.is_finite() && dt.abs() <= self.max_coast_s) {
+            return None;
+        }
+        let eph = self.ephemerides.get(&prn)?;
+        let (pos, _) = self.motion(t_s, dt);
+        // The receiver clock runs on between updates: GPS time advances by dt less its drift.
+        let t_gps = self
+            .gps_time
+            .add_seconds(dt * (1.0 - self.x[DRIFT] / SPEED_OF_LIGHT_MPS));
+        let seen = eph.at_reception(t_gps, &pos, 0.075, 2);
+        let tow = t_gps.tow_s - seen.flight_time_s + seen.sv.clock_bias_s;
+        tow.is_finite().then_some(tow)
     }
 
     /// The receiver clock bias at the update, m.
@@ -184,4 +221,10 @@ impl gpsrx_tracking::AidingPort for VectorPort {
             source: gpsrx_tracking::AidSource::Vector,
         })
     }
+}
+
+/// The C/A code phase at SV time `sv_tow_s` (s), chips in `[0, 1023)`: `1.023e6 (t_sv mod
+/// 1 ms)` (the code starts with every millisecond of SV time, IS-GPS-200 3.3.2.3).
+pub fn code_phase_chips(sv_tow_s: f64) -> f64 {
+    (sv_tow_s.rem_euclid(CA_CODE_PERIOD_S) * CA_CHIP_RATE_HZ) % CA_CODE_LENGTH as f64
 }

@@ -9,6 +9,8 @@
 //!   ([`VectorPort`]);
 //! - `dynamics`: the acceleration test that keeps the filter's feed-forward, 0.2-0.3 s ahead
 //!   of its last measurement, off the channels while the receiver accelerates hard;
+//! - `vouch`: the channels whose code agrees with the prediction before the filter measures
+//!   them (they keep the lower loss threshold until it does);
 //! - `tracker`: [`VectorTracking`], the handover scalar to vector and back, fed with what the
 //!   navigation processor emits ([`Captured`], taken by [`Tap`]).
 //!
@@ -23,6 +25,7 @@ pub mod measure;
 pub mod noise;
 mod tap;
 mod tracker;
+pub mod vouch;
 
 pub use ekf::{ClockModel, FilterParams, NavFilter, Row, RowKind, UpdateOutcome};
 pub use feed::{Snapshot, VectorPort};

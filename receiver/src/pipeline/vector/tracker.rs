@@ -60,9 +60,10 @@
 
 use super::dynamics::AccelWatch;
 use super::ekf::{ClockModel, FilterParams, NavFilter, RowKind, BIAS};
-use super::feed::{InsAnchor, Snapshot, VectorPort};
+use super::feed::{InsAnchor, Snapshot, VectorPort, CHECKED_S};
 use super::measure::{epoch_rows, RowModel};
 use super::noise::LoopNoise;
+use super::vouch::Vouchers;
 use crate::config::{IonoModel, ReceiverConfig, TropoModel};
 use crate::pipeline::aiding::InsFeedForward;
 use crate::pipeline::navigation::NavigationProcessor;
@@ -73,6 +74,7 @@ use gpsrx_nav::ephemeris::{Ephemeris, HealthPolicy};
 use gpsrx_nav::pvt::{chi_square_quantile, PvtOptions, PvtSolution};
 use gpsrx_nav::rinex_nav::NavData;
 use gpsrx_nav::time::GpsTime;
+use gpsrx_tracking::ChannelEpoch;
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::Arc;
 
@@ -174,6 +176,15 @@ pub struct VectorTracking {
     last_admitted_s: f64,
     /// Stream time of each satellite's last admitted row.
     admitted_s: BTreeMap<u8, f64>,
+    /// The channels the prediction vouches for before the filter measures them.
+    vouchers: Vouchers,
+    /// Before the filter starts: the last valid fix, as a prediction of code and SV time.
+    fix_prediction: Option<Snapshot>,
+    /// Data-bit edges for the channels vouched for, not yet handed to them.
+    bit_edges: Vec<(usize, u8, usize)>,
+    /// Stream time of samples possibly lost (a carrier-phase jump or a collapse, s): no bit
+    /// edges or SV times from the prediction until a valid fix of a later epoch.
+    time_doubt_s: Option<f64>,
     /// `[vector] max_coast_s`.
     max_coast_s: f64,
     /// The filter after each of its last epochs.
@@ -223,6 +234,10 @@ impl VectorTracking {
             last: None,
             last_admitted_s: 0.0,
             admitted_s: BTreeMap::new(),
+            vouchers: Vouchers::default(),
+            fix_prediction: None,
+            bit_edges: Vec::new(),
+            time_doubt_s: None,
             max_coast_s: v.max_coast_s,
             history: VecDeque::new(),
             quarantine_until_s: f64::NEG_INFINITY,
@@ -255,6 +270,51 @@ impl VectorTracking {
     /// What vector tracking did so far.
     pub fn summary(&self) -> VectorSummary {
         self.summary.clone()
+    }
+
+    /// A channel's report, compared with the prediction while the filter drives the channels
+    /// (`super::vouch`).
+    pub fn vouch(&mut self, channel: usize, e: &ChannelEpoch) {
+        let snap = self.port.snapshot.as_ref().or(self.fix_prediction.as_ref());
+        let edge = snap.and_then(|snap| self.vouchers.observe(snap, e));
+        if let (Some(edge), None) = (edge, self.time_doubt_s) {
+            self.bit_edges.push((channel, e.prn, edge));
+        }
+    }
+
+    /// Samples may have been lost at stream time `t_s` (a carrier-phase jump common to the
+    /// satellites, or a collapse of their prompt power): the prediction's time may be off by
+    /// them, so it gives no data-bit edges or SV times until a valid fix of a later epoch
+    /// (the receiver time re-established), and the last fix's prediction is dropped.
+    pub fn doubt_time(&mut self, t_s: f64) {
+        self.time_doubt_s = Some(self.time_doubt_s.map_or(t_s, |t| t.max(t_s)));
+        self.fix_prediction = None;
+        self.bit_edges.clear();
+    }
+
+    /// The data-bit edges the prediction put on the channels it vouched for since the last
+    /// call: `(channel, PRN, ms_count modulo 20 of a bit's first code period)`, for
+    /// `Channel::assume_bit_edge`.
+    pub fn take_bit_edges(&mut self) -> Vec<(usize, u8, usize)> {
+        std::mem::take(&mut self.bit_edges)
+    }
+
+    /// The predicted SV time (TOW, s) of report `e`'s satellite at its first sample, for a
+    /// report at a bit edge of a channel the filter checks (its measurements admitted, or its
+    /// code vouched for: `super::vouch`); `crate::pipeline::timing::predicted` takes it.
+    pub fn predicted_sv_tow_s(&self, e: &ChannelEpoch) -> Option<f64> {
+        if self.time_doubt_s.is_some() {
+            return None;
+        }
+        let snap = self.prediction()?;
+        let vouched = self
+            .vouchers
+            .vouched_s()
+            .get(&e.prn)
+            .is_some_and(|t| e.t_rx_s - t <= CHECKED_S);
+        (e.bit_edge && (vouched || snap.checked(e.prn, e.t_rx_s)))
+            .then(|| snap.sv_tow_s(e.prn, e.t_rx_s))
+            .flatten()
     }
 
     /// Takes what the navigation processor emitted in a round, in order, with its decoded
@@ -300,7 +360,15 @@ impl VectorTracking {
                 );
             }
             self.on_epoch(&epoch, t_stream_s, nav);
+            if self
+                .time_doubt_s
+                .is_some_and(|t| fix.as_ref().is_some_and(|f| f.2) && t_stream_s > t)
+            {
+                self.time_doubt_s = None;
+            }
             if let (None, Some((_, sol, true))) = (&self.filter, &fix) {
+                let x = *NavFilter::from_solution(sol, self.params).state();
+                self.fix_prediction = Some(self.snapshot(&epoch, t_stream_s, x, nav));
                 if starts_the_filter(sol) && self.dynamics.calm_at(t_stream_s) {
                     self.engage(&epoch, t_stream_s, sol, nav);
                 }
@@ -325,6 +393,7 @@ impl VectorTracking {
         self.last = Some((epoch.time, t_stream_s));
         self.last_admitted_s = t_stream_s;
         self.admitted_s.clear();
+        self.vouchers.clear();
         self.unhealthy_in_row = 0;
         self.summary.engagements += 1;
         self.publish(epoch, t_stream_s, nav);
@@ -427,6 +496,7 @@ impl VectorTracking {
             tracing::debug!(
                 "{t_stream_s:.2} s: vector filter excluded the {what} of G{prn:02} (NIS {nis:.1})"
             );
+            self.vouchers.note_excluded(*prn, t_stream_s);
         }
         if out.admitted > 0 {
             self.last_admitted_s = t_stream_s;
@@ -548,17 +618,35 @@ impl VectorTracking {
             return;
         };
         let x = *filter.state();
+        self.port.snapshot = Some(self.snapshot(epoch, t_stream_s, x, nav));
+    }
+
+    /// A prediction from state `x` at `epoch` (stream time `t_stream_s`).
+    fn snapshot(
+        &self,
+        epoch: &ObsEpoch,
+        t_stream_s: f64,
+        x: super::ekf::State,
+        nav: &NavigationProcessor,
+    ) -> Snapshot {
         let ephemerides: BTreeMap<u8, Ephemeris> = (1..=32u8)
             .filter_map(|prn| Some((prn, self.ephemeris(nav, prn, epoch.time)?)))
             .collect();
-        self.port.snapshot = Some(Snapshot {
+        Snapshot {
             t_stream_s,
             gps_time: epoch.time.add_seconds(-x[BIAS] / SPEED_OF_LIGHT_MPS),
             x,
             ephemerides: Arc::new(ephemerides),
             admitted_s: Arc::new(self.admitted_s.clone()),
+            vouched_s: Arc::new(self.vouchers.vouched_s().clone()),
             max_coast_s: self.max_coast_s,
             ins: self.ins.as_ref().and_then(|i| InsAnchor::at(i, t_stream_s)),
-        });
+        }
+    }
+
+    /// The prediction of the satellites' code and SV time: the filter's while it drives the
+    /// channels, else that of the last valid fix (module docs, "Before the filter").
+    fn prediction(&self) -> Option<&Snapshot> {
+        self.port.snapshot.as_ref().or(self.fix_prediction.as_ref())
     }
 }

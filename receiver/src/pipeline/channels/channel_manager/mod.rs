@@ -606,6 +606,18 @@ impl ChannelManager {
                 .all(|c| c.state() == ChannelState::Lost)
     }
 
+    /// Channel `channel`, if it still tracks `prn`, takes data-bit edges from outside
+    /// ([`Channel::assume_bit_edge`]: vector tracking's prediction).
+    pub fn assume_bit_edge(&mut self, channel: usize, prn: u8, edge_phase: usize) {
+        if let Some(c) = self
+            .channels
+            .get_mut(channel)
+            .filter(|c| c.prn().get() == prn)
+        {
+            c.assume_bit_edge(edge_phase);
+        }
+    }
+
     /// Every live channel forgets its data-bit edges ([`Channel::restart_bit_sync`]).
     pub fn restart_bit_sync(&mut self) {
         for c in self
