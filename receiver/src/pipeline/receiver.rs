@@ -920,7 +920,7 @@ impl ReportsOut<'_> {
                 monitor.observe(i, e, &predict);
             }
             let predicted_sv_tow_s = vector.as_deref_mut().and_then(|v| {
-                v.vouch(i, e);
+                v.vouch(i, e, !nav.sv_time_ever_known(e.prn));
                 v.predicted_sv_tow_s(e)
             });
             if tapping {

@@ -445,6 +445,13 @@ impl NavigationProcessor {
         }
     }
 
+    /// Whether the receiver ever knew the SV time of `prn` in this run (a satellite timed
+    /// before keeps its own checks of a new bit edge against that time: the data-bit edges
+    /// of vector tracking's prediction are not imposed on it).
+    pub fn sv_time_ever_known(&self, prn: u8) -> bool {
+        self.time.ever_known(prn)
+    }
+
     /// The channel's row, at most once per fix interval.
     fn channel_row(
         &mut self,

@@ -147,6 +147,11 @@ impl TimeKeeper {
         self.sv.last_known(prn)
     }
 
+    /// Whether an SV time of `prn` was ever kept (roughly or not).
+    pub fn ever_known(&self, prn: u8) -> bool {
+        self.sv.ever_known(prn)
+    }
+
     /// Marks the SV time of `prn` (all with `None`) as rough: samples may have been lost.
     pub fn make_rough(&mut self, prn: Option<u8>) {
         self.sv.make_rough(prn);

@@ -403,6 +403,11 @@ impl SvTimeKeeper {
             .map(|c| (c.sample, c.sv_tow_s))
     }
 
+    /// Whether an SV time of `prn` was ever kept (roughly or not).
+    pub fn ever_known(&self, prn: u8) -> bool {
+        self.clocks.contains_key(&prn)
+    }
+
     /// Marks the SV time of `prn` (all with `None`) as rough: samples may have been lost.
     pub fn make_rough(&mut self, prn: Option<u8>) {
         for (p, c) in self.clocks.iter_mut() {

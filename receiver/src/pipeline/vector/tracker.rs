@@ -272,12 +272,15 @@ impl VectorTracking {
         self.summary.clone()
     }
 
-    /// A channel's report, compared with the prediction while the filter drives the channels
-    /// (`super::vouch`).
-    pub fn vouch(&mut self, channel: usize, e: &ChannelEpoch) {
+    /// Report `e` of channel `channel`, compared with the prediction (`super::vouch`): the
+    /// filter's, else the last valid fix's. With `give_edges` (a satellite never timed before:
+    /// one timed before checks its new bit edges against its kept time, which is how samples
+    /// lost unseen are caught) and no doubt on the time, the bit edges the prediction puts on
+    /// a channel it vouches for are queued for it ([`VectorTracking::take_bit_edges`]).
+    pub fn vouch(&mut self, channel: usize, e: &ChannelEpoch, give_edges: bool) {
         let snap = self.port.snapshot.as_ref().or(self.fix_prediction.as_ref());
         let edge = snap.and_then(|snap| self.vouchers.observe(snap, e));
-        if let (Some(edge), None) = (edge, self.time_doubt_s) {
+        if let (Some(edge), None, true) = (edge, self.time_doubt_s, give_edges) {
             self.bit_edges.push((channel, e.prn, edge));
         }
     }
@@ -409,6 +412,10 @@ impl VectorTracking {
         self.last = None;
         self.history.clear();
         self.unhealthy_in_row = 0;
+        // A prediction that failed its health test may have failed on its time (samples lost
+        // that no detector saw): no bit edges or SV times from the fixes' either until a
+        // valid fix of a later epoch.
+        self.doubt_time(t_stream_s);
     }
 
     /// The ephemeris of `prn` at `t`: decoded, else from the navigation file (as the fixes).
