@@ -595,6 +595,26 @@ impl Channel {
         })
     }
 
+    /// A channel started from a prediction of its signal instead of a search (vector
+    /// tracking's filter knows the satellite's code phase and Doppler, not its C/N0): it pulls
+    /// in with the weak-signal pull-in ([`WeakPullInConfig`], if configured), whose
+    /// pre-synchronisation C/N0 test releases it within about a second if no signal is there;
+    /// its C/N0 is unknown (NaN) until its own first estimate.
+    pub fn predicted(
+        start: &ChannelStart,
+        fs_hz: f64,
+        cfg: &ChannelConfig,
+    ) -> Result<Self, ConfigError> {
+        let weak = ChannelStart {
+            cn0_dbhz: f64::NEG_INFINITY,
+            ..*start
+        };
+        let mut ch = Self::new(&weak, fs_hz, cfg)?;
+        ch.cn0_dbhz = f64::NAN;
+        ch.tracked_cn0_dbhz = f64::NAN;
+        Ok(ch)
+    }
+
     /// Whether the carrier is being pulled in: after acquisition ([`ChannelState::PullIn`])
     /// or after a loss of lock ([`ChannelState::Recover`]).
     fn pulling_in(&self) -> bool {
@@ -1324,8 +1344,10 @@ impl Channel {
         }
     }
 
-    /// An aid that checks the channel's measurements is applied ([`DopplerAid::checked`]).
-    fn checked_aid(&self) -> bool {
+    /// An aid that checks the channel's measurements is applied ([`DopplerAid::checked`]):
+    /// vector tracking's filter admitted them, or its prediction vouches for the channel's
+    /// code, within the last second.
+    pub fn checked_aid(&self) -> bool {
         self.ff_applied_hz.is_some() && self.aid.is_some_and(|(a, _)| a.checked)
     }
 

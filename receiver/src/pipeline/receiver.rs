@@ -809,6 +809,12 @@ impl Receiver {
             }
             None => {}
         }
+        if let Some(v) = self.vector.as_mut() {
+            let manager = &self.manager;
+            let tracked = |prn: u8| Prn::new(prn).is_ok_and(|p| manager.tracks(p));
+            let starts = v.take_in(end, self.fs_hz, &tracked);
+            self.manager.start_predicted(&starts);
+        }
         let keep_from = self.manager.oldest_needed(end);
         self.window.discard_before(keep_from);
         Ok(())

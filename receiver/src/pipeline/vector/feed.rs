@@ -156,6 +156,11 @@ impl Snapshot {
         by_ins.unwrap_or((pos + vel * dt, vel))
     }
 
+    /// The receiver's predicted position at stream time `t_s`, ECEF m (module docs).
+    pub fn position_at(&self, t_s: f64) -> Vector3<f64> {
+        self.motion(t_s, t_s - self.t_stream_s).0
+    }
+
     /// Whether the channel of `prn` may coast on the prediction at stream time `t_s` through
     /// an outage of its signal: the filter admitted a measurement of it within
     /// [`Snapshot::max_coast_s`] (module docs).

@@ -11,6 +11,8 @@
 //!   of its last measurement, off the channels while the receiver accelerates hard;
 //! - `vouch`: the channels whose code agrees with the prediction before the filter measures
 //!   them (they keep the lower loss threshold until it does);
+//! - `take_in`: satellites above the horizon that no channel tracks, started where the
+//!   prediction puts their signals (no search);
 //! - `tracker`: [`VectorTracking`], the handover scalar to vector and back, fed with what the
 //!   navigation processor emits ([`Captured`], taken by [`Tap`]).
 //!
@@ -23,6 +25,7 @@ pub mod ekf;
 pub mod feed;
 pub mod measure;
 pub mod noise;
+pub mod take_in;
 mod tap;
 mod tracker;
 pub mod vouch;

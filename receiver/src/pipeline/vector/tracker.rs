@@ -63,6 +63,7 @@ use super::ekf::{ClockModel, FilterParams, NavFilter, RowKind, BIAS};
 use super::feed::{InsAnchor, Snapshot, VectorPort, CHECKED_S};
 use super::measure::{epoch_rows, RowModel};
 use super::noise::LoopNoise;
+use super::take_in::TakeIn;
 use super::vouch::Vouchers;
 use crate::config::{IonoModel, ReceiverConfig, TropoModel};
 use crate::pipeline::aiding::InsFeedForward;
@@ -182,6 +183,10 @@ pub struct VectorTracking {
     fix_prediction: Option<Snapshot>,
     /// Data-bit edges for the channels vouched for, not yet handed to them.
     bit_edges: Vec<(usize, u8, usize)>,
+    /// The satellites taken in from the prediction.
+    take_in: TakeIn,
+    /// `[run] elevation_mask_deg`.
+    mask_deg: f64,
     /// Stream time of samples possibly lost (a carrier-phase jump or a collapse, s): no bit
     /// edges or SV times from the prediction until a valid fix of a later epoch.
     time_doubt_s: Option<f64>,
@@ -237,6 +242,8 @@ impl VectorTracking {
             vouchers: Vouchers::default(),
             fix_prediction: None,
             bit_edges: Vec::new(),
+            take_in: TakeIn::default(),
+            mask_deg: config.run.elevation_mask_deg,
             time_doubt_s: None,
             max_coast_s: v.max_coast_s,
             history: VecDeque::new(),
@@ -293,6 +300,25 @@ impl VectorTracking {
         self.time_doubt_s = Some(self.time_doubt_s.map_or(t_s, |t| t.max(t_s)));
         self.fix_prediction = None;
         self.bit_edges.clear();
+    }
+
+    /// Channels to start for satellites above the horizon that no channel tracks
+    /// (`tracked`), where the filter's prediction puts their signals after the samples read
+    /// so far (`end_sample`): only while the filter drives the channels and its time is not
+    /// in doubt (`super::take_in`).
+    pub fn take_in(
+        &mut self,
+        end_sample: u64,
+        fs_hz: f64,
+        tracked: &dyn Fn(u8) -> bool,
+    ) -> Vec<gpsrx_tracking::ChannelStart> {
+        match (&self.port.snapshot, self.time_doubt_s) {
+            (Some(snap), None) => {
+                self.take_in
+                    .starts(snap, end_sample, fs_hz, self.mask_deg, tracked)
+            }
+            _ => Vec::new(),
+        }
     }
 
     /// The data-bit edges the prediction put on the channels it vouched for since the last
@@ -397,6 +423,7 @@ impl VectorTracking {
         self.last_admitted_s = t_stream_s;
         self.admitted_s.clear();
         self.vouchers.clear();
+        self.take_in.clear();
         self.unhealthy_in_row = 0;
         self.summary.engagements += 1;
         self.publish(epoch, t_stream_s, nav);

@@ -478,7 +478,10 @@ impl ChannelManager {
     /// pull-in's last estimate is no measure, and its Doppler wanders, so the tight rule for
     /// detections is not used). A false channel locks on the strong satellite's carrier and
     /// data and must never be confirmed (measured: one 29 dB below a 52 dB-Hz satellite
-    /// reached tracking).
+    /// reached tracking). Not a channel its aid checks ([`Channel::checked_aid`]: vector
+    /// tracking's prediction puts its own satellite's code where the channel's is, which a
+    /// cross-correlation, at the strong satellite's code alignment, matches by chance only:
+    /// a 24 dB-Hz satellite 1 kHz from a 43 dB-Hz one was released again and again).
     fn release_cross_correlations(&mut self) {
         let sources: Vec<(Prn, f64, f64)> = self
             .channels
@@ -489,7 +492,7 @@ impl ChannelManager {
         for c in self
             .channels
             .iter_mut()
-            .filter(|c| !c.confirmed() && c.state() != ChannelState::Lost)
+            .filter(|c| !c.confirmed() && c.state() != ChannelState::Lost && !c.checked_aid())
         {
             let own_cn0 = match c.tracked_cn0_dbhz() {
                 x if x.is_finite() => x.max(c.cn0_dbhz()),
@@ -575,6 +578,38 @@ impl ChannelManager {
                     started.push(d);
                 }
                 Err(e) => tracing::warn!("{}: cannot start a channel: {e}", d.prn),
+            }
+        }
+        started
+    }
+
+    /// Whether a live channel tracks `prn`.
+    pub fn tracks(&self, prn: Prn) -> bool {
+        self.live(prn).is_some()
+    }
+
+    /// Channels started from predictions of their signals, without a search
+    /// ([`Channel::predicted`]: vector tracking takes in a satellite it predicts above the
+    /// horizon but no channel tracks); a satellite already tracked is skipped. Returns the
+    /// satellites started.
+    pub fn start_predicted(&mut self, starts: &[ChannelStart]) -> Vec<Prn> {
+        let mut started = Vec::new();
+        for start in starts {
+            if self.live(start.prn).is_some() {
+                continue;
+            }
+            match Channel::predicted(start, self.fs_hz, &self.channel_config) {
+                Ok(ch) => {
+                    tracing::info!(
+                        "{}: taken in from vector tracking's prediction at {:.2} s, Doppler {:.0} Hz (no search)",
+                        start.prn,
+                        start.code_start_sample as f64 / self.fs_hz,
+                        start.doppler_hz
+                    );
+                    self.channels.push(ch);
+                    started.push(start.prn);
+                }
+                Err(e) => tracing::warn!("{}: cannot start a channel: {e}", start.prn),
             }
         }
         started
