@@ -14,7 +14,10 @@ of the blockage (the scenario with another seed); `turn-ins` runs scalar with th
 and vector with the INS on the turn with a 1 mg INS; `turn-ins-wrong` runs scalar and vector with
 that INS log altered three ways (50 ms late, 10 mg more bias, 5 % scale factor on its velocity
 change) and prints the satellites held and the 3-D RMS over 19-30 s; `turn-ins-cut` cuts 31 ms
-of samples at 22 s (inside the turn) and scores scalar and vector with the INS.
+of samples at 22 s (inside the turn) and scores scalar and vector with the INS;
+`gpssim-weak [DB]` weakens the GPS-SDR-SIM recording of ../shared/data by DB (default 12) with
+scripts/tools/weaken.py and scores scalar and vector (with --nav) against its truth position:
+valid fixes, mean satellites in them, horizontal RMS, over all fixes and from 15 s.
 """
 import csv, json, math, subprocess, sys, os
 
@@ -197,3 +200,42 @@ if __name__ == "__main__" and sys.argv[1] == "turn-ins-cut":
         rs = [x for x in res if 19 <= x[0] <= 30]
         worst = max((x[7] for x in rs), default=float("nan"))
         print(f"31 ms cut at 22 s, {mode} + INS: {len(rs)} valid fixes over 19-30 s, 3-D RMS {rms_3d(res, 19, 30):.2f} m, max {worst:.1f} m")
+
+def gpssim_score(out, t_from):
+    """Valid fixes of `out` from `t_from` s (TOW 538200 + t_from) against the GPS-SDR-SIM
+    recording's truth (37.5665, 126.9780, 40 m): count, mean satellites, horizontal RMS."""
+    la, lo, h = math.radians(37.5665), math.radians(126.9780), 40.0
+    a, e2 = 6378137.0, 6.69437999014e-3
+    n = a / math.sqrt(1 - e2 * math.sin(la) ** 2)
+    tx, ty = (n + h) * math.cos(la) * math.cos(lo), (n + h) * math.cos(la) * math.sin(lo)
+    tz = (n * (1 - e2) + h) * math.sin(la)
+    hs, ns = [], []
+    for r in csv.DictReader(open(f"{out}/pvt.csv")):
+        if r["quality"] == "none" or float(r["tow_s"]) - 538200.0 < t_from:
+            continue
+        e, nn, _ = ecef_to_enu_err(float(r["x_m"]), float(r["y_m"]), float(r["z_m"]), tx, ty, tz, 37.5665, 126.9780)
+        hs.append(math.hypot(e, nn))
+        ns.append(int(r["n_sv"]))
+    if not hs:
+        return "no valid fix"
+    return f"{len(hs)} valid fixes, mean satellites {sum(ns) / len(ns):.2f} of 8, horizontal RMS {math.sqrt(sum(x * x for x in hs) / len(hs)):.2f} m"
+
+if __name__ == "__main__" and sys.argv[1] == "gpssim-weak":
+    # The GPS-SDR-SIM recording of ../shared/data weakened by DB (default 12) with
+    # scripts/tools/weaken.py, scalar against vector with --nav (no troposphere in it).
+    db = sys.argv[2] if len(sys.argv) > 2 else "12"
+    base = os.environ.get("VEC_WORK", "/tmp/vec")
+    src = os.path.join(ROOT, "../shared/data/gpssim-static-seoul-2p6msps.ci8.zst")
+    raw, weak = f"{base}/gpssim.ci8", f"{base}/gpssim-weak-{db}.ci8"
+    if not os.path.exists(raw):
+        subprocess.run(["zstd", "-q", "-d", "-f", "-o", raw, src], check=True)
+    if not os.path.exists(weak):
+        subprocess.run([sys.executable, os.path.join(ROOT, "scripts/tools/weaken.py"), raw, weak, "--db", db], check=True, capture_output=True)
+    for mode in ("scalar", "vector"):
+        out = f"{base}/gpssim-weak-{db}-{mode}"
+        cmd = [GPSRX, "run", weak, "--format", "ci8", "--fs", "2.6e6", "--tropo", "none", "--nav", NAV,
+               "--allow-unhealthy", "--tracking", mode, "--out", out, "--json", "--no-plots"]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            print(r.stderr[-2000:]); sys.exit(1)
+        print(f"-{db} dB, {mode}: all: {gpssim_score(out, 0.0)}; from 15 s: {gpssim_score(out, 15.0)}")
