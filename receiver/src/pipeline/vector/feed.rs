@@ -115,11 +115,7 @@ impl Snapshot {
     /// The predicted Doppler (Hz) of `prn` at stream time `t_s` (module docs), None without
     /// its ephemeris, beyond [`Snapshot::max_coast_s`] or when the geometry is degenerate.
     pub fn doppler_hz(&self, prn: u8, t_s: f64) -> Option<f64> {
-        let dt = t_s - self.t_stream_s;
-        if !(dt.is_finite() && dt.abs() <= self.max_coast_s) {
-            return None;
-        }
-        let eph = self.ephemerides.get(&prn)?;
+        let (eph, dt) = self.ephemeris_within_reach(prn, t_s)?;
         let (pos, vel) = self.motion(t_s, dt);
         let drift_mps = self.x[DRIFT];
         let seen = eph.at_reception(self.gps_time.add_seconds(dt), &pos, 0.075, 2);
@@ -138,6 +134,16 @@ impl Snapshot {
             drift_mps / SPEED_OF_LIGHT_MPS,
         )?;
         f.is_finite().then_some(f)
+    }
+
+    /// The ephemeris of `prn` and the time from the update to stream time `t_s`, s, when
+    /// the prediction reaches that far ([`Snapshot::max_coast_s`]).
+    fn ephemeris_within_reach(&self, prn: u8, t_s: f64) -> Option<(&Ephemeris, f64)> {
+        let dt = t_s - self.t_stream_s;
+        if !(dt.is_finite() && dt.abs() <= self.max_coast_s) {
+            return None;
+        }
+        Some((self.ephemerides.get(&prn)?, dt))
     }
 
     /// The receiver's predicted position and velocity (ECEF m, m/s) at stream time `t_s`,
@@ -184,11 +190,7 @@ impl Snapshot {
     /// Without the ionosphere and troposphere (2-50 m, 7-170 ns; the filter's clock bias
     /// holds their mean). None as [`Snapshot::doppler_hz`].
     pub fn sv_tow_s(&self, prn: u8, t_s: f64) -> Option<f64> {
-        let dt = t_s - self.t_stream_s;
-        if !(dt.is_finite() && dt.abs() <= self.max_coast_s) {
-            return None;
-        }
-        let eph = self.ephemerides.get(&prn)?;
+        let (eph, dt) = self.ephemeris_within_reach(prn, t_s)?;
         let (pos, _) = self.motion(t_s, dt);
         // The receiver clock runs on between updates: GPS time advances by dt less its drift.
         let t_gps = self
@@ -232,4 +234,31 @@ impl gpsrx_tracking::AidingPort for VectorPort {
 /// 1 ms)` (the code starts with every millisecond of SV time, IS-GPS-200 3.3.2.3).
 pub fn code_phase_chips(sv_tow_s: f64) -> f64 {
     (sv_tow_s.rem_euclid(CA_CODE_PERIOD_S) * CA_CHIP_RATE_HZ) % CA_CODE_LENGTH as f64
+}
+
+/// A prediction for the unit tests: a static receiver at Seoul (37.5665, 126.978, 40 m) with
+/// a perfect clock at GPS week 2190, TOW 538200 s, at stream time 10 s, with the broadcast
+/// ephemerides of the simulator's built-in navigation file.
+#[cfg(test)]
+pub(crate) fn test_snapshot() -> Snapshot {
+    use gpsrx_nav::ephemeris::HealthPolicy;
+    let nav = gpsrx_nav::rinex_nav::parse_rinex_nav(gpsrx_samples::sim::scenario::BUILTIN_NAV_TEXT)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let t = GpsTime::new(2190, 538_200.0);
+    let ephemerides = (1..=32u8)
+        .filter_map(|p| Some((p, nav.select_with(p, t, HealthPolicy::Ignore)?.clone())))
+        .collect();
+    let mut x = State::zeros();
+    let pos = gpsrx_core::frames::Llh::from_degrees(37.5665, 126.978, 40.0).to_ecef();
+    x.fixed_rows_mut::<3>(0).copy_from(&pos);
+    Snapshot {
+        t_stream_s: 10.0,
+        gps_time: t,
+        x,
+        ephemerides: Arc::new(ephemerides),
+        admitted_s: Arc::new(BTreeMap::new()),
+        vouched_s: Arc::new(BTreeMap::new()),
+        max_coast_s: 5.0,
+        ins: None,
+    }
 }

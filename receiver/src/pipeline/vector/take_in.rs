@@ -42,13 +42,14 @@ pub struct TakeIn {
 
 impl TakeIn {
     /// The channels to start for the satellites `snap` predicts above `mask_deg` and no
-    /// channel tracks (`tracked`), after the samples read so far (`end_sample`, at `fs_hz`).
+    /// channel tracks (`tracked`), among `prns` (`[run] prns`; empty: all), after the samples
+    /// read so far (`end_sample`, at `fs_hz`).
     pub fn starts(
         &mut self,
         snap: &Snapshot,
         end_sample: u64,
         fs_hz: f64,
-        mask_deg: f64,
+        (mask_deg, prns): (f64, &[u8]),
         tracked: &dyn Fn(u8) -> bool,
     ) -> Vec<ChannelStart> {
         let now_s = end_sample as f64 / fs_hz;
@@ -59,7 +60,11 @@ impl TakeIn {
         let min_el = mask_deg.max(MIN_ELEVATION_DEG).to_radians();
         let mut out = Vec::new();
         for (&prn, eph) in snap.ephemerides.iter() {
-            if tracked(prn) || self.tried_s.get(&prn).is_some_and(|t| now_s - t < RETRY_S) {
+            let wanted = prns.is_empty() || prns.contains(&prn);
+            if !wanted
+                || tracked(prn)
+                || self.tried_s.get(&prn).is_some_and(|t| now_s - t < RETRY_S)
+            {
                 continue;
             }
             let Ok(p) = Prn::new(prn) else { continue };
@@ -92,5 +97,62 @@ impl TakeIn {
     /// Forgets the satellites tried (the filter starts again).
     pub fn clear(&mut self) {
         *self = Self::default();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::vector::feed::test_snapshot;
+
+    const FS_HZ: f64 = 2.6e6;
+
+    #[test]
+    fn satellites_above_the_horizon_start_where_their_code_period_starts() {
+        let snap = test_snapshot();
+        let end = (10.2 * FS_HZ) as u64;
+        let mut take = TakeIn::default();
+        let tracked = |prn: u8| prn == 31;
+        let starts = take.starts(&snap, end, FS_HZ, (5.0, &[]), &tracked);
+        let prns: Vec<u8> = starts.iter().map(|s| s.prn.get()).collect();
+        // The GPS-SDR-SIM recording of this place and time sees 3, 16, 22, 25, 26, 29, 31
+        // and 32 (../shared/data/README.md); 31 is tracked already.
+        for p in [3, 16, 22, 25, 26, 29, 32] {
+            assert!(prns.contains(&p), "G{p:02} not taken in: {prns:?}");
+        }
+        assert!(!prns.contains(&31), "{prns:?}");
+        for s in &starts {
+            // The predicted code phase at the start sample is a whole period (within half a
+            // sample, 0.2 chip at 2.6 MHz), within 1 ms after the end of the samples read.
+            assert!(s.code_start_sample >= end && s.code_start_sample < end + 2600);
+            let t = s.code_start_sample as f64 / FS_HZ;
+            let sv = snap.sv_tow_s(s.prn.get(), t).unwrap_or(f64::NAN);
+            let off =
+                crate::pipeline::vector::vouch::code_distance_chips(code_phase_chips(sv), 0.0);
+            assert!(off <= 0.25, "{}: {off:.3} chip off a period start", s.prn);
+            assert!(s.cn0_dbhz.is_nan() && s.doppler_hz.abs() < 5000.0, "{s:?}");
+            let (_, el) = azimuth_elevation(&snap.position_at(t), &{
+                let eph = &snap.ephemerides[&s.prn.get()];
+                eph.at_reception(snap.gps_time, &snap.position_at(t), 0.075, 2)
+                    .sv
+                    .pos_m
+            });
+            assert!(
+                el.to_degrees() >= MIN_ELEVATION_DEG,
+                "{}: {:.1} deg",
+                s.prn,
+                el.to_degrees()
+            );
+        }
+        // Not again within the second, nor for RETRY_S; only the listed PRNs with `prns`.
+        assert!(take
+            .starts(&snap, end + 1000, FS_HZ, (5.0, &[]), &tracked)
+            .is_empty());
+        let mut fresh = TakeIn::default();
+        let only = fresh.starts(&snap, end, FS_HZ, (5.0, &[16, 31]), &tracked);
+        assert_eq!(
+            only.iter().map(|s| s.prn.get()).collect::<Vec<_>>(),
+            vec![16]
+        );
     }
 }

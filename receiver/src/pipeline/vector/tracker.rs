@@ -187,6 +187,8 @@ pub struct VectorTracking {
     take_in: TakeIn,
     /// `[run] elevation_mask_deg`.
     mask_deg: f64,
+    /// `[run] prns` (empty: all): the satellites that may be taken in.
+    prns: Vec<u8>,
     /// Stream time of samples possibly lost (a carrier-phase jump or a collapse, s): no bit
     /// edges or SV times from the prediction until a valid fix of a later epoch.
     time_doubt_s: Option<f64>,
@@ -244,6 +246,7 @@ impl VectorTracking {
             bit_edges: Vec::new(),
             take_in: TakeIn::default(),
             mask_deg: config.run.elevation_mask_deg,
+            prns: config.run.prns.clone(),
             time_doubt_s: None,
             max_coast_s: v.max_coast_s,
             history: VecDeque::new(),
@@ -314,8 +317,9 @@ impl VectorTracking {
     ) -> Vec<gpsrx_tracking::ChannelStart> {
         match (&self.port.snapshot, self.time_doubt_s) {
             (Some(snap), None) => {
+                let limits = (self.mask_deg, self.prns.as_slice());
                 self.take_in
-                    .starts(snap, end_sample, fs_hz, self.mask_deg, tracked)
+                    .starts(snap, end_sample, fs_hz, limits, tracked)
             }
             _ => Vec::new(),
         }

@@ -3,7 +3,8 @@
 //!
 //! While the filter drives the channels, every report of a channel that is neither lost nor
 //! coasting is compared (at most every [`VOUCH_EVERY_S`] per satellite) with the predicted
-//! code phase at its first sample ([`Snapshot::code_phase_chips`]): within [`VOUCH_CHIPS`]
+//! code phase at its first sample ([`code_phase_chips`] of
+//! [`Snapshot::sv_tow_s`]): within [`VOUCH_CHIPS`]
 //! (modulo the 1023-chip period) the channel tracks its satellite's signal, and counts as
 //! checked for [`super::feed::CHECKED_S`] ([`Snapshot::checked`]): its loss threshold is
 //! `[tracking] vector_cn0_lost_dbhz`, so a satellite at 22-25 dB-Hz stays tracked until its
@@ -46,7 +47,7 @@ pub struct Vouchers {
 impl Vouchers {
     /// Compares report `e` with the prediction `snap` (module docs); when it vouches for the
     /// channel, returns the data-bit edges the prediction puts on it
-    /// ([`predicted::bit_edge_phase`]).
+    /// (`crate::pipeline::timing::predicted::bit_edge_phase`).
     pub fn observe(&mut self, snap: &Snapshot, e: &ChannelEpoch) -> Option<usize> {
         if e.state == ChannelState::Lost || e.coasting {
             return None;
@@ -106,5 +107,46 @@ mod tests {
         assert!((code_distance_chips(1022.9, 0.2) - 0.3).abs() < 1e-9);
         assert!((code_distance_chips(100.0, 611.5) - 511.5).abs() < 1e-9);
         assert_eq!(code_distance_chips(5.0, 5.0), 0.0);
+    }
+}
+
+#[cfg(test)]
+mod prediction_tests {
+    use super::*;
+    use crate::pipeline::vector::feed::test_snapshot;
+    use num_complex::Complex64;
+
+    /// A report of G16 at stream time `t_s` whose code stands `off_chips` from the prediction.
+    fn report_at(snap: &Snapshot, t_s: f64, off_chips: f64) -> ChannelEpoch {
+        let mut e = crate::pipeline::test_support::report(
+            16,
+            (t_s * 1e3) as u64,
+            Complex64::new(1.0, 0.0),
+            0.0,
+            0.0,
+            24.0,
+        );
+        e.t_rx_s = t_s;
+        let sv = snap.sv_tow_s(16, t_s).unwrap_or(f64::NAN);
+        e.code_phase_chips = (code_phase_chips(sv) + off_chips).rem_euclid(1023.0);
+        e
+    }
+
+    #[test]
+    fn a_channel_on_the_predicted_code_is_vouched_for_and_one_off_it_is_not() {
+        let snap = test_snapshot();
+        let mut v = Vouchers::default();
+        assert!(v.observe(&snap, &report_at(&snap, 10.0, 3.0)).is_none());
+        assert!(v.vouched_s().is_empty());
+        // Compared again only after VOUCH_EVERY_S.
+        assert!(v.observe(&snap, &report_at(&snap, 10.05, 0.1)).is_none());
+        let edge = v.observe(&snap, &report_at(&snap, 10.2, 0.1));
+        assert!(edge.is_some_and(|p| p < 20), "{edge:?}");
+        assert_eq!(v.vouched_s().get(&16), Some(&10.2));
+        // An exclusion by the innovation test withdraws it and holds it off for CHECKED_S.
+        v.note_excluded(16, 10.25);
+        assert!(v.vouched_s().is_empty());
+        assert!(v.observe(&snap, &report_at(&snap, 10.4, 0.0)).is_none());
+        assert!(v.observe(&snap, &report_at(&snap, 11.3, 0.0)).is_some());
     }
 }
