@@ -95,6 +95,11 @@ pub const MAX_START_VELOCITY_SIGMA_MPS: f64 = 0.5;
 /// detector's power-change test restarts it from five 20 ms tests, so a channel whose signal
 /// went reports no lock 0.1-0.2 s after.
 pub const QUARANTINE_S: f64 = 0.3;
+/// How long after the valid fix that ends a doubt on the time (samples possibly lost) the
+/// prediction still gives no bit edges or SV times, s: the channels moved onto their codes
+/// again pull in for a second (after a 5 s cut a satellite timed 0.2 s after the time came
+/// back put fixes 9 m off, 3 sigma, for 0.8 s).
+pub const DOUBT_SETTLE_S: f64 = 2.0;
 /// How far back the filter's states are kept for a rollback, s.
 const HISTORY_S: f64 = 1.0;
 
@@ -190,8 +195,11 @@ pub struct VectorTracking {
     /// `[run] prns` (empty: all): the satellites that may be taken in.
     prns: Vec<u8>,
     /// Stream time of samples possibly lost (a carrier-phase jump or a collapse, s): no bit
-    /// edges or SV times from the prediction until a valid fix of a later epoch.
+    /// edges or SV times from the prediction until [`DOUBT_SETTLE_S`] after a valid fix of
+    /// a later epoch (`doubt_ends_s`).
     time_doubt_s: Option<f64>,
+    /// When the doubt ends, once a valid fix of a later epoch came, s of stream time.
+    doubt_ends_s: Option<f64>,
     /// `[vector] max_coast_s`.
     max_coast_s: f64,
     /// The filter after each of its last epochs.
@@ -248,6 +256,7 @@ impl VectorTracking {
             mask_deg: config.run.elevation_mask_deg,
             prns: config.run.prns.clone(),
             time_doubt_s: None,
+            doubt_ends_s: None,
             max_coast_s: v.max_coast_s,
             history: VecDeque::new(),
             quarantine_until_s: f64::NEG_INFINITY,
@@ -297,10 +306,12 @@ impl VectorTracking {
 
     /// Samples may have been lost at stream time `t_s` (a carrier-phase jump common to the
     /// satellites, or a collapse of their prompt power): the prediction's time may be off by
-    /// them, so it gives no data-bit edges or SV times until a valid fix of a later epoch
-    /// (the receiver time re-established), and the last fix's prediction is dropped.
+    /// them, so it gives no data-bit edges or SV times until [`DOUBT_SETTLE_S`] after a
+    /// valid fix of a later epoch (the receiver time re-established, and the channels moved
+    /// onto their codes again settled), and the last fix's prediction is dropped.
     pub fn doubt_time(&mut self, t_s: f64) {
         self.time_doubt_s = Some(self.time_doubt_s.map_or(t_s, |t| t.max(t_s)));
+        self.doubt_ends_s = None;
         self.fix_prediction = None;
         self.bit_edges.clear();
     }
@@ -393,11 +404,16 @@ impl VectorTracking {
                 );
             }
             self.on_epoch(&epoch, t_stream_s, nav);
-            if self
-                .time_doubt_s
-                .is_some_and(|t| fix.as_ref().is_some_and(|f| f.2) && t_stream_s > t)
-            {
-                self.time_doubt_s = None;
+            let valid = fix.as_ref().is_some_and(|f| f.2);
+            match (self.time_doubt_s, self.doubt_ends_s) {
+                (Some(t), None) if valid && t_stream_s > t => {
+                    self.doubt_ends_s = Some(t_stream_s + DOUBT_SETTLE_S);
+                }
+                (Some(_), Some(end)) if t_stream_s >= end => {
+                    self.time_doubt_s = None;
+                    self.doubt_ends_s = None;
+                }
+                _ => {}
             }
             if let (None, Some((_, sol, true))) = (&self.filter, &fix) {
                 let x = *NavFilter::from_solution(sol, self.params).state();
