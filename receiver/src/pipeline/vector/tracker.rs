@@ -195,7 +195,7 @@ pub struct VectorTracking {
     /// `[run] prns` (empty: all): the satellites that may be taken in.
     prns: Vec<u8>,
     /// Stream time of samples possibly lost (a carrier-phase jump or a collapse, s): no bit
-    /// edges or SV times from the prediction until [`DOUBT_SETTLE_S`] after a valid fix of
+    /// edges or SV times from the prediction until `DOUBT_SETTLE_S` after a valid fix of
     /// a later epoch (`doubt_ends_s`).
     time_doubt_s: Option<f64>,
     /// When the doubt ends, once a valid fix of a later epoch came, s of stream time.
@@ -306,7 +306,7 @@ impl VectorTracking {
 
     /// Samples may have been lost at stream time `t_s` (a carrier-phase jump common to the
     /// satellites, or a collapse of their prompt power): the prediction's time may be off by
-    /// them, so it gives no data-bit edges or SV times until [`DOUBT_SETTLE_S`] after a
+    /// them, so it gives no data-bit edges or SV times until `DOUBT_SETTLE_S` after a
     /// valid fix of a later epoch (the receiver time re-established, and the channels moved
     /// onto their codes again settled), and the last fix's prediction is dropped.
     pub fn doubt_time(&mut self, t_s: f64) {
