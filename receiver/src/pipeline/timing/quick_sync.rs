@@ -59,7 +59,7 @@ impl TowCandidate {
     }
 
     /// Whether SV time `sv_tow_s` at `sample` agrees with this candidate.
-    fn agrees(&self, sample: u64, sv_tow_s: f64, fs_hz: f64) -> bool {
+    pub fn agrees(&self, sample: u64, sv_tow_s: f64, fs_hz: f64) -> bool {
         let predicted = self.sv_tow_s + (sample as f64 - self.sample as f64) / fs_hz;
         GpsTime::fold_tow_difference_s(sv_tow_s - predicted).abs() < AGREEMENT_S
     }

@@ -147,6 +147,18 @@ impl NavigationProcessor {
             return Ok(());
         };
         let confirmed = quick.offer(c, &known, self.fs_hz);
+        // Times read from HOWs that two satellites agree on, against SV times carried over an
+        // outage (checked by the bit edges modulo 20 ms only): a carried time that disagrees
+        // counts whole data bits of samples lost unseen; every carried time is dropped.
+        let wrong_carried = confirmed.first().is_some_and(|c| {
+            known.iter().any(|&(p, k, sv)| {
+                self.decoders.get(&p).is_some_and(NavDecoder::time_carried)
+                    && !c.agrees(k, sv, self.fs_hz)
+            })
+        });
+        if wrong_carried {
+            self.drop_carried_times(c.sample as f64 / self.fs_hz);
+        }
         let by: Vec<String> = confirmed.iter().map(|c| format!("G{:02}", c.prn)).collect();
         for c in &confirmed {
             let synced = self
