@@ -254,16 +254,7 @@ pub(crate) fn biased_ins(
         accel_bias_enu_mps2: [bias_mps2; 3],
         ..Default::default()
     };
-    let truth = |t_s: f64| {
-        let (tow, s) = sim.receiver_truth(t_s);
-        gpsrx_ins_aiding::TruthState {
-            t_s,
-            gps_tow_s: Some(tow),
-            pos_m: s.pos_m,
-            vel_mps: s.vel_mps,
-        }
-    };
-    gpsrx_ins_aiding::simulate_ins(&truth, sim.duration_s(), &cfg)
+    gpsrx_receiver::simulate::simulate_ins_for(sim, &cfg)
         .and_then(gpsrx_ins_aiding::InsTrack::from_samples)
         .unwrap_or_else(|e| panic!("{e}"))
 }

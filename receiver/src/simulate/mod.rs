@@ -16,7 +16,8 @@ pub use tables::{accel_config, dr_config, ins_config};
 use crate::fusion::vehicle::{vehicle_truth, EcefState};
 use gpsrx_ins_aiding::{
     simulate_accel, simulate_dr, simulate_ins, write_accel_csv, write_dr_csv, write_ins_csv,
-    AccelSensorConfig, DrSensorConfig, InsError, InsErrorConfig, TruthState, VehicleTruth,
+    AccelSensorConfig, DrSensorConfig, InsError, InsErrorConfig, InsSample, TruthState,
+    VehicleTruth,
 };
 use gpsrx_nav::frames::Llh;
 use gpsrx_samples::sim::{Scenario, SimError, SimReport, Simulator};
@@ -158,16 +159,24 @@ pub fn simulate(
     Ok((report, sensors))
 }
 
-/// Writes the INS of `cfg` for the simulation `sim` to `path` (see
-/// [`gpsrx_ins_aiding::error_model`]) and returns the number of rows. Truth at sample time `t`
-/// (seconds since the first IF sample) is [`Simulator::receiver_truth`], as in `truth.csv`:
-/// position and velocity at the true time `t_true` solving `t_true + b(t_true) = t`, and
-/// `gps_tow_s` the GPS time of week of `t_true`.
+/// Writes the INS of `cfg` for the simulation `sim` to `path` ([`simulate_ins_for`]) and
+/// returns the number of rows.
 pub fn write_ins_for(
     sim: &Simulator,
     cfg: &InsErrorConfig,
     path: &Path,
 ) -> Result<usize, InsError> {
+    let samples = simulate_ins_for(sim, cfg)?;
+    write_ins_csv(path, &samples)?;
+    Ok(samples.len())
+}
+
+/// The INS of `cfg` for the simulation `sim` over the whole recording (see
+/// [`gpsrx_ins_aiding::error_model`]). Truth at sample time `t` (seconds since the first IF
+/// sample) is [`Simulator::receiver_truth`], as in `truth.csv`: position and velocity at the
+/// true time `t_true` solving `t_true + b(t_true) = t`, and `gps_tow_s` the GPS time of week
+/// of `t_true`.
+pub fn simulate_ins_for(sim: &Simulator, cfg: &InsErrorConfig) -> Result<Vec<InsSample>, InsError> {
     let truth = |t_s: f64| {
         let (tow_s, s) = sim.receiver_truth(t_s);
         TruthState {
@@ -177,9 +186,7 @@ pub fn write_ins_for(
             vel_mps: s.vel_mps,
         }
     };
-    let samples = simulate_ins(&truth, sim.duration_s(), cfg)?;
-    write_ins_csv(path, &samples)?;
-    Ok(samples.len())
+    simulate_ins(&truth, sim.duration_s(), cfg)
 }
 
 /// The simulation's truth as a land vehicle, at 100 Hz over the whole recording, in the local

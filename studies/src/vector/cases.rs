@@ -171,15 +171,6 @@ pub fn biased_ins(sim: &Simulator) -> anyhow::Result<gpsrx_ins_aiding::InsTrack>
         accel_bias_enu_mps2: [INS_BIAS_MPS2; 3],
         ..Default::default()
     };
-    let truth = |t_s: f64| {
-        let (tow, s) = sim.receiver_truth(t_s);
-        gpsrx_ins_aiding::TruthState {
-            t_s,
-            gps_tow_s: Some(tow),
-            pos_m: s.pos_m,
-            vel_mps: s.vel_mps,
-        }
-    };
-    let samples = gpsrx_ins_aiding::simulate_ins(&truth, sim.duration_s(), &cfg)?;
+    let samples = gpsrx_receiver::simulate::simulate_ins_for(sim, &cfg)?;
     Ok(gpsrx_ins_aiding::InsTrack::from_samples(samples)?)
 }
