@@ -165,6 +165,32 @@ impl NavigationProcessor {
         self.last_raim = Some(sol.raim);
     }
 
+    /// Whether a fix that passed the integrity and geometry tests, at stream time `t_s`, may
+    /// be valid when RAIM could not check it: not just after an outage (`settle`), and not
+    /// with an SV time carried over an outage that no HOW has confirmed yet. Such a time is
+    /// checked by the bit edges only modulo 20 ms: samples lost during the outage by a whole
+    /// number of data bits do not show (a 5 s cut of a 24-32 dB-Hz recording, which no
+    /// lost-sample detector saw: 4-satellite fixes 5.8 km off handed out as valid for 3 s),
+    /// and without redundancy nothing else checks it: such a fix waits for the satellites'
+    /// HOWs (or for RAIM).
+    fn unchecked_fix_admitted(&mut self, s: &PvtSolution, t_s: f64) -> bool {
+        let checked = !matches!(s.raim, RaimStatus::Unavailable);
+        if !self.settle.admit(t_s, checked, 1.0 / self.settings.rate_hz) {
+            tracing::debug!("{t_s:.2} s: a fix of 4 satellites just after an outage is not valid (waiting for one RAIM can check)");
+            return false;
+        }
+        let unconfirmed = s
+            .used_prns
+            .iter()
+            .filter(|p| self.decoders.get(p).is_some_and(|d| d.time_carried()))
+            .count();
+        if !checked && unconfirmed > 0 {
+            tracing::debug!("{t_s:.2} s: a fix RAIM cannot check, with the SV times of {unconfirmed} satellites carried over an outage and not yet confirmed by a HOW, is not valid");
+            return false;
+        }
+        true
+    }
+
     /// Solves one epoch and hands its observables and fix to the sink.
     pub(super) fn solve_epoch(
         &mut self,
@@ -181,26 +207,7 @@ impl NavigationProcessor {
         let integrity_ok = solution.as_ref().is_some_and(passes_integrity);
         let mut valid = integrity_ok && solution.as_ref().is_some_and(|s| s.dop.pdop <= max_pdop);
         if let Some(s) = solution.as_ref().filter(|_| valid) {
-            let checked = !matches!(s.raim, RaimStatus::Unavailable);
-            let t_s = epoch.sample / self.fs_hz;
-            if !self.settle.admit(t_s, checked, 1.0 / self.settings.rate_hz) {
-                tracing::debug!("{t_s:.2} s: a fix of 4 satellites just after an outage is not valid (waiting for one RAIM can check)");
-                valid = false;
-            }
-            // An SV time carried over an outage is checked by the bit edges only modulo 20 ms:
-            // samples lost during the outage by a whole number of data bits do not show (a 5 s
-            // cut of a 24-32 dB-Hz recording, which no lost-sample detector saw: 4-satellite
-            // fixes 5.8 km off handed out as valid for 3 s). Without redundancy nothing else
-            // checks it: such a fix waits for the satellites' HOWs (or for RAIM).
-            let unconfirmed = s
-                .used_prns
-                .iter()
-                .filter(|p| self.decoders.get(p).is_some_and(|d| d.time_carried()))
-                .count();
-            if valid && !checked && unconfirmed > 0 {
-                tracing::debug!("{t_s:.2} s: a fix RAIM cannot check, with the SV times of {unconfirmed} satellites carried over an outage and not yet confirmed by a HOW, is not valid");
-                valid = false;
-            }
+            valid = self.unchecked_fix_admitted(s, epoch.sample / self.fs_hz);
         }
         if let Some(s) = solution.as_ref().filter(|s| s.dop.pdop > max_pdop) {
             self.log_poor_geometry(epoch.sample / self.fs_hz, s.dop.pdop, s.n_sv);
