@@ -17,8 +17,9 @@
 //!   navigation processor emits ([`Captured`], taken by [`Tap`]).
 //!
 //! Not in this part: the code NCO driven from the predicted range (the code loop stays
-//! carrier-aided), long coherent integration with data-bit wipe-off, the INS error states
-//! (`--tracking vector` with `--ins` is refused), re-acquisition from the filter's prediction.
+//! carrier-aided), long coherent integration with data-bit wipe-off, INS error states (with
+//! `--ins` the INS's motion drives the prediction, its velocity error a random walk), the
+//! filter at the discriminator rate.
 
 mod dynamics;
 pub mod ekf;
