@@ -23,6 +23,7 @@
 //! anywhere in the period: one chance in 1023 to fall within it.
 
 use super::feed::{code_phase_chips, Snapshot, CHECKED_S};
+use crate::pipeline::timing::modulo::nearest_remainder;
 use crate::pipeline::timing::predicted;
 use gpsrx_core::constants::CA_CODE_LENGTH;
 use gpsrx_tracking::{ChannelEpoch, ChannelState};
@@ -92,9 +93,7 @@ impl Vouchers {
 
 /// Distance of two code phases modulo the C/A period, chips in `[0, 511.5]`.
 pub fn code_distance_chips(a: f64, b: f64) -> f64 {
-    let n = CA_CODE_LENGTH as f64;
-    let d = (a - b).rem_euclid(n);
-    d.min(n - d)
+    nearest_remainder(a - b, CA_CODE_LENGTH as f64).abs()
 }
 
 #[cfg(test)]
