@@ -227,8 +227,13 @@ if __name__ == "__main__" and sys.argv[1] == "gpssim-weak":
     base = os.environ.get("VEC_WORK", "/tmp/vec")
     src = os.path.join(ROOT, "../shared/data/gpssim-static-seoul-2p6msps.ci8.zst")
     raw, weak = f"{base}/gpssim.ci8", f"{base}/gpssim-weak-{db}.ci8"
+    if not os.path.exists(src):
+        sys.exit(f"vector-compare.py gpssim-weak: {src} not found (the shared GPS-SDR-SIM recording)")
     if not os.path.exists(raw):
-        subprocess.run(["zstd", "-q", "-d", "-f", "-o", raw, src], check=True)
+        try:
+            subprocess.run(["zstd", "-q", "-d", "-f", "-o", raw, src], check=True)
+        except (OSError, subprocess.CalledProcessError) as e:
+            sys.exit(f"vector-compare.py gpssim-weak: cannot decompress {src} with zstd ({e}): install zstd")
     if not os.path.exists(weak):
         subprocess.run([sys.executable, os.path.join(ROOT, "scripts/tools/weaken.py"), raw, weak, "--db", db], check=True, capture_output=True)
     for mode in ("scalar", "vector"):
