@@ -18,6 +18,7 @@ of samples at 22 s (inside the turn) and scores scalar and vector with the INS;
 `gpssim-weak [DB]` weakens the GPS-SDR-SIM recording of ../shared/data by DB (default 12) with
 scripts/tools/weaken.py and scores scalar and vector (with --nav) against its truth position:
 valid fixes, mean satellites in them, horizontal RMS, over all fixes and from 15 s.
+VEC_EXTRA adds arguments to every `gpsrx run` (e.g. `--config my.toml`).
 """
 import csv, json, math, subprocess, sys, os
 
@@ -50,7 +51,8 @@ def truth_at(tr, tow):
 
 def run(sim, mode, out, extra=()):
     cmd = [GPSRX, "run", f"{sim}/signal.sigmf-meta", "--nav", NAV, "--allow-unhealthy",
-           "--tracking", mode, "--out", out, "--json", "--no-plots", *extra]
+           "--tracking", mode, "--out", out, "--json", "--no-plots", *extra,
+           *os.environ.get("VEC_EXTRA", "").split()]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         print(r.stderr[-2000:]); sys.exit(1)
@@ -239,7 +241,8 @@ if __name__ == "__main__" and sys.argv[1] == "gpssim-weak":
     for mode in ("scalar", "vector"):
         out = f"{base}/gpssim-weak-{db}-{mode}"
         cmd = [GPSRX, "run", weak, "--format", "ci8", "--fs", "2.6e6", "--tropo", "none", "--nav", NAV,
-               "--allow-unhealthy", "--tracking", mode, "--out", out, "--json", "--no-plots"]
+               "--allow-unhealthy", "--tracking", mode, "--out", out, "--json", "--no-plots",
+               *os.environ.get("VEC_EXTRA", "").split()]
         r = subprocess.run(cmd, capture_output=True, text=True)
         if r.returncode != 0:
             print(r.stderr[-2000:]); sys.exit(1)

@@ -9,7 +9,10 @@ Usage: gpsrx simulate samples/scenarios/vector-threshold-fade.toml -o SIM
 GPSRX (default target/ci/gpsrx) and NAV (default ../shared/data/brdc0010.22n, else the copy in
 samples/data) name the binary and the navigation file. Prints, per mode, every satellite's
 threshold, their median and how many were used until the end, and the median gain of vector
-over scalar; exits 1 if a run fails.
+over scalar; then, so that a threshold counts only right observables, the errors of those taken
+below 23 dB-Hz (true) against truth_sv.csv, their common part at each epoch removed (the
+receiver clock): pseudorange RMS and largest, Doppler RMS, and carrier-phase slips (an
+epoch-to-epoch phase change 0.35 cycle or more off the truth's). Exits 1 if a run fails.
 """
 import csv
 import os
@@ -57,6 +60,64 @@ def last_observed(rinex):
     return last
 
 
+def read_observables(rinex):
+    """[(GPS time of week, {prn: (C1C, L1C, D1C)})] from a RINEX 3 observation file."""
+    import datetime
+    gps0 = datetime.datetime(1980, 1, 6)
+    epochs, header = [], True
+    for line in open(rinex):
+        if header:
+            header = "END OF HEADER" not in line
+            continue
+        if line.startswith(">"):
+            f = line[1:].split()
+            dt = datetime.datetime(int(f[0]), int(f[1]), int(f[2]), int(f[3]), int(f[4]))
+            epochs.append((((dt - gps0).total_seconds() + float(f[5])) % 604800.0, {}))
+        elif line.startswith("G") and epochs:
+            cells = [line[3 + 16 * i: 3 + 16 * i + 14].strip() for i in range(3)]
+            epochs[-1][1][int(line[1:3])] = tuple(float(c) if c else None for c in cells)
+    return epochs
+
+
+def weak_quality(sim, rinex, below_dbhz=23.0):
+    """Errors of the observables taken below `below_dbhz` (true C/N0), the common part of
+    each epoch removed: (count, pseudorange RMS m, pseudorange max m, Doppler RMS Hz, slips)."""
+    truth = {}
+    for r in csv.DictReader(open(f"{sim}/truth_sv.csv")):
+        truth[(round(float(r["t_s"]), 1), int(r["prn"]))] = (
+            float(r["pseudorange_m"]), float(r["carrier_phase_cycles"]), float(r["doppler_hz"]),
+            float(r["cn0_dbhz"]))
+    rows = list(csv.DictReader(open(f"{sim}/truth.csv")))
+    t0 = float(rows[0]["tow_s"]) - float(rows[0]["t_s"])
+    pr, dop, slips, prev = [], [], 0, {}
+    for tow, obs in read_observables(rinex):
+        t = round(tow - t0, 1)
+        sats = {p: (o, truth[(t, p)]) for p, o in obs.items()
+                if (t, p) in truth and None not in o}
+        if len(sats) < 4:
+            prev = {}
+            continue
+        e_pr = {p: o[0] - tr[0] for p, (o, tr) in sats.items()}
+        e_dop = {p: o[2] - tr[2] for p, (o, tr) in sats.items()}
+        m_pr, m_dop = statistics.median(e_pr.values()), statistics.median(e_dop.values())
+        # Phase change against the truth's (the RINEX phase has the opposite sign of a
+        # range-rate phase); its common part removed too.
+        d_ph = {p: (o[1] - prev[p][0]) + (tr[1] - prev[p][1]) for p, (o, tr) in sats.items()
+                if p in prev}
+        m_ph = statistics.median(d_ph.values()) if len(d_ph) >= 4 else None
+        for p, (o, tr) in sats.items():
+            if tr[3] < below_dbhz:
+                pr.append(e_pr[p] - m_pr)
+                dop.append(e_dop[p] - m_dop)
+                if m_ph is not None and p in d_ph and abs(d_ph[p] - m_ph) >= 0.35:
+                    slips += 1
+        prev = {p: (o[1], tr[1]) for p, (o, tr) in sats.items()}
+    if not pr:
+        return None
+    rms = lambda v: (sum(x * x for x in v) / len(v)) ** 0.5
+    return len(pr), rms(pr), max(map(abs, pr)), rms(dop), slips
+
+
 def thresholds(sim, out, extra, mode):
     """Per PRN the stream time of its last observables (None: to the end of the recording),
     and the recording's length."""
@@ -85,7 +146,7 @@ def main():
     out_dir = args[1] if len(args) > 1 else "/tmp/vector-threshold"
     os.makedirs(out_dir, exist_ok=True)
     truth = truth_cn0(sim)
-    medians = {}
+    medians, modes_last = {}, {}
     for mode in ("scalar", "vector"):
         last, end_t = thresholds(sim, f"{out_dir}/{mode}", extra, mode)
         per = {}
@@ -100,6 +161,16 @@ def main():
         medians[mode] = med
         print(f"{mode}: thresholds (true C/N0 at each satellite's last observables, dB-Hz): {cells}; "
               f"median {med:.1f} dB-Hz; used to the end: {to_end}")
+        q = weak_quality(sim, f"{out_dir}/{mode}/observables.rnx")
+        if q:
+            print(f"  {q[0]} observables below 23 dB-Hz: pseudorange error RMS {q[1]:.1f} m (max {q[2]:.1f}), "
+                  f"Doppler error RMS {q[3]:.2f} Hz, carrier-phase slips {q[4]}")
+        modes_last[mode] = per
+    gains = [modes_last["scalar"][p] - modes_last["vector"][p]
+             for p in modes_last["scalar"] if p in modes_last["vector"]]
+    if gains:
+        print(f"per satellite gain of vector over scalar: {min(gains):.1f} to {max(gains):.1f} dB, "
+              f"{sum(g >= 3.0 for g in gains)} of {len(gains)} at least 3 dB")
     print(f"median threshold gain of vector over scalar: {medians['scalar'] - medians['vector']:.1f} dB")
 
 

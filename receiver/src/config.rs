@@ -315,7 +315,7 @@ impl ReceiverConfig {
         let vector_lost = self.tracking.vector_cn0_lost_dbhz;
         if !(lo..=hi).contains(&vector_lost) {
             return Err(ConfigError::Invalid(format!(
-                "[tracking] vector_cn0_lost_dbhz = {vector_lost}: use {lo} to {hi} dB-Hz (the C/N0 below which a channel the vector filter checks counts as lost; default 22)"
+                "[tracking] vector_cn0_lost_dbhz = {vector_lost}: use {lo} to {hi} dB-Hz (the C/N0 below which a channel the vector filter checks counts as lost; default 19)"
             )));
         }
         self.run.validate()?;

@@ -124,8 +124,12 @@ fn fade(md: &mut String, results: &[(Case, CaseResult)], test: &Test) {
             );
         }
     }
-    md.push_str(
-        " On a static receiver an INS has no dynamics to take out of the loops; what lowers the vector threshold is the filter's check, which lets a checked channel count as lost only at 22 dB-Hz, and the narrower loops its prediction allows.\n",
+    let tracking = gpsrx_receiver::ReceiverConfig::default().tracking;
+    let _ = writeln!(
+        md,
+        " On a static receiver an INS has no dynamics to take out of the loops; what lowers the vector threshold is the filter's check, which lets a checked channel count as lost only below {} dB-Hz (an unchecked one below {} dB-Hz), and the narrower loops its prediction allows.",
+        fmt(tracking.vector_cn0_lost_dbhz, 0),
+        fmt(tracking.cn0_lost_dbhz, 0)
     );
 }
 

@@ -7,7 +7,8 @@
 //! The channel goes to [`ChannelState::Recover`]: **code-only tracking**. Its DLL keeps the
 //! code (carrier-aided by an NCO that is off by hertz at most, 0.001 chip/s per Hz), its
 //! bit synchronisation stays, its measurements are marked unlocked and never feed a fix, and
-//! the carrier is pulled in again from the frequency memory:
+//! the carrier is pulled in again from the frequency memory (from the feed-forward alone when
+//! the navigation filter of vector tracking checks the channel, `DopplerAid::checked`):
 //!
 //! - at a C/N0 of at least the weak pull-in's [`WeakPullInConfig::enter_dbhz`](super::WeakPullInConfig::enter_dbhz)
 //!   (or without a weak pull-in) with the wide, FLL-assisted pull-in loops
@@ -26,6 +27,15 @@ use crate::carrier_loop::CarrierLoop;
 use crate::channel::weak_pull_in::WeakStage;
 use num_complex::Complex64;
 
+/// Time without phase lock after which a channel the navigation filter checks
+/// ([`crate::aiding::DopplerAid::checked`]) goes to recovery, s, when
+/// [`super::ChannelConfig::relock_after_s`] is longer. Out of lock, a narrow 3rd-order loop
+/// wanders on noise (a 25 dB-Hz channel: 5 Hz off within 0.6 s, 10 Hz within 1.5 s, never
+/// back by itself); a checked channel's recovery starts at the feed-forward, which is right to
+/// a fraction of a hertz, and locks again within about a second. Measured at 25 dB-Hz
+/// (receiver test `vector_tracking_uses_satellites_below_the_scalar_loss_threshold...`).
+pub const CHECKED_RELOCK_AFTER_S: f64 = 0.5;
+
 impl Channel {
     /// Per integration interval in tracking or recovery: counts the time without phase lock
     /// (from the interval's length `dur_ms`), starts a recovery after
@@ -43,8 +53,13 @@ impl Channel {
                     return; // the aid holds the signal's place (`Channel::coasting_on_aid`)
                 }
                 self.unlocked_ms += dur_ms;
-                let limit_ms = (self.cfg.relock_after_s * 1e3).round() as u64;
-                if self.cfg.relock_after_s > 0.0 && self.unlocked_ms >= limit_ms {
+                let relock_after_s = if self.checked_aid() {
+                    self.cfg.relock_after_s.min(CHECKED_RELOCK_AFTER_S)
+                } else {
+                    self.cfg.relock_after_s
+                };
+                let limit_ms = (relock_after_s * 1e3).round() as u64;
+                if relock_after_s > 0.0 && self.unlocked_ms >= limit_ms {
                     self.start_recovery();
                 }
             }
@@ -60,6 +75,14 @@ impl Channel {
     /// at the running loop's frequency memory; the code loop, the bit synchronisation and the
     /// C/N0 estimate carry on.
     fn start_recovery(&mut self) {
+        if self.checked_aid() {
+            // The navigation filter checks this satellite: its Doppler is the feed-forward's
+            // to a fraction of a hertz, and what the loop holds beyond it is what the loop
+            // wandered off on noise while out of lock (a 25 dB-Hz channel: 5 Hz within
+            // 0.6 s). The pull-in starts at the feed-forward.
+            self.carrier
+                .shift_base_hz(-self.carrier.frequency_memory_hz());
+        }
         let f = self.carrier.frequency_memory_hz();
         let weak = self
             .cfg
@@ -593,5 +616,71 @@ mod tests {
         let _ = run(&mut strong, &mut strong_sig, 4.0);
         let rate = strong.los_rate_hz_s().expect("rate of a strong channel");
         assert!(rate.abs() < 2.0, "{rate} Hz/s on a static signal");
+    }
+
+    /// A channel the navigation filter checks (`DopplerAid::checked`, the aid at the signal's
+    /// Doppler) whose signal goes: it goes to recovery 0.5 s after its lock
+    /// ([`super::CHECKED_RELOCK_AFTER_S`]), not after `relock_after_s` (2 s), and its pull-in
+    /// starts at the feed-forward, not where its loop wandered on the noise. Unchecked, the
+    /// same aid changes neither.
+    #[test]
+    fn a_checked_channel_out_of_lock_recovers_soon_at_the_feed_forward() {
+        let aid = |checked| crate::aiding::DopplerAid {
+            doppler_hz: DOPPLER_HZ,
+            doppler_rate_hz_s: 0.0,
+            coast: false,
+            checked,
+            source: crate::aiding::AidSource::Vector,
+        };
+        let run_with = |checked: bool| {
+            let mut sig = Signal {
+                code: CaCode::new(Prn::new(7).expect("PRN")),
+                step_s: f64::INFINITY,
+                step_hz: 0.0,
+                off_s: 3.0,
+                cut: (f64::INFINITY, 0.0),
+                zeros: (f64::INFINITY, 0.0),
+                cn0_dbhz: 40.0,
+                rng: SimRng::new(5),
+            };
+            let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
+            ch.set_aid(Some(aid(checked)), 0.0);
+            let eps = run(&mut ch, &mut sig, 5.5);
+            let unlocked = eps
+                .iter()
+                .find(|e| e.0 > 3.0 && e.1 == ChannelState::Track && !e.2)
+                .copied()
+                .expect("lock lost");
+            // The report that starts the recovery carries the slipped loop's frequency; the
+            // next one the pull-in's first.
+            let recovery = eps
+                .iter()
+                .filter(|e| e.1 == ChannelState::Recover)
+                .nth(1)
+                .copied();
+            (unlocked, recovery)
+        };
+        let (unlocked, recovery) = run_with(true);
+        let recovery = recovery.expect("no recovery");
+        assert!(
+            recovery.0 - unlocked.0 <= 0.6,
+            "lock lost at {:.2} s, recovery at {:.2} s",
+            unlocked.0,
+            recovery.0
+        );
+        assert!(
+            (recovery.3 - DOPPLER_HZ).abs() < 1.0,
+            "recovery starts at {:.2} Hz, the aid is at {DOPPLER_HZ} Hz",
+            recovery.3
+        );
+        let (unlocked, recovery) = run_with(false);
+        if let Some(r) = recovery {
+            assert!(
+                r.0 - unlocked.0 >= 1.9,
+                "unchecked: lock lost at {:.2} s, recovery at {:.2} s",
+                unlocked.0,
+                r.0
+            );
+        }
     }
 }

@@ -19,7 +19,7 @@
 //! The tolerance, half a chip (147 m), is the DLL's own pull-in range; what the prediction
 //! leaves out or gets wrong stays well inside it: the ionosphere and troposphere (2-50 m,
 //! their mean in the filter's clock bias), the filter's position (metres), and the code
-//! noise at 22 dB-Hz (0.1 chip). A cross-correlation peak or a false acquisition lies
+//! noise at 19 dB-Hz (under 0.1 chip). A cross-correlation peak or a false acquisition lies
 //! anywhere in the period: one chance in 1023 to fall within it.
 
 use super::feed::{code_phase_chips, Snapshot, CHECKED_S};
