@@ -152,6 +152,16 @@ if zstd -q -d -o "$SEOUL" "$DATA/gpssim-static-seoul-2p6msps.ci8.zst"; then
     if rnx2rtkp -k "$WORK/spp.conf" -o "$WORK/rtk.pos" "$WORK/seoul/observables.rnx" "$DATA/brdc0010.22n" >/dev/null 2>&1 \
       && python3 scripts/tools/pos_error.py "$WORK/rtk.pos" 37.5665 126.9780 40.0 --max-mean-m 1.0
     then ok "RTKLIB single point on our observables.rnx: mean position within 1 m of the truth"; else bad "RTKLIB on our observables.rnx"; fi
+    # Issue 29: vector tracking marks where it takes the channels in observables.rnx (an event
+    # record with flag 4 and COMMENT lines); RTKLIB reads the file through it.
+    if "$GPSRX" run "$SEOUL" --format ci8 --fs 2.6e6 --tropo none --allow-unhealthy --nav "$DATA/brdc0010.22n" \
+        --tracking vector --no-plots --out "$WORK/seoul-vector" >/dev/null 2>"$WORK/seoul-vector.err" \
+      && grep -q "^>  *4  *[0-9]" "$WORK/seoul-vector/observables.rnx" \
+      && grep -q "^VECTOR TRACKING ON" "$WORK/seoul-vector/observables.rnx" \
+      && rnx2rtkp -k "$WORK/spp.conf" -o "$WORK/rtk-vector.pos" "$WORK/seoul-vector/observables.rnx" "$DATA/brdc0010.22n" >/dev/null 2>&1 \
+      && python3 scripts/tools/pos_error.py "$WORK/rtk-vector.pos" 37.5665 126.9780 40.0 --max-mean-m 1.0
+    then ok "vector tracking: its event record in observables.rnx, and RTKLIB single point on it within 1 m of the truth"
+    else bad "vector tracking's observables.rnx (event record, RTKLIB): $(tail -2 "$WORK/seoul-vector.err")"; fi
   else
     bad "gpsrx run on the GPS-SDR-SIM recording: $(tail -3 "$WORK/seoul.err")"
   fi

@@ -262,6 +262,11 @@ pub fn events<'py>(py: Python<'py>, events: &[ReceiverEvent]) -> PyResult<Vec<Bo
                     d.set_item("satellites", satellites)?;
                     d.set_item("time_correction_s", time_correction_s)?;
                 }
+                ReceiverEvent::VectorTracking { t_s, engaged } => {
+                    d.set_item("kind", "vector_tracking")?;
+                    d.set_item("t_s", t_s)?;
+                    d.set_item("engaged", engaged)?;
+                }
                 ReceiverEvent::CoarseTimeDropped { t_s } => {
                     d.set_item("kind", "coarse_time_dropped")?;
                     d.set_item("t_s", t_s)?;

@@ -505,7 +505,23 @@ fn vector_tracking_uses_satellites_below_the_scalar_loss_threshold_from_its_pred
         sink
     };
     let (scalar, scalar_h) = usage_after(&sim, &run(TrackingMode::Scalar), &weak, 8.0);
-    let (vector, vector_h) = usage_after(&sim, &run(TrackingMode::Vector), &weak, 8.0);
+    let vector_sink = run(TrackingMode::Vector);
+    let (vector, vector_h) = usage_after(&sim, &vector_sink, &weak, 8.0);
+    // The filter took the channels once (the event observables.rnx marks) and kept them.
+    let switches: Vec<(f64, bool)> = vector_sink
+        .events
+        .iter()
+        .filter_map(|e| match *e {
+            gpsrx_receiver::pipeline::ReceiverEvent::VectorTracking { t_s, engaged } => {
+                Some((t_s, engaged))
+            }
+            _ => None,
+        })
+        .collect();
+    assert!(
+        switches.len() == 1 && switches[0].1 && switches[0].0 < 6.0,
+        "{switches:?}"
+    );
     eprintln!(
         "G03 G16 G22 (first used s, share of the valid fixes from 8 s): scalar {scalar:.2?} (H max {scalar_h:.1} m), vector {vector:.2?} (H max {vector_h:.1} m)"
     );

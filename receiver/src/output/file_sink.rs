@@ -16,7 +16,9 @@ use crate::output::{
     ChannelRow, Fix, NavHeader, NavRecord, NmeaOptions, NmeaWriter, ObsEpoch, ObsHeader,
     OutputError, PvtCsvWriter, RinexObsWriter,
 };
-use crate::pipeline::sink::{FixReport, NavigationEnd, ObservablesReport, Sink, SinkError};
+use crate::pipeline::sink::{
+    FixReport, NavigationEnd, ObservablesReport, ReceiverEvent, Sink, SinkError,
+};
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
@@ -41,6 +43,8 @@ pub struct FileSink {
     obs_dropped: usize,
     /// Observable epochs left out because their time was not after the last one written.
     obs_not_after: usize,
+    /// `COMMENT` lines for observables.rnx that came before it was opened (its header's).
+    obs_comments: Vec<String>,
     fixes: Vec<Fix>,
     /// What the plots need, when they are drawn.
     plots: Option<RunPlotData>,
@@ -71,6 +75,7 @@ impl FileSink {
             obs_week_known: false,
             obs_dropped: 0,
             obs_not_after: 0,
+            obs_comments: Vec::new(),
             fixes: Vec::new(),
             plots: None,
         })
@@ -107,6 +112,7 @@ impl FileSink {
             approx_position_m: approx_position_m.unwrap_or_default(),
             interval_s: Some(1.0 / self.rate_hz),
             leap_seconds: Some(gpsrx_nav::utc::leap_seconds_on(year, month)),
+            comments: std::mem::take(&mut self.obs_comments),
             ..ObsHeader::default()
         };
         if self.obs_dropped > 0 {
@@ -197,6 +203,34 @@ impl Sink for FileSink {
                     );
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// Vector tracking taking the channels or giving them back is marked in observables.rnx
+    /// (an event record with `COMMENT` lines, [`RinexObsWriter::write_comments`]; in its
+    /// header when it comes before the file is opened): the observables after it come from
+    /// other loops, and weak ones from channels only the navigation filter's check keeps.
+    fn event(&mut self, event: &ReceiverEvent) -> Result<(), SinkError> {
+        let ReceiverEvent::VectorTracking { t_s, engaged } = *event else {
+            return Ok(());
+        };
+        let lines: Vec<String> = if engaged {
+            vec![
+                format!("VECTOR TRACKING ON (STREAM TIME {t_s:.2} S): CARRIER NCOS"),
+                "FOLLOW THE NAVIGATION FILTER'S PREDICTED DOPPLER; WEAK".into(),
+                "CHANNELS IT CHECKS ARE KEPT BELOW THE SCALAR LOSS".into(),
+                "THRESHOLD (S1C GIVES THEIR C/N0, HENCE THEIR NOISE)".into(),
+            ]
+        } else {
+            vec![
+                format!("VECTOR TRACKING OFF (STREAM TIME {t_s:.2} S): EACH"),
+                "CHANNEL TRACKS ON ITS OWN LOOPS AGAIN".into(),
+            ]
+        };
+        match &mut self.obs_writer {
+            Some(w) => w.write_comments(&lines)?,
+            None => self.obs_comments.extend(lines),
         }
         Ok(())
     }

@@ -202,6 +202,38 @@ impl<W: Write> RinexObsWriter<W> {
         Ok(())
     }
 
+    /// Writes `comments` as `COMMENT` lines of an event record with flag 4 ("header
+    /// information follows", RINEX 3.04 Table A3; its epoch left blank, as flags 2-5 allow)
+    /// between the last epoch written and the next: they apply from there on. Before the first
+    /// epoch they join the header's comments instead. Each line is cut to 60 characters.
+    pub fn write_comments(&mut self, comments: &[String]) -> Result<(), OutputError> {
+        if comments.is_empty() {
+            return Ok(());
+        }
+        if self.last_time.is_none() {
+            self.header.comments.extend(comments.iter().cloned());
+            return Ok(());
+        }
+        if comments.len() > 999 {
+            return Err(OutputError::invalid(
+                &self.file,
+                format!(
+                    "{} comment lines in one event (at most 999)",
+                    comments.len()
+                ),
+            ));
+        }
+        // `>`, the blank epoch (columns 2-31), the flag (32) and the number of records (33-35).
+        let mut text = format!(">{:30}4{:3}\n", "", comments.len());
+        for c in comments {
+            text.push_str(&fit_ascii(c, 60));
+            text.push_str("COMMENT\n");
+        }
+        self.out
+            .write_all(text.as_bytes())
+            .map_err(OutputError::io(&self.file))
+    }
+
     /// The time of the last epoch written, if any.
     pub fn last_epoch_time(&self) -> Option<GpsTime> {
         self.last_time
@@ -457,6 +489,43 @@ mod tests {
         }
         let bytes = w.finish()?;
         Ok(String::from_utf8_lossy(&bytes).into_owned())
+    }
+
+    /// A comment between epochs is an event record with flag 4 and its number of lines in
+    /// RINEX 3.04's columns (those RTKLIB reads: flag at 32, count at 33-35); before the first
+    /// epoch it joins the header.
+    #[test]
+    fn comments_between_epochs_are_a_flag_4_event() -> Result<(), OutputError> {
+        let mut w = RinexObsWriter::new(Vec::new(), "test.rnx", header());
+        w.write_comments(&["BEFORE THE FIRST EPOCH".to_string()])?;
+        w.write_epoch(&epoch(538_200.0))?;
+        let lines = ["VECTOR TRACKING ON".to_string(), "x".repeat(70)];
+        w.write_comments(&lines)?;
+        w.write_epoch(&epoch(538_200.5))?;
+        let text = String::from_utf8_lossy(&w.finish()?).into_owned();
+        let all: Vec<&str> = text.lines().collect();
+        let end = all
+            .iter()
+            .position(|l| l.ends_with("END OF HEADER"))
+            .expect("header");
+        assert!(all[..end]
+            .iter()
+            .any(|l| l.starts_with("BEFORE THE FIRST EPOCH") && l.ends_with("COMMENT")));
+        let event = all
+            .iter()
+            .position(|l| l.starts_with('>') && l.get(31..32) == Some("4"))
+            .expect("event record");
+        assert_eq!(all[event].len(), 35, "{:?}", all[event]);
+        assert_eq!(all[event][1..31].trim(), "", "blank epoch");
+        assert_eq!(all[event][32..35].trim(), "2");
+        assert_eq!(
+            all[event + 1],
+            format!("{:60}COMMENT", "VECTOR TRACKING ON")
+        );
+        assert_eq!(all[event + 2], format!("{}COMMENT", "x".repeat(60)));
+        // Between the two epochs.
+        assert!(all[event - 1].starts_with("G12") && all[event + 3].starts_with("> 2022"));
+        Ok(())
     }
 
     #[test]

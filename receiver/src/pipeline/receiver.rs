@@ -778,6 +778,10 @@ impl Receiver {
             for (channel, prn, edge) in v.take_bit_edges() {
                 self.manager.assume_bit_edge(channel, prn, edge);
             }
+            for (t_s, engaged) in v.take_switches() {
+                sink.event(&ReceiverEvent::VectorTracking { t_s, engaged })
+                    .map_err(ReceiverError::Sink)?;
+            }
         }
         self.follow_bridge(end as f64 / self.fs_hz);
         match found {

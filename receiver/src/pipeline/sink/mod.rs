@@ -111,6 +111,14 @@ pub enum ReceiverEvent {
         /// Correction to the approximate time, s.
         time_correction_s: f64,
     },
+    /// Vector tracking took the channels (`engaged`: the navigation filter's prediction drives
+    /// their carrier NCOs from here on) or gave them back to their own loops.
+    VectorTracking {
+        /// Stream time, s.
+        t_s: f64,
+        /// Taken (true) or given back (false).
+        engaged: bool,
+    },
     /// The SV times of the coarse-time fix were dropped (a bit edge or a HOW disagreed, or the
     /// fixes failed the integrity test): the time comes from frame sync.
     CoarseTimeDropped {

@@ -188,6 +188,9 @@ pub struct VectorTracking {
     fix_prediction: Option<Snapshot>,
     /// Data-bit edges for the channels vouched for, not yet handed to them.
     bit_edges: Vec<(usize, u8, usize)>,
+    /// The filter taken (true) or given back (false) since the last call of
+    /// [`VectorTracking::take_switches`], at stream time s.
+    switches: Vec<(f64, bool)>,
     /// The satellites taken in from the prediction.
     take_in: TakeIn,
     /// `[run] elevation_mask_deg`.
@@ -252,6 +255,7 @@ impl VectorTracking {
             vouchers: Vouchers::default(),
             fix_prediction: None,
             bit_edges: Vec::new(),
+            switches: Vec::new(),
             take_in: TakeIn::default(),
             mask_deg: config.run.elevation_mask_deg,
             prns: config.run.prns.clone(),
@@ -341,6 +345,12 @@ impl VectorTracking {
     /// `Channel::assume_bit_edge`.
     pub fn take_bit_edges(&mut self) -> Vec<(usize, u8, usize)> {
         std::mem::take(&mut self.bit_edges)
+    }
+
+    /// When the filter took the channels (true) or gave them back (false) since the last
+    /// call: `(stream time s, engaged)`, for [`crate::pipeline::ReceiverEvent::VectorTracking`].
+    pub fn take_switches(&mut self) -> Vec<(f64, bool)> {
+        std::mem::take(&mut self.switches)
     }
 
     /// The predicted SV time (TOW, s) of report `e`'s satellite at its first sample, for a
@@ -446,6 +456,7 @@ impl VectorTracking {
         self.take_in.clear();
         self.unhealthy_in_row = 0;
         self.summary.engagements += 1;
+        self.switches.push((t_stream_s, true));
         self.publish(epoch, t_stream_s, nav);
     }
 
@@ -454,6 +465,7 @@ impl VectorTracking {
         if self.filter.take().is_some() {
             tracing::info!("{t_stream_s:.2} s: vector tracking off ({why}): the channels track alone until the next valid fix");
             self.summary.disengagements += 1;
+            self.switches.push((t_stream_s, false));
         }
         self.port.snapshot = None;
         self.last = None;
