@@ -48,9 +48,10 @@ pub struct RunArgs {
     pub profile: bool,
     /// Who drives the channels: `scalar` (each channel's own loops) or `vector` (after the
     /// first valid fix a navigation filter predicts every satellite's Doppler and feeds it
-    /// forward into the carrier NCOs; back to scalar when its health test fails). Not with
-    /// `--ins` yet. Config file: `[tracking] mode`; `[vector]` tunes the filter
-    /// [default: scalar].
+    /// forward into the carrier NCOs; back to scalar when its health test fails; a channel it
+    /// checks is kept down to `vector_cn0_lost_dbhz`, 19 dB-Hz). With `--ins` the INS's motion
+    /// drives the prediction between updates. Config file: `[tracking] mode`; `[vector]` tunes
+    /// the filter [default: scalar].
     #[arg(long, value_name = "MODE")]
     pub tracking: Option<gpsrx_tracking::TrackingMode>,
     /// RINEX 2/3 navigation file: ephemerides before (or instead of) decoding them.
