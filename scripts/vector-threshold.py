@@ -40,36 +40,24 @@ def cn0_at(series, t):
     return best[1]
 
 
-def last_observed(rinex):
-    """Per PRN: the GPS time of week of its last epoch in a RINEX 3 observation file."""
-    import datetime
-    gps0 = datetime.datetime(1980, 1, 6)
-    last, tow = {}, None
-    header = True
-    for line in open(rinex):
-        if header:
-            header = "END OF HEADER" not in line
-            continue
-        if line.startswith(">"):
-            f = line[1:].split()
-            sec = float(f[5])
-            dt = datetime.datetime(int(f[0]), int(f[1]), int(f[2]), int(f[3]), int(f[4]))
-            tow = ((dt - gps0).total_seconds() + sec) % 604800.0
-        elif line.startswith("G") and tow is not None:
-            last[int(line[1:3])] = tow
-    return last
-
-
 def read_observables(rinex):
-    """[(GPS time of week, {prn: (C1C, L1C, D1C)})] from a RINEX 3 observation file."""
+    """[(GPS time of week, {prn: (C1C, L1C, D1C)})] from a RINEX 3 observation file; event
+    records (flags 2-5, e.g. where vector tracking takes the channels) and the lines they
+    announce are skipped."""
     import datetime
     gps0 = datetime.datetime(1980, 1, 6)
-    epochs, header = [], True
+    epochs, header, skip = [], True, 0
     for line in open(rinex):
         if header:
             header = "END OF HEADER" not in line
             continue
+        if skip:
+            skip -= 1
+            continue
         if line.startswith(">"):
+            if line[31:32] not in ("0", "1"):
+                skip = int(line[32:35])
+                continue
             f = line[1:].split()
             dt = datetime.datetime(int(f[0]), int(f[1]), int(f[2]), int(f[3]), int(f[4]))
             epochs.append((((dt - gps0).total_seconds() + float(f[5])) % 604800.0, {}))
@@ -77,6 +65,15 @@ def read_observables(rinex):
             cells = [line[3 + 16 * i: 3 + 16 * i + 14].strip() for i in range(3)]
             epochs[-1][1][int(line[1:3])] = tuple(float(c) if c else None for c in cells)
     return epochs
+
+
+def last_observed(rinex):
+    """Per PRN: the GPS time of week of its last epoch in a RINEX 3 observation file."""
+    last = {}
+    for tow, obs in read_observables(rinex):
+        for prn in obs:
+            last[prn] = tow
+    return last
 
 
 def weak_quality(sim, rinex, below_dbhz=23.0):

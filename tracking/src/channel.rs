@@ -504,6 +504,8 @@ pub struct Channel {
     /// `(t_c, f, rate)` (negated when it went) the phase fit's samples are to be measured
     /// against from then on ([`QuadraticPhaseFit::subtract_trajectory`]).
     aid_switched: Option<(f64, f64, f64)>,
+    /// The last step of a vector aid, fading (`Channel::aid_blend_hz`): (receive time s, Hz).
+    aid_blend: Option<(f64, f64)>,
     /// The stage of a weak-signal pull-in (`None`: the normal pull-in, or after the hand-over).
     weak_stage: Option<WeakStage>,
     /// The weak pull-in's C/N0 estimator before bit synchronisation (NWPR over unaligned
@@ -591,6 +593,7 @@ impl Channel {
             phase_fit: QuadraticPhaseFit::new(),
             ff_phase_cycles: 0.0,
             aid_switched: None,
+            aid_blend: None,
             pending_bit: None,
             weak_stage: weak_pull_in.map(|_| WeakStage::Frequency),
             presync_cn0: SmoothedNwpr::new(
@@ -695,11 +698,42 @@ impl Channel {
     /// forward from the next integration interval on: the NCO gets its mean over that interval,
     /// extrapolated with its rate. `None` removes the aid. Switching the aid on or off keeps the
     /// NCO frequency continuous (the loop's base frequency takes up the difference).
+    ///
+    /// A vector aid's steps (each filter update moves its prediction: 0.1-0.4 Hz on a static
+    /// 25 dB-Hz satellite) are not passed on as steps: the feed-forward moves from the old
+    /// prediction to the new one with the time constant [`VECTOR_AID_BLEND_S`]
+    /// ([`Channel::aid_blend_hz`]).
     pub fn set_aid(&mut self, aid: Option<DopplerAid>, t_s: f64) {
         if aid.is_some_and(|a| a.doppler_rate_hz_s.abs() > AID_MANOEUVRE_HZ_S) {
             self.aid_manoeuvre_until_s = t_s + AID_MANOEUVRE_HOLD_S;
         }
+        let t_next = self.next_sample as f64 / self.fs_hz;
+        let vector = |a: &DopplerAid| a.source == crate::aiding::AidSource::Vector;
+        self.aid_blend = match (self.aid, aid) {
+            (Some((old, t_old)), Some(new))
+                if vector(&old) && vector(&new) && self.ff_applied_hz.is_some() =>
+            {
+                // What the NCO would get at the next sample, from the old aid and from the
+                // new one: the difference fades from there.
+                let old_hz = old.doppler_hz
+                    + old.doppler_rate_hz_s * (t_next - t_old)
+                    + self.aid_blend_hz(t_next);
+                let new_hz = new.doppler_hz + new.doppler_rate_hz_s * (t_next - t_s);
+                Some((t_next, old_hz - new_hz)).filter(|(_, d)| d.is_finite())
+            }
+            _ => None,
+        };
         self.aid = aid.map(|a| (a, t_s));
+    }
+
+    /// The part of a vector aid's last step not yet passed on at receive time `t_s`, Hz:
+    /// `d (1 - (t - t0) / tau)` from the step `d` at `t0` over [`VECTOR_AID_BLEND_S`] (renewed
+    /// with every code period's aid, so a step fades about exponentially with that time
+    /// constant).
+    fn aid_blend_hz(&self, t_s: f64) -> f64 {
+        self.aid_blend.map_or(0.0, |(t0, d)| {
+            d * (1.0 - (t_s - t0) / VECTOR_AID_BLEND_S).clamp(0.0, 1.0)
+        })
     }
 
     /// The aid predicts a manoeuvre: its Doppler rate was above [`AID_MANOEUVRE_HZ_S`] within
@@ -712,7 +746,9 @@ impl Channel {
     fn feedforward_hz(&self, t_coh_s: f64) -> Option<f64> {
         self.aid.map(|(a, t_aid)| {
             let t_next = self.next_sample as f64 / self.fs_hz;
-            a.doppler_hz + a.doppler_rate_hz_s * (t_next - t_aid + 0.5 * t_coh_s)
+            a.doppler_hz
+                + a.doppler_rate_hz_s * (t_next - t_aid + 0.5 * t_coh_s)
+                + self.aid_blend_hz(t_next + 0.5 * t_coh_s)
         })
     }
 
@@ -1477,6 +1513,12 @@ pub const COAST_BELOW_LOST_DB: f64 = 6.0;
 /// its 0.3-0.9 Hz swings in a 10 g turn with an INS (31-32 dB-Hz satellites: 0.36 of the turn
 /// locked); the weak-signal loops (6 Hz) held them.
 pub const AID_MANOEUVRE_HZ_S: f64 = 5.0;
+
+/// Time constant over which a vector aid's step (a filter update) reaches the carrier NCO, s:
+/// the filter's update interval. A 3 Hz 3rd-order loop (`wn` = 3.8 rad/s) answers a frequency
+/// step `df` with a transient phase error of about `2 pi df / wn` rad (0.3 Hz: 28 deg); spread
+/// over 0.1 s, the same change costs about a fifth of it.
+pub const VECTOR_AID_BLEND_S: f64 = 0.1;
 /// How long after its last rate above [`AID_MANOEUVRE_HZ_S`] an aid still counts as a
 /// manoeuvre's, s (the end of a turn swings as its start does).
 pub const AID_MANOEUVRE_HOLD_S: f64 = 2.0;

@@ -683,4 +683,69 @@ mod tests {
             );
         }
     }
+
+    /// A vector aid's step (a filter update) reaches the NCO over about
+    /// [`crate::channel::VECTOR_AID_BLEND_S`], not at once; an INS aid's at once.
+    #[test]
+    fn a_vector_aid_step_fades_in_and_an_ins_one_does_not() {
+        let feedforward = |source: crate::aiding::AidSource| {
+            let mut sig = Signal {
+                code: CaCode::new(Prn::new(7).expect("PRN")),
+                step_s: f64::INFINITY,
+                step_hz: 0.0,
+                off_s: f64::INFINITY,
+                cut: (f64::INFINITY, 0.0),
+                zeros: (f64::INFINITY, 0.0),
+                cn0_dbhz: 45.0,
+                rng: SimRng::new(9),
+            };
+            let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
+            let mut out = Vec::new();
+            loop {
+                let (first, n) = ch.next_span();
+                let t = first as f64 / FS;
+                if t > 2.6 {
+                    break;
+                }
+                // The aid steps by 0.5 Hz at 2 s (as at a filter update).
+                let doppler_hz = DOPPLER_HZ + if t >= 2.0 { 0.5 } else { 0.0 };
+                let aid = crate::aiding::DopplerAid {
+                    doppler_hz,
+                    doppler_rate_hz_s: 0.0,
+                    coast: false,
+                    checked: true,
+                    source,
+                };
+                ch.set_aid(Some(aid), t);
+                let x: Vec<Complex32> = (first..first + n as u64).map(|k| sig.sample(k)).collect();
+                // The aid reaches the NCO from the interval after the one it came in.
+                if let Some((e, f)) = ch
+                    .process_code_period(&x)
+                    .and_then(|e| Some((e.t_rx_s, e.feedforward_hz?)))
+                {
+                    out.push((e, f));
+                }
+            }
+            let at = |t0: f64| out.iter().find(|e| e.0 >= t0).expect("report").1;
+            (at(2.01), at(2.1), at(2.5))
+        };
+        let (first, t_01, t_05) = feedforward(crate::aiding::AidSource::Vector);
+        assert!(
+            (first - DOPPLER_HZ).abs() < 0.1,
+            "vector, 10 ms after: {first}"
+        );
+        assert!(
+            (t_01 - DOPPLER_HZ - 0.5 * (1.0 - (-1.0f64).exp())).abs() < 0.1,
+            "vector, 0.1 s after: {t_01}"
+        );
+        assert!(
+            (t_05 - DOPPLER_HZ - 0.5).abs() < 0.02,
+            "vector, 0.5 s after: {t_05}"
+        );
+        let (first, _, _) = feedforward(crate::aiding::AidSource::Ins);
+        assert!(
+            (first - DOPPLER_HZ - 0.5).abs() < 1e-9,
+            "INS, 10 ms after: {first}"
+        );
+    }
 }
