@@ -702,7 +702,7 @@ impl Channel {
     /// A vector aid's steps (each filter update moves its prediction: 0.1-0.4 Hz on a static
     /// 25 dB-Hz satellite) are not passed on as steps: the feed-forward moves from the old
     /// prediction to the new one with the time constant [`VECTOR_AID_BLEND_S`]
-    /// ([`Channel::aid_blend_hz`]).
+    /// (`Channel::aid_blend_hz`).
     pub fn set_aid(&mut self, aid: Option<DopplerAid>, t_s: f64) {
         if aid.is_some_and(|a| a.doppler_rate_hz_s.abs() > AID_MANOEUVRE_HZ_S) {
             self.aid_manoeuvre_until_s = t_s + AID_MANOEUVRE_HOLD_S;
