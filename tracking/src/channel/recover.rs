@@ -146,6 +146,20 @@ mod tests {
     }
 
     impl Signal {
+        /// PRN 7 at `cn0_dbhz`, steady: no Doppler step, cut, zeros or end.
+        fn steady(cn0_dbhz: f64, seed: u64) -> Self {
+            Signal {
+                code: CaCode::new(Prn::new(7).expect("PRN")),
+                step_s: f64::INFINITY,
+                step_hz: 0.0,
+                off_s: f64::INFINITY,
+                cut: (f64::INFINITY, 0.0),
+                zeros: (f64::INFINITY, 0.0),
+                cn0_dbhz,
+                rng: SimRng::new(seed),
+            }
+        }
+
         fn sample(&mut self, k: u64) -> Complex32 {
             let t = k as f64 / FS;
             if (self.zeros.0..self.zeros.0 + self.zeros.1).contains(&t) {
@@ -245,14 +259,9 @@ mod tests {
     #[test]
     fn a_slipped_narrow_loop_is_pulled_in_again() {
         let mut sig = Signal {
-            code: CaCode::new(Prn::new(7).expect("PRN")),
             step_s: 4.0,
             step_hz: 5.0,
-            off_s: f64::INFINITY,
-            cut: (f64::INFINITY, 0.0),
-            zeros: (f64::INFINITY, 0.0),
-            cn0_dbhz: 45.0,
-            rng: SimRng::new(11),
+            ..Signal::steady(45.0, 11)
         };
         let mut ch = Channel::new(&start(), FS, &narrow_config()).expect("channel");
         let eps = run(&mut ch, &mut sig, 9.0);
@@ -281,14 +290,9 @@ mod tests {
     #[test]
     fn a_weak_channel_recovers_through_the_weak_pull_in() {
         let mut sig = Signal {
-            code: CaCode::new(Prn::new(7).expect("PRN")),
             step_s: 6.0,
             step_hz: 5.0,
-            off_s: f64::INFINITY,
-            cut: (f64::INFINITY, 0.0),
-            zeros: (f64::INFINITY, 0.0),
-            cn0_dbhz: 31.0,
-            rng: SimRng::new(23),
+            ..Signal::steady(31.0, 23)
         };
         let cfg = ChannelConfig {
             weak_track: None,
@@ -341,14 +345,8 @@ mod tests {
     #[test]
     fn a_channel_that_cannot_recover_is_released() {
         let mut sig = Signal {
-            code: CaCode::new(Prn::new(7).expect("PRN")),
-            step_s: f64::INFINITY,
-            step_hz: 0.0,
             off_s: 2.0,
-            cut: (f64::INFINITY, 0.0),
-            zeros: (f64::INFINITY, 0.0),
-            cn0_dbhz: 45.0,
-            rng: SimRng::new(5),
+            ..Signal::steady(45.0, 5)
         };
         let cfg = ChannelConfig {
             cn0_lost_dbhz: -100.0,
@@ -379,14 +377,8 @@ mod tests {
     /// its data-bit edges move by 11 ms.
     fn cut_at_3_s(cn0_dbhz: f64, seed: u64) -> Signal {
         Signal {
-            code: CaCode::new(Prn::new(7).expect("PRN")),
-            step_s: f64::INFINITY,
-            step_hz: 0.0,
-            off_s: f64::INFINITY,
             cut: (3.0, 0.031),
-            zeros: (f64::INFINITY, 0.0),
-            cn0_dbhz,
-            rng: SimRng::new(seed),
+            ..Signal::steady(cn0_dbhz, seed)
         }
     }
 
@@ -396,9 +388,8 @@ mod tests {
     /// receiver is manoeuvring. Returns the reports of 3.95-5.0 s and the channel.
     fn one_second_of_zeros(dynamics: bool) -> (Vec<(f64, ChannelState, bool, f64)>, Channel) {
         let mut sig = Signal {
-            cut: (f64::INFINITY, 0.0),
             zeros: (3.0, 1.0),
-            ..cut_at_3_s(36.0, 41)
+            ..Signal::steady(36.0, 41)
         };
         let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
         ch.set_dynamics(dynamics);
@@ -449,9 +440,8 @@ mod tests {
     fn a_channel_coasting_on_a_feed_forward_is_not_released_for_the_outage() {
         let run_aided = |aided: bool| {
             let mut sig = Signal {
-                cut: (f64::INFINITY, 0.0),
                 zeros: (3.0, 1.2),
-                ..cut_at_3_s(30.0, 7)
+                ..Signal::steady(30.0, 7)
             };
             let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
             let mut last = None;
@@ -574,11 +564,7 @@ mod tests {
     /// read as the receiver's (weak loops), a strong channel's is, once settled.
     #[test]
     fn a_weak_channel_widens_its_loops_under_dynamics_and_narrows_after() {
-        let mut sig = Signal {
-            step_s: f64::INFINITY,
-            cut: (f64::INFINITY, 0.0),
-            ..cut_at_3_s(30.0, 29)
-        };
+        let mut sig = Signal::steady(30.0, 29);
         let weak_start = ChannelStart {
             cn0_dbhz: 30.0,
             ..start()
@@ -605,11 +591,7 @@ mod tests {
         );
         // A 40 dB-Hz channel on its 1 ms loops: its rate (a static signal: near 0) is read
         // once it has tracked for 2 s.
-        let mut strong_sig = Signal {
-            step_s: f64::INFINITY,
-            cut: (f64::INFINITY, 0.0),
-            ..cut_at_3_s(40.0, 31)
-        };
+        let mut strong_sig = Signal::steady(40.0, 31);
         let mut strong = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
         let _ = run(&mut strong, &mut strong_sig, 1.5);
         assert_eq!(strong.los_rate_hz_s(), None, "read before it settled");
@@ -634,14 +616,8 @@ mod tests {
         };
         let run_with = |checked: bool| {
             let mut sig = Signal {
-                code: CaCode::new(Prn::new(7).expect("PRN")),
-                step_s: f64::INFINITY,
-                step_hz: 0.0,
                 off_s: 3.0,
-                cut: (f64::INFINITY, 0.0),
-                zeros: (f64::INFINITY, 0.0),
-                cn0_dbhz: 40.0,
-                rng: SimRng::new(5),
+                ..Signal::steady(40.0, 5)
             };
             let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
             ch.set_aid(Some(aid(checked)), 0.0);
@@ -689,16 +665,7 @@ mod tests {
     #[test]
     fn a_vector_aid_step_fades_in_and_an_ins_one_does_not() {
         let feedforward = |source: crate::aiding::AidSource| {
-            let mut sig = Signal {
-                code: CaCode::new(Prn::new(7).expect("PRN")),
-                step_s: f64::INFINITY,
-                step_hz: 0.0,
-                off_s: f64::INFINITY,
-                cut: (f64::INFINITY, 0.0),
-                zeros: (f64::INFINITY, 0.0),
-                cn0_dbhz: 45.0,
-                rng: SimRng::new(9),
-            };
+            let mut sig = Signal::steady(45.0, 9);
             let mut ch = Channel::new(&start(), FS, &ChannelConfig::default()).expect("channel");
             let mut out = Vec::new();
             loop {
