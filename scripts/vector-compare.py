@@ -25,6 +25,7 @@ import csv, json, math, subprocess, sys, os
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GPSRX = os.environ.get("GPSRX", os.path.join(ROOT, "target/ci/gpsrx"))
 NAV = os.environ.get("NAV", os.path.join(ROOT, "../shared/data/brdc0010.22n"))
+EXTRA = os.environ.get("VEC_EXTRA", "").split()  # added to every `gpsrx run`
 
 def ecef_to_enu_err(x, y, z, tx, ty, tz, lat, lon):
     la, lo = math.radians(lat), math.radians(lon)
@@ -52,7 +53,7 @@ def truth_at(tr, tow):
 def run(sim, mode, out, extra=()):
     cmd = [GPSRX, "run", f"{sim}/signal.sigmf-meta", "--nav", NAV, "--allow-unhealthy",
            "--tracking", mode, "--out", out, "--json", "--no-plots", *extra,
-           *os.environ.get("VEC_EXTRA", "").split()]
+           *EXTRA]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         print(r.stderr[-2000:]); sys.exit(1)
@@ -242,7 +243,7 @@ if __name__ == "__main__" and sys.argv[1] == "gpssim-weak":
         out = f"{base}/gpssim-weak-{db}-{mode}"
         cmd = [GPSRX, "run", weak, "--format", "ci8", "--fs", "2.6e6", "--tropo", "none", "--nav", NAV,
                "--allow-unhealthy", "--tracking", mode, "--out", out, "--json", "--no-plots",
-               *os.environ.get("VEC_EXTRA", "").split()]
+               *EXTRA]
         r = subprocess.run(cmd, capture_output=True, text=True)
         if r.returncode != 0:
             print(r.stderr[-2000:]); sys.exit(1)
